@@ -1,0 +1,92 @@
+"""Run output: ``summary.json`` and snapshots ``snapshots/snap_NNNNN.npz``, with loaders.
+
+A run directory holds
+
+    summary.json              scene, method, dim, dp, h, n_particles, n_steps, wall_time_s, status, metrics, ...
+    snapshots/snap_00000.npz  one file per output time (NumPy .npz, arrays below, SI units)
+    snapshots/last_good.npz   only after a failure: the last state that was finite
+
+Snapshot arrays (N particles, d dimensions):
+
+| key       | shape     | unit          | meaning                                              |
+|-----------|-----------|---------------|------------------------------------------------------|
+| t         | ()        | s             | time                                                 |
+| x, v      | (N, d)    | m, m/s        | position, velocity                                   |
+| m         | (N,)      | kg (2D: kg/m) | mass                                                 |
+| rho       | (N,)      | kg/m^3        | density                                              |
+| p         | (N,)      | Pa            | pressure, Eq. (24)                                   |
+| S         | (N, d, d) | Pa            | deviatoric Cauchy stress (in-plane block in 2D)      |
+| S_zz      | (N,)      | Pa            | out-of-plane deviatoric stress (2D plane strain)     |
+| sigma_vm  | (N,)      | Pa            | von Mises stress sqrt(3 J2), S_zz included           |
+| X, V0     | (N, d), (N,) | m, m^d     | reference position and volume (TLSPH)                |
+| F         | (N, d, d) | -             | deformation gradient (TLSPH only)                    |
+| units     | ()        | -             | JSON string: unit of every key                       |
+"""
+from __future__ import annotations
+
+import json
+import os
+from pathlib import Path
+
+import numpy as np
+
+from .material import eos_pressure, von_mises
+from .state import FIELD_UNITS, State
+
+__all__ = ["save_snapshot", "load_snapshot", "load_run", "write_json", "SNAPSHOT_UNITS"]
+
+SNAPSHOT_UNITS = dict(FIELD_UNITS, p="Pa", sigma_vm="Pa", F="1")
+
+
+def save_snapshot(path, state: State, material, F: np.ndarray | None = None) -> None:
+    """Write one snapshot (atomically: a crash never leaves a half-written file)."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    arrays = dict(
+        t=np.float64(state.t), x=state.x, v=state.v, m=state.m, rho=state.rho,
+        p=eos_pressure(state.rho, material.rho0, material.K), S=state.S, S_zz=state.S_zz,
+        sigma_vm=von_mises(state.S, state.S_zz), X=state.X, V0=state.V0,
+    )
+    if F is not None:
+        arrays["F"] = F
+    units = {k: SNAPSHOT_UNITS[k] for k in arrays}
+    tmp = path.with_name(path.name + ".tmp.npz")
+    np.savez(tmp, units=json.dumps(units), **arrays)
+    os.replace(tmp, path)
+
+
+def load_snapshot(path) -> dict:
+    """Snapshot as a dict of arrays (``t`` a float, ``units`` a dict)."""
+    with np.load(path, allow_pickle=False) as z:
+        out = {k: z[k] for k in z.files}
+    out["units"] = json.loads(str(out["units"]))
+    out["t"] = float(out["t"])
+    return out
+
+
+def load_run(directory) -> tuple[dict, list[Path]]:
+    """(summary dict, sorted list of snapshot paths) of a run directory."""
+    directory = Path(directory)
+    with open(directory / "summary.json") as f:
+        summary = json.load(f)
+    snaps = sorted((directory / "snapshots").glob("snap_*.npz"))
+    return summary, snaps
+
+
+def _default(o):
+    if isinstance(o, np.ndarray):
+        return o.tolist()
+    if isinstance(o, (np.floating, np.integer, np.bool_)):
+        return o.item()
+    raise TypeError(f"not JSON serialisable: {type(o)}")
+
+
+def write_json(path, data: dict) -> None:
+    """Write JSON atomically (temporary file, then rename)."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_name(path.name + ".tmp")
+    with open(tmp, "w") as f:
+        json.dump(data, f, indent=2, default=_default)
+        f.write("\n")
+    os.replace(tmp, path)

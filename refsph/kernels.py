@@ -1,0 +1,146 @@
+"""Smoothing kernels W(r, h) and their radial derivatives.
+
+Both kernels have compact support r <= 2h, so a neighbour search radius of 2h is enough.
+
+* :class:`CubicSpline` -- the cubic B-spline of Islam, Bansal & Peng, Eq. (9):
+
+      W(q, h) = alpha_d * { 1 - 3/2 q^2 + 3/4 q^3   for 0 <= q <= 1
+                          { 1/4 (2 - q)^3           for 1 <= q <= 2
+                          { 0                       otherwise,
+      q = |x_i - x_j| / h,  alpha_2 = 10 / (7 pi h^2),  alpha_3 = 1 / (pi h^3).
+
+* :class:`WendlandC2` -- the Wendland C2 kernel (Wendland 1995; normalisation for support 2h as in
+  Dehnen & Aly 2012, MNRAS 425, 1068), used by the second paper (Rodriguez Prieto et al.):
+
+      W(q, h) = alpha_d (1 - q/2)^4 (2 q + 1)   for 0 <= q <= 2,
+      alpha_2 = 7 / (4 pi h^2),  alpha_3 = 21 / (16 pi h^3).
+
+The gradient with respect to x_i is  grad_i W(x_ij) = (dW/dr) x_ij / r  with x_ij = x_i - x_j;
+it points from i towards j (dW/dr < 0), and grad_j W(x_ji) = -grad_i W(x_ij).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ["Kernel", "CubicSpline", "WendlandC2", "KERNELS", "get_kernel"]
+
+
+def _check_dim(dim: int) -> None:
+    if dim not in (2, 3):
+        raise ValueError(f"dim must be 2 or 3, got {dim!r}")
+
+
+class Kernel:
+    """Radial kernel with compact support ``support * h``. Subclasses give f(q), f'(q) and alpha_d."""
+
+    name: str = ""
+    support: float = 2.0  # in units of h
+
+    def alpha(self, h: float, dim: int) -> float:
+        raise NotImplementedError
+
+    def f(self, q: np.ndarray) -> np.ndarray:
+        raise NotImplementedError
+
+    def df(self, q: np.ndarray) -> np.ndarray:
+        raise NotImplementedError
+
+    def w(self, r, h: float, dim: int) -> np.ndarray:
+        """W(r, h) = alpha_d f(r / h)."""
+        _check_dim(dim)
+        return self.alpha(h, dim) * self.f(np.asarray(r, dtype=float) / h)
+
+    def dw_dr(self, r, h: float, dim: int) -> np.ndarray:
+        """dW/dr = alpha_d f'(r / h) / h."""
+        _check_dim(dim)
+        return self.alpha(h, dim) / h * self.df(np.asarray(r, dtype=float) / h)
+
+    def dw_dr_over_r(self, r, h: float, dim: int) -> np.ndarray:
+        """(dW/dr) / r, finite at r = 0 (f'(q) ~ q there), so that grad W = (dW/dr / r) x_ij."""
+        _check_dim(dim)
+        q = np.asarray(r, dtype=float) / h
+        return self.alpha(h, dim) / (h * h) * self.df_over_q(q)
+
+    def df_over_q(self, q: np.ndarray) -> np.ndarray:
+        q = np.asarray(q, dtype=float)
+        out = np.empty_like(q)
+        small = q < 1e-12
+        out[~small] = self.df(q[~small]) / q[~small]
+        out[small] = self.df_over_q_at_zero
+        return out
+
+    df_over_q_at_zero: float = 0.0
+
+    def grad(self, xij: np.ndarray, h: float, dim: int) -> np.ndarray:
+        """grad_i W(x_ij) = (dW/dr) x_ij / r for separation vectors x_ij of shape (M, dim)."""
+        xij = np.asarray(xij, dtype=float)
+        r = np.sqrt(np.einsum("pk,pk->p", xij, xij))
+        return self.dw_dr_over_r(r, h, dim)[:, None] * xij
+
+
+class CubicSpline(Kernel):
+    """Cubic B-spline, Eq. (9) of Islam, Bansal & Peng."""
+
+    name = "cubic"
+    df_over_q_at_zero = -3.0
+
+    def alpha(self, h: float, dim: int) -> float:
+        _check_dim(dim)
+        return 10.0 / (7.0 * np.pi * h**2) if dim == 2 else 1.0 / (np.pi * h**3)
+
+    def f(self, q):
+        q = np.asarray(q, dtype=float)
+        t = np.clip(2.0 - q, 0.0, None)
+        inner = 1.0 - 1.5 * q**2 + 0.75 * q**3
+        return np.where(q <= 1.0, inner, 0.25 * t**3)
+
+    def df(self, q):
+        q = np.asarray(q, dtype=float)
+        t = np.clip(2.0 - q, 0.0, None)
+        return np.where(q <= 1.0, -3.0 * q + 2.25 * q**2, -0.75 * t**2)
+
+    def df_over_q(self, q):
+        # f'(q)/q without the division: -3 + 9/4 q (q <= 1), -3/4 (2-q)^2 / q (1 < q <= 2)
+        q = np.asarray(q, dtype=float)
+        t = np.clip(2.0 - q, 0.0, None)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            outer = -0.75 * t * t / q
+        return np.where(q <= 1.0, -3.0 + 2.25 * q, outer)
+
+
+class WendlandC2(Kernel):
+    """Wendland C2 kernel with support 2h (Dehnen & Aly 2012 normalisation)."""
+
+    name = "wendland"
+    df_over_q_at_zero = -5.0
+
+    def alpha(self, h: float, dim: int) -> float:
+        _check_dim(dim)
+        return 7.0 / (4.0 * np.pi * h**2) if dim == 2 else 21.0 / (16.0 * np.pi * h**3)
+
+    def f(self, q):
+        q = np.asarray(q, dtype=float)
+        t = np.clip(1.0 - 0.5 * q, 0.0, None)
+        return t**4 * (2.0 * q + 1.0)
+
+    def df(self, q):
+        # d/dq [(1 - q/2)^4 (2q + 1)] = -5 q (1 - q/2)^3
+        q = np.asarray(q, dtype=float)
+        t = np.clip(1.0 - 0.5 * q, 0.0, None)
+        return -5.0 * q * t**3
+
+    def df_over_q(self, q):
+        q = np.asarray(q, dtype=float)
+        t = np.clip(1.0 - 0.5 * q, 0.0, None)
+        return -5.0 * t**3
+
+
+KERNELS = {"cubic": CubicSpline(), "wendland": WendlandC2()}
+
+
+def get_kernel(name: str) -> Kernel:
+    """Kernel by name: 'cubic' (Eq. 9) or 'wendland'."""
+    try:
+        return KERNELS[name]
+    except KeyError:
+        raise ValueError(f"unknown kernel {name!r}; choose one of {sorted(KERNELS)}") from None

@@ -1,0 +1,108 @@
+"""Particle state: a dataclass of arrays, SI units.
+
+Shapes: N particles in d = 2 or 3 dimensions. In 2D every extensive quantity is per unit thickness
+(mass in kg/m, volume in m^2) and the model is plane strain: the out-of-plane strain rate is zero but the
+out-of-plane normal stress is not, so the deviatoric stress carries its zz component ``S_zz``. Dropping it
+(as some codes do) makes the pressure p = -(s_xx + s_yy + s_zz)/3 + ... and the von Mises stress wrong.
+
+| field | shape     | unit            | meaning                                                  |
+|-------|-----------|-----------------|----------------------------------------------------------|
+| x     | (N, d)    | m               | current position                                         |
+| v     | (N, d)    | m/s             | velocity                                                 |
+| m     | (N,)      | kg (2D: kg/m)   | mass, constant                                           |
+| rho   | (N,)      | kg/m^3          | density (ESPH: integrated by Eq. 10; TLSPH: m/(J V0))    |
+| S     | (N, d, d) | Pa              | deviatoric Cauchy stress (in-plane block in 2D)          |
+| S_zz  | (N,)      | Pa              | out-of-plane deviatoric normal stress (2D plane strain; zero and unused in 3D) |
+| X     | (N, d)    | m               | reference position (TLSPH; the initial position for ESPH)|
+| V0    | (N,)      | m^3 (2D: m^2)   | reference volume (TLSPH; V <- J V at a reference update) |
+| t     | scalar    | s               | time                                                     |
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, fields, replace
+
+import numpy as np
+
+__all__ = ["State", "FIELD_UNITS", "make_state"]
+
+FIELD_UNITS = {
+    "x": "m",
+    "v": "m/s",
+    "m": "kg (2D: kg per metre of thickness)",
+    "rho": "kg/m^3",
+    "S": "Pa",
+    "S_zz": "Pa",
+    "X": "m",
+    "V0": "m^3 (2D: m^2)",
+    "t": "s",
+}
+
+
+@dataclass
+class State:
+    x: np.ndarray
+    v: np.ndarray
+    m: np.ndarray
+    rho: np.ndarray
+    S: np.ndarray
+    S_zz: np.ndarray
+    X: np.ndarray
+    V0: np.ndarray
+    t: float = 0.0
+
+    @property
+    def n(self) -> int:
+        return self.x.shape[0]
+
+    @property
+    def dim(self) -> int:
+        return self.x.shape[1]
+
+    def copy(self) -> "State":
+        return replace(self, **{f.name: np.array(getattr(self, f.name), copy=True)
+                                for f in fields(self) if f.name != "t"})
+
+    def check(self) -> None:
+        """Shapes and finiteness; raises ValueError naming the offending field."""
+        n, d = self.x.shape
+        if d not in (2, 3):
+            raise ValueError(f"x must have shape (N, 2) or (N, 3), got {self.x.shape}")
+        expect = {"v": (n, d), "m": (n,), "rho": (n,), "S": (n, d, d), "S_zz": (n,),
+                  "X": (n, d), "V0": (n,)}
+        for name, shape in expect.items():
+            a = getattr(self, name)
+            if a.shape != shape:
+                raise ValueError(f"state field {name} must have shape {shape}, got {a.shape}")
+        for name in ("m", "rho", "V0"):
+            if np.any(getattr(self, name) <= 0):
+                raise ValueError(f"state field {name} must be positive everywhere")
+
+    def first_nonfinite(self) -> tuple[str, int] | None:
+        """(field, particle index) of the first NaN/inf in an evolving field, or None."""
+        for name in ("x", "v", "rho", "S", "S_zz"):
+            a = getattr(self, name)
+            bad = ~np.isfinite(a.reshape(a.shape[0], -1)).all(axis=1)
+            if bad.any():
+                return name, int(np.flatnonzero(bad)[0])
+        return None
+
+
+def make_state(x: np.ndarray, v: np.ndarray, rho0: float, volume: np.ndarray | float) -> State:
+    """A stress-free state at rest density ``rho0``: m = rho0 V, X = x, V0 = V."""
+    x = np.array(x, dtype=float)
+    n, d = x.shape
+    V = np.broadcast_to(np.asarray(volume, dtype=float), (n,)).copy()
+    if np.any(V <= 0):
+        raise ValueError("particle volume must be positive")
+    if not rho0 > 0:
+        raise ValueError(f"rho0 must be positive, got {rho0!r}")
+    return State(
+        x=x,
+        v=np.broadcast_to(np.asarray(v, dtype=float), (n, d)).copy(),
+        m=rho0 * V,
+        rho=np.full(n, float(rho0)),
+        S=np.zeros((n, d, d)),
+        S_zz=np.zeros(n),
+        X=x.copy(),
+        V0=V,
+    )

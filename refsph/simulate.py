@@ -125,6 +125,11 @@ def simulate(setup: Setup, method: str, *, scene=None, out=None, dt: float | Non
     if record_every is None:
         dt_est = dt if dt is not None else cfl_time_step(state, setup.material, setup.h, setup.numerics.courant)
         record_every = max(1, int(setup.t_end / dt_est / 400))
+    if dt is not None:
+        dt_cfl = cfl_time_step(state, setup.material, setup.h, setup.numerics.courant)
+        if dt > dt_cfl:
+            print(f"refsph: warning: fixed dt = {dt:.3e} s exceeds the CFL estimate {dt_cfl:.3e} s "
+                  f"(Courant {setup.numerics.courant}); the run may become unstable", file=sys.stderr)
     record(state)
     maybe_snapshot(state)
     tag = label or f"{summary['scene']} {method} {state.dim}D"
@@ -134,7 +139,8 @@ def simulate(setup: Setup, method: str, *, scene=None, out=None, dt: float | Non
                                                                setup.numerics.courant)
             step_dt = min(step_dt, setup.t_end - state.t)
             prev = state
-            state = predictor_corrector_step(state, solver, step_dt)
+            with np.errstate(divide="ignore", invalid="ignore", over="ignore"):  # non-finite: caught below
+                state = predictor_corrector_step(state, solver, step_dt)
             n_steps += 1
             dts.append(step_dt)
             if not (np.isfinite(state.v).all() and np.isfinite(state.x).all()):

@@ -1,0 +1,89 @@
+"""The run driver, CLI and output files: validation, summary and snapshots, failure handling."""
+import json
+
+import numpy as np
+import pytest
+
+from refsph import load_run, load_snapshot
+from refsph.cli import main
+from refsph.material import ElasticMaterial
+from refsph.scenes import get_scene
+from refsph.simulate import SimulationError, run, simulate
+
+REQUIRED = {"scene", "method", "dim", "dp", "n_particles", "n_steps", "wall_time_s", "metrics"}
+
+
+@pytest.mark.parametrize("method", ["esph", "tlsph"])
+def test_run_writes_summary_and_snapshots(tmp_path, method):
+    out = tmp_path / "run"
+    res = run("bar", method, quick=True, t_end=2e-6, out=out, progress=False)
+    summary, snaps = load_run(out)
+    assert REQUIRED <= set(summary)
+    assert summary["status"] == "ok"
+    assert summary["n_particles"] == res.state.n and summary["n_steps"] > 0
+    assert summary["method"] == method and summary["dim"] == 2
+    assert len(snaps) == get_scene("bar").build(2, summary["dp"], True).n_snapshots + 1
+    last = load_snapshot(snaps[-1])
+    assert last["t"] == pytest.approx(2e-6)
+    np.testing.assert_allclose(last["x"], res.state.x)
+    assert last["units"]["x"] == "m" and last["units"]["p"] == "Pa"
+    assert ("F" in last) == (method == "tlsph")
+    for key in ("x", "v", "m", "rho", "p", "S", "S_zz", "sigma_vm", "X", "V0"):
+        assert key in last
+
+
+def test_nan_stops_and_keeps_last_good(tmp_path):
+    out = tmp_path / "bad"
+    setup = get_scene("bar").build(2, get_scene("bar").default_dp(2, True), True)
+    setup.t_end = 2e-5                           # a fixed dt 5 x above the CFL limit blows TLSPH up
+    with pytest.raises(SimulationError, match=r"non-finite .* at particle \d+ in step \d+"):
+        simulate(setup, "tlsph", scene=get_scene("bar"), out=out, dt=8e-8, progress=False)
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["status"] == "nan" and "step" in summary["error"]
+    good = load_snapshot(out / "snapshots" / "last_good.npz")
+    assert np.isfinite(good["x"]).all() and np.isfinite(good["v"]).all()
+
+
+@pytest.mark.parametrize("kwargs, word", [
+    (dict(dp=-1e-3), "dp"), (dict(dp=0.0), "dp"), (dict(t_end=-1.0), "t_end"), (dict(dt=0.0), "dt"),
+    (dict(dim=4), "dim"), (dict(numerics={"h_over_dp": 0.8}), "h"), (dict(numerics={"bogus": 1}), "bogus"),
+])
+def test_bad_input_names_the_parameter(kwargs, word):
+    with pytest.raises(ValueError, match=word):
+        run("bar", "esph", quick=True, progress=False, **kwargs)
+
+
+def test_unknown_scene_and_method():
+    with pytest.raises(ValueError, match="unknown scene 'nope'"):
+        run("nope", "esph")
+    with pytest.raises(ValueError, match="unknown method 'fem'"):
+        run("bar", "fem")
+
+
+@pytest.mark.parametrize("d, missing", [({"rho0": 1.0, "E": 1.0}, "nu"), ({"E": 1.0, "nu": 0.3}, "rho0"),
+                                        ({"rho0": 1.0, "G": 1.0}, "K")])
+def test_missing_material_constant(d, missing):
+    with pytest.raises(ValueError, match=missing):
+        ElasticMaterial.from_dict(d)
+
+
+def test_material_constants_have_no_defaults():
+    with pytest.raises(TypeError):
+        ElasticMaterial(rho0=7830.0, E=207e9)  # nu missing
+    with pytest.raises(ValueError, match="nu"):
+        ElasticMaterial(rho0=7830.0, E=207e9, nu=0.5)
+    m = ElasticMaterial.from_shear_bulk(7830.0, 82.9e9, 169.1e9)
+    assert m.G == pytest.approx(82.9e9) and m.K == pytest.approx(169.1e9)
+
+
+def test_cli_list_and_run(tmp_path, capsys):
+    assert main(["list"]) == 0
+    assert "bar" in capsys.readouterr().out
+    out = tmp_path / "cli"
+    assert main(["run", "bar", "--method", "tlsph", "--quick", "--t-end", "1e-6", "--out", str(out),
+                 "--quiet"]) == 0
+    text = capsys.readouterr().out
+    assert "particles" in text and (out / "summary.json").exists()
+    assert main(["run", "nope"]) == 2
+    assert main(["run", "bar", "--dp", "-1", "--out", str(tmp_path / "x")]) == 2
+    assert "dp" in capsys.readouterr().err

@@ -11,7 +11,8 @@ Per half pair (i, j), with x_ij = x_i - x_j, v_ij = v_i - v_j and grad_i W_ij = 
               zero when p_i > 0 and p_j > 0 (both in compression)
 
 Every pair term is symmetric (Eq. 10, 23) or antisymmetric (Eq. 11) under i <-> j, so it is computed
-once per half pair and added to both particles: linear momentum is conserved to round-off.
+once per half pair and added to both particles: linear momentum is conserved to round-off. The adding is
+done by :class:`~refsph.neighbours.PairSum` (two sparse products per sum, the pair values as matrix entries).
 The velocity gradient (Eq. 23) is exact for a linear velocity field only where the kernel support is
 full; at a free surface it is not (no correction is applied in ESPH, as in the paper).
 """
@@ -23,8 +24,9 @@ import numpy as np
 
 from .kernels import Kernel
 from .material import ElasticMaterial, cauchy_stress, eos_pressure, jaumann_deviatoric_rate
-from .neighbours import scatter_add
+from .neighbours import PairSum
 from .state import State
+from .tensor import empty, rowdot
 
 __all__ = ["ESPHParams", "Rates", "esph_rates", "artificial_viscosity", "artificial_pressure",
            "velocity_gradient", "continuity_rate"]
@@ -66,60 +68,97 @@ def artificial_viscosity(vr, r2, rho_bar, c_bar, h, beta1, beta2, eps):
     return (-beta1 * c_bar * mu + beta2 * mu * mu) / rho_bar
 
 
+def _power(w, n):
+    """w**n; by repeated multiplication for small integer n (np.power calls pow() per element: ~10x slower)."""
+    if float(n).is_integer() and 1 <= n <= 8:
+        out = w
+        for _ in range(int(n) - 1):
+            out = out * w
+        return out
+    return w**n
+
+
 def artificial_pressure(p_i, p_j, rho_i, rho_j, w_ratio, gamma, n):
     """Eq. (14): p^a_ij = gamma (|p_i|/rho_i^2 + |p_j|/rho_j^2) (W_ij / W(dp))^n, 0 if p_i > 0 and p_j > 0."""
-    pa = gamma * (np.abs(p_i) / rho_i**2 + np.abs(p_j) / rho_j**2) * w_ratio**n
-    return np.where((p_i > 0) & (p_j > 0), 0.0, pa)
+    return _artificial_pressure(np.abs(p_i) / rho_i**2, np.abs(p_j) / rho_j**2, (p_i > 0) & (p_j > 0),
+                                w_ratio, gamma, n)
 
 
-def continuity_rate(I, J, m, dv_dot_gW, n):
+def _artificial_pressure(a_i, a_j, both_compressed, w_ratio, gamma, n):
+    """Eq. (14) from a = |p| / rho^2 of both particles: gamma (a_i + a_j) (W_ij / W(dp))^n, 0 if both p > 0."""
+    pa = gamma * (a_i + a_j) * _power(w_ratio, n)
+    np.putmask(pa, both_compressed, 0.0)
+    return pa
+
+
+def continuity_rate(I, J, m, dv_dot_gW, n, pairs: PairSum | None = None):
     """Eq. (10): d rho_i/dt = sum_j m_j v_ij . grad_i W_ij (symmetric pair term)."""
-    return np.bincount(I, m[J] * dv_dot_gW, minlength=n) + np.bincount(J, m[I] * dv_dot_gW, minlength=n)
+    pairs = pairs if pairs is not None else PairSum(I, J, n)
+    return pairs.symmetric(dv_dot_gW, m)
 
 
-def velocity_gradient(I, J, V, dv, gW, n):
-    """Eq. (23): l_i = -sum_j V_j v_ij (x) grad_i W_ij  (l_ab = dv_a/dx_b; symmetric pair term)."""
-    T = dv[:, :, None] * gW[:, None, :]
+def velocity_gradient(I, J, V, dv, gW, n, pairs: PairSum | None = None):
+    """Eq. (23): l_i = -sum_j V_j v_ij (x) grad_i W_ij  (l_ab = dv_a/dx_b; symmetric pair term).
+
+    Returned component-major (see :mod:`refsph.tensor`)."""
+    pairs = pairs if pairs is not None else PairSum(I, J, n)
     d = dv.shape[1]
-    T = T.reshape(len(I), d * d)
-    l = scatter_add(I, V[J][:, None] * T, n) + scatter_add(J, V[I][:, None] * T, n)
-    return -l.reshape(n, d, d)
+    l = empty(n, d)
+    for a in range(d):
+        for b in range(d):
+            l[:, a, b] = -pairs.symmetric(dv[:, a] * gW[:, b], V)
+    return l
 
 
-def esph_rates(state: State, mat: ElasticMaterial, prm: ESPHParams, I: np.ndarray, J: np.ndarray) -> Rates:
-    """All ESPH time derivatives for half pairs (I, J) (pairs beyond 2h contribute zero)."""
+def esph_rates(state: State, mat: ElasticMaterial, prm: ESPHParams, I: np.ndarray, J: np.ndarray,
+               pairs: PairSum | None = None) -> Rates:
+    """All ESPH time derivatives for half pairs (I, J) (pairs beyond 2h contribute zero).
+
+    ``pairs``: a :class:`~refsph.neighbours.PairSum` of (I, J), if the caller keeps one (it depends only on
+    the pair list); otherwise it is built here.
+    """
     n, d = state.x.shape
     x, v, m, rho = state.x, state.v, state.m, state.rho
     h = prm.h
+    pairs = pairs if pairs is not None else PairSum(I, J, n)
 
     dx = np.take(x, I, axis=0) - np.take(x, J, axis=0)
     dv = np.take(v, I, axis=0) - np.take(v, J, axis=0)
-    r2 = np.einsum("pk,pk->p", dx, dx)
+    r2 = rowdot(dx, dx)
     r = np.sqrt(r2)
     fr = prm.kernel.dw_dr_over_r(r, h, d)           # (dW/dr)/r, zero beyond 2h
-    gW = fr[:, None] * dx                           # grad_i W_ij
+    gW = np.empty((d, len(I)))                      # grad_i W_ij, one contiguous row per component
+    for k in range(d):
+        np.multiply(fr, dx[:, k], out=gW[k])
 
     # Eq. (10) and Eq. (23)
-    vr = np.einsum("pk,pk->p", dv, dx)
-    drho = continuity_rate(I, J, m, fr * vr, n)
+    vr = rowdot(dv, dx)
+    drho = continuity_rate(I, J, m, fr * vr, n, pairs)
     V = m / rho
-    l = velocity_gradient(I, J, V, dv, gW, n)
-
-    # Eq. (24) and sigma / rho^2
-    p = eos_pressure(rho, mat.rho0, mat.K)
-    sig = cauchy_stress(state.S, p) / (rho * rho)[:, None, None]
+    l = velocity_gradient(I, J, V, dv, gW.T, n, pairs)
 
     # pair scalar: artificial viscosity (Eqs. 12-13) + artificial pressure (Eq. 14)
-    rho_I, rho_J = rho[I], rho[J]
+    p = eos_pressure(rho, mat.rho0, mat.K)                              # Eq. (24)
+    rho_I, rho_J = np.take(rho, I), np.take(rho, J)
     pi = artificial_viscosity(vr, r2, 0.5 * (rho_I + rho_J), mat.c0, h, prm.beta1, prm.beta2, prm.eps)
     if prm.gamma > 0.0:
         w_ratio = prm.kernel.w(r, h, d) / prm.kernel.w(prm.dp, h, d)
-        pi = pi + artificial_pressure(p[I], p[J], rho_I, rho_J, w_ratio, prm.gamma, prm.n_ap)
+        a_p, compressed = np.abs(p) / (rho * rho), p > 0                  # per particle, gathered per pair
+        pi += _artificial_pressure(np.take(a_p, I), np.take(a_p, J),
+                                   np.take(compressed, I) & np.take(compressed, J), w_ratio, prm.gamma, prm.n_ap)
 
-    # Eq. (11): f_p = (sigma_i/rho_i^2 + sigma_j/rho_j^2) gW - (pi + p^a) gW
-    sig_sum = np.take(sig, I, axis=0) + np.take(sig, J, axis=0)
-    f = np.einsum("pab,pb->pa", sig_sum, gW) - pi[:, None] * gW
-    a = scatter_add(I, m[J][:, None] * f, n) - scatter_add(J, m[I][:, None] * f, n)
+    # Eq. (11) with s = sigma / rho^2, the stress term split in an i-side and a j-side sum (as in TLSPH's
+    # ReferenceOperator.momentum_sum), so that no pair array of d x d stresses is gathered:
+    #   a_i = sum_j m_j (s_i + s_j) gW_ij - sum_j m_j (pi_ij + p^a_ij) gW_ij
+    #       = s_i . (sum_j m_j gW_ij)  +  sum_j m_j s_j gW_ij  -  sum_j m_j (pi_ij + p^a_ij) gW_ij
+    # Every term is antisymmetric in (i, j): momentum is conserved to round-off.
+    s = cauchy_stress(state.S, p) / (rho * rho)[:, None, None]
+    a = np.empty((d, n))
+    mgW = [pairs.antisymmetric(gW[b], m) for b in range(d)]           # sum_j m_j gW_ij (antisymmetric)
+    for c in range(d):
+        a[c] = -pairs.antisymmetric(pi * gW[c], m)
+        for b in range(d):
+            a[c] += s[:, c, b] * mgW[b] + pairs.antisymmetric(gW[b], m * s[:, c, b])
 
     dS, dS_zz = jaumann_deviatoric_rate(state.S, state.S_zz, l, mat.G)
-    return Rates(x=v.copy(), v=a, rho=drho, S=dS, S_zz=dS_zz)
+    return Rates(x=v.copy(), v=a.T, rho=drho, S=dS, S_zz=dS_zz)

@@ -22,7 +22,7 @@ import numpy as np
 
 from .esph import ESPHParams, Rates, esph_rates
 from .material import ElasticMaterial
-from .neighbours import VerletList
+from .neighbours import PairSum, VerletList
 from .state import State
 from .tensor import det
 from .tlsph import ReferenceOperator, TLSPHParams, green_lagrange_norm, reference_update, tlsph_rates
@@ -39,6 +39,8 @@ class ESPHSolver:
     def __init__(self, material: ElasticMaterial, params: ESPHParams, skin_factor: float = 0.3):
         self.material, self.params = material, params
         self.pairs = VerletList(params.kernel.support * params.h, skin_factor * params.h)
+        self._pair_sum: PairSum | None = None              # sparse pattern of the current pair list
+        self._pair_sum_build = -1
 
     @property
     def h(self) -> float:
@@ -46,7 +48,9 @@ class ESPHSolver:
 
     def rates(self, state: State) -> Rates:
         I, J = self.pairs.update(state.x)
-        return esph_rates(state, self.material, self.params, I, J)
+        if self._pair_sum_build != self.pairs.n_builds:
+            self._pair_sum, self._pair_sum_build = PairSum(I, J, state.n), self.pairs.n_builds
+        return esph_rates(state, self.material, self.params, I, J, pairs=self._pair_sum)
 
     def after_step(self, state: State) -> State:
         return state
@@ -65,6 +69,7 @@ class TLSPHSolver:
         self.material, self.params = material, params
         self.op: ReferenceOperator | None = None
         self.n_reference_updates = 0
+        self._F_after_step: tuple | None = None
 
     @property
     def h(self) -> float:
@@ -77,13 +82,17 @@ class TLSPHSolver:
         return self.op
 
     def rates(self, state: State) -> Rates:
-        return tlsph_rates(state, self.material, self.params, self.operator(state))
+        op = self.operator(state)
+        return tlsph_rates(state, self.material, self.params, op, F=self._F_from_after_step(state, op))
 
     def deformation_gradient(self, state: State) -> np.ndarray:
         return self.operator(state).deformation_gradient(state.x)
 
     def after_step(self, state: State) -> State:
-        """rho = m / (J V0) (Eq. 2); reference update when max |E| > ref_update_strain."""
+        """rho = m / (J V0) (Eq. 2); reference update when max |E| > ref_update_strain.
+
+        The F computed here is kept for the first rate evaluation of the next step, which starts from this
+        very configuration (it is used only if x is unchanged, checked element by element)."""
         op = self.operator(state)
         F = op.deformation_gradient(state.x)
         state.rho = state.m / (det(F) * state.V0)
@@ -91,11 +100,22 @@ class TLSPHSolver:
         if thr is not None and float(np.max(green_lagrange_norm(F))) > thr:
             state, self.op = reference_update(state, op)
             self.n_reference_updates += 1
+            self._F_after_step = None
+        else:
+            self._F_after_step = (op, state.x.copy(), F)
         return state
+
+    def _F_from_after_step(self, state: State, op: ReferenceOperator) -> np.ndarray | None:
+        """The F of the last after_step if it belongs to this operator and these positions (used once)."""
+        known, self._F_after_step = self._F_after_step, None
+        if known is not None and known[0] is op and np.array_equal(known[1], state.x):
+            return known[2]
+        return None
 
     def diagnostics(self) -> dict:
         return {"reference_updates": self.n_reference_updates,
-                "n_pairs": int(self.op.n_pairs) if self.op is not None else 0}
+                "n_pairs": int(self.op.n_pairs) if self.op is not None else 0,
+                "degenerate_correction_particles": int(len(self.op.degenerate)) if self.op is not None else 0}
 
 
 def _advance(state: State, rates: Rates, dt: float, evolved) -> State:

@@ -88,21 +88,22 @@ class CubicSpline(Kernel):
         _check_dim(dim)
         return 10.0 / (7.0 * np.pi * h**2) if dim == 2 else 1.0 / (np.pi * h**3)
 
+    # Powers are written as products: q**3 on an array calls pow() per element, ~10x slower.
     def f(self, q):
         q = np.asarray(q, dtype=float)
-        t = np.clip(2.0 - q, 0.0, None)
-        inner = 1.0 - 1.5 * q**2 + 0.75 * q**3
-        return np.where(q <= 1.0, inner, 0.25 * t**3)
+        t = np.maximum(2.0 - q, 0.0)
+        inner = 1.0 - q * q * (1.5 - 0.75 * q)              # 1 - 3/2 q^2 + 3/4 q^3
+        return np.where(q <= 1.0, inner, 0.25 * t * t * t)
 
     def df(self, q):
         q = np.asarray(q, dtype=float)
-        t = np.clip(2.0 - q, 0.0, None)
-        return np.where(q <= 1.0, -3.0 * q + 2.25 * q**2, -0.75 * t**2)
+        t = np.maximum(2.0 - q, 0.0)
+        return np.where(q <= 1.0, q * (2.25 * q - 3.0), -0.75 * t * t)
 
     def df_over_q(self, q):
         # f'(q)/q without the division: -3 + 9/4 q (q <= 1), -3/4 (2-q)^2 / q (1 < q <= 2)
         q = np.asarray(q, dtype=float)
-        t = np.clip(2.0 - q, 0.0, None)
+        t = np.maximum(2.0 - q, 0.0)
         with np.errstate(divide="ignore", invalid="ignore"):
             outer = -0.75 * t * t / q
         return np.where(q <= 1.0, -3.0 + 2.25 * q, outer)
@@ -120,19 +121,20 @@ class WendlandC2(Kernel):
 
     def f(self, q):
         q = np.asarray(q, dtype=float)
-        t = np.clip(1.0 - 0.5 * q, 0.0, None)
-        return t**4 * (2.0 * q + 1.0)
+        t = np.maximum(1.0 - 0.5 * q, 0.0)
+        t2 = t * t
+        return t2 * t2 * (2.0 * q + 1.0)
 
     def df(self, q):
         # d/dq [(1 - q/2)^4 (2q + 1)] = -5 q (1 - q/2)^3
         q = np.asarray(q, dtype=float)
-        t = np.clip(1.0 - 0.5 * q, 0.0, None)
-        return -5.0 * q * t**3
+        t = np.maximum(1.0 - 0.5 * q, 0.0)
+        return -5.0 * q * t * t * t
 
     def df_over_q(self, q):
         q = np.asarray(q, dtype=float)
-        t = np.clip(1.0 - 0.5 * q, 0.0, None)
-        return -5.0 * t**3
+        t = np.maximum(1.0 - 0.5 * q, 0.0)
+        return -5.0 * t * t * t
 
 
 KERNELS = {"cubic": CubicSpline(), "wendland": WendlandC2()}

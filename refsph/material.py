@@ -20,6 +20,8 @@ import math
 
 import numpy as np
 
+from .tensor import component_major, matmul, transpose
+
 __all__ = [
     "ElasticMaterial",
     "eos_pressure",
@@ -113,7 +115,7 @@ def eos_pressure(rho: np.ndarray, rho0: float, K: float) -> np.ndarray:
 
 def strain_rate_and_spin(l: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Eqs. (21)-(22): eps_dot = (l + l^T)/2, omega = (l - l^T)/2, for l of shape (N, d, d)."""
-    lT = np.swapaxes(l, 1, 2)
+    lT = transpose(l)
     return 0.5 * (l + lT), 0.5 * (l - lT)
 
 
@@ -121,28 +123,42 @@ def jaumann_deviatoric_rate(S: np.ndarray, S_zz: np.ndarray, l: np.ndarray, G: f
     """Eq. (20): s_dot = 2 G (eps_dot - tr(eps_dot)/3 I) + omega s - s omega.
 
     S is the (N, d, d) deviatoric stress, S_zz the plane-strain out-of-plane component (2D), l the
-    velocity gradient l_ab = dv_a/dx_b. Returns (dS, dS_zz). In 3D dS_zz is zero (S_zz unused).
+    velocity gradient l_ab = dv_a/dx_b. Returns (dS, dS_zz), dS stored component-major (see
+    :mod:`refsph.tensor`). In 3D dS_zz is zero (S_zz unused).
+
+    In 2D the spin has one component, omega = [[0, w], [-w, 0]] with w = (l_01 - l_10)/2, and the
+    spin terms are written out:  omega s - s omega = w [[s_01 + s_10, s_11 - s_00], [s_11 - s_00, -(s_01 + s_10)]].
     """
     n, d, _ = l.shape
+    S = component_major(S)
+    l = component_major(l)
     eps_dot, omega = strain_rate_and_spin(l)
-    tr = np.trace(eps_dot, axis1=1, axis2=2)
+    tr = eps_dot[:, 0, 0] + eps_dot[:, 1, 1]
+    if d == 3:
+        tr += eps_dot[:, 2, 2]
     dS = 2.0 * G * eps_dot
-    idx = np.arange(d)
-    dS[:, idx, idx] -= (2.0 * G / 3.0) * tr[:, None]
-    dS += omega @ S - S @ omega
+    for a in range(d):
+        dS[:, a, a] -= (2.0 * G / 3.0) * tr
     if d == 2:
+        w = omega[:, 0, 1]
+        on_diagonal = w * (S[:, 0, 1] + S[:, 1, 0])
+        off_diagonal = w * (S[:, 1, 1] - S[:, 0, 0])
+        dS[:, 0, 0] += on_diagonal
+        dS[:, 1, 1] -= on_diagonal
+        dS[:, 0, 1] += off_diagonal
+        dS[:, 1, 0] += off_diagonal
         dS_zz = -(2.0 * G / 3.0) * tr
     else:
+        dS += matmul(omega, S) - matmul(S, omega)
         dS_zz = np.zeros(n)
     return dS, dS_zz
 
 
 def cauchy_stress(S: np.ndarray, p: np.ndarray) -> np.ndarray:
-    """sigma = s - p I (in-plane block in 2D)."""
-    sigma = S.copy()
-    d = S.shape[1]
-    idx = np.arange(d)
-    sigma[:, idx, idx] -= p[:, None]
+    """sigma = s - p I (in-plane block in 2D); a new component-major stack."""
+    sigma = component_major(S, copy=True)
+    for a in range(S.shape[1]):
+        sigma[:, a, a] -= p
     return sigma
 
 

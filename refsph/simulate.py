@@ -153,7 +153,8 @@ def simulate(setup: Setup, method: str, *, scene=None, out=None, dt: float | Non
                 summary.update(status="nan", error=msg)
                 raise SimulationError(msg)
             if n_steps % record_every == 0:
-                record(state)
+                with np.errstate(over="ignore"):
+                    record(state)
             maybe_snapshot(state)
             now = time.perf_counter()
             if progress and now - last_print > 2.0:

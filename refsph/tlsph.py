@@ -2,7 +2,9 @@
 
 Pairs, kernel gradients grad_i W(X_ij) and reference volumes V_j = m_j / rho_0j do not change until the
 reference configuration is updated, so every sum below is a product with a fixed sparse matrix
-(:class:`ReferenceOperator`), built once per reference configuration.
+(:class:`ReferenceOperator`), built once per reference configuration. The artificial viscosity, whose pair
+terms depend on the current x_ij and v_ij, is computed on the approaching pairs only and summed with the
+operator's :class:`~refsph.neighbours.PairSum` (fixed sparse pattern, new values at each evaluation).
 
     Eq. (18)  F_i     = - sum_j V_j (x_i - x_j) (x) grad_i W(X_ij)            (deformation gradient)
     Eq. (19)  Fdot_i  = - sum_j V_j (v_i - v_j) (x) grad_i W(X_ij)
@@ -38,12 +40,12 @@ import scipy.sparse as sp
 from .esph import Rates, artificial_viscosity
 from .kernels import Kernel
 from .material import ElasticMaterial, cauchy_stress, eos_pressure, jaumann_deviatoric_rate
-from .neighbours import find_pairs, scatter_add
+from .neighbours import PairSum, find_pairs, scatter_add
 from .state import State
-from .tensor import det, identity, inv
+from .tensor import component_major, det, identity, inv, matmul, rowdot, transpose
 
 __all__ = ["TLSPHParams", "ReferenceOperator", "tlsph_rates", "first_piola", "green_lagrange_norm",
-           "reference_update"]
+           "reference_update", "reference_viscosity"]
 
 
 @dataclass(frozen=True)
@@ -72,6 +74,8 @@ class ReferenceOperator:
     so that  sum_j V_j f_j (x) grad~_i W_ij = (G[k] @ f)_i  and  sum_j V_j grad~_i W_ij = G[k] @ 1.
     ``GT[k]`` is its transpose (CSR), used for the j-side term of the momentum sum (Eq. 17).
     The kernel-gradient correction L is baked into the entries, so F needs no per-step matrix product.
+    Products are taken one column at a time: SciPy's single-vector CSR product is its fastest sparse
+    kernel (about 0.5 ns per stored entry), faster than its multi-vector one.
     """
 
     def __init__(self, X: np.ndarray, V: np.ndarray, h: float, kernel: Kernel, corrected: bool):
@@ -92,18 +96,30 @@ class ReferenceOperator:
         Vg = self.V[cols][:, None] * g
         dXd = X[cols] - X[rows]
         self.M = scatter_add(rows, (dXd[:, :, None] * Vg[:, None, :]).reshape(len(rows), d * d), n).reshape(n, d, d)
-        self.L = np.swapaxes(inv(self.M), 1, 2) if corrected else identity(n, d)
+        self.L, self.degenerate = (correction_matrix(self.M) if corrected
+                                   else (identity(n, d), np.zeros(0, dtype=np.intp)))
         gc = np.einsum("pab,pb->pa", self.L[rows], g)     # corrected gradient L_row grad W
         Vgc = self.V[cols][:, None] * gc
         self.G = [sp.csr_matrix((Vgc[:, k], (rows, cols)), shape=(n, n)) for k in range(d)]
         self.GT = [Gk.T.tocsr() for Gk in self.G]
         self.s = np.stack([Gk @ np.ones(n) for Gk in self.G], axis=1)   # sum_j V_j grad~_i W_ij
+        self.pairs = PairSum(I, J, n)
         self._sm, self._sm_m = None, None
 
     def gradient(self, f: np.ndarray) -> np.ndarray:
-        """Eq. (16) with the corrected gradient: sum_j V_j (f_j - f_i) (x) grad~_i W_ij, (N, c) -> (N, c, d)."""
-        out = np.stack([Gk @ f for Gk in self.G], axis=2)  # [i, c, k]
-        return out - f[:, :, None] * self.s[:, None, :]
+        """Eq. (16) with the corrected gradient: sum_j V_j (f_j - f_i) (x) grad~_i W_ij, (N, c) -> (N, c, d).
+
+        Computed as (G[k] @ f)_i - f_i s_ik, one column of f at a time (SciPy's single-vector CSR product is
+        its fastest sparse kernel). The result is stored component-major (see :mod:`refsph.tensor`).
+        """
+        f = np.asarray(f, dtype=float)
+        n, c = f.shape
+        fT = np.ascontiguousarray(f.T)                      # fT[a]: column a of f, contiguous
+        out = np.empty((self.dim, c, n))                    # out[k, a, i]: each component contiguous
+        for k, Gk in enumerate(self.G):
+            for a in range(c):
+                np.subtract(Gk @ fT[a], fT[a] * self.s[:, k], out=out[k, a])
+        return out.transpose(2, 1, 0)
 
     def deformation_gradient(self, x: np.ndarray) -> np.ndarray:
         """Eq. (18): F_i = sum_j V_j (x_j - x_i) (x) grad~_i W(X_ij)."""
@@ -121,36 +137,96 @@ class ReferenceOperator:
             self._sm = np.stack([Gk @ rho_ref for Gk in self.G], axis=1)  # sum_j m_j grad~_i W_ij (fixed)
             self._sm_m = m
         sm = self._sm
-        mQ = m[:, None, None] * Q
-        jside = sum(self.GT[k] @ mQ[:, :, k] for k in range(self.dim))  # sum_j m_j Q_j V_i grad~_j W_ji
-        return np.einsum("nak,nk->na", Q, sm) - jside / self.V[:, None]
+        Q = component_major(Q)
+        d = self.dim
+        out = np.empty((d, self.n))                         # out[a, i]
+        for a in range(d):
+            iside = rowdot(Q[:, a, :], sm)                                  # Q_i,ak sm_ik
+            jside = self.GT[0] @ (m * Q[:, a, 0])                           # sum_j m_j Q_j,ak V_i grad~_j W_ji
+            for k in range(1, d):
+                jside += self.GT[k] @ (m * Q[:, a, k])
+            out[a] = iside - jside / self.V
+        return out.T
+
+
+def correction_matrix(M: np.ndarray, tol: float = 1e-6) -> tuple[np.ndarray, np.ndarray]:
+    """L_i = M_i^-T (Bonet & Lok 1999). Where M_i is (nearly) singular -- a particle whose neighbours do not
+    span every direction (no neighbours, a single row of particles) -- the Moore-Penrose pseudo-inverse is used
+    instead (Bonet & Lok's correction restricted to the directions the neighbours span), so the operator stays
+    finite. Returns (L, indices of those degenerate particles); F of such a particle is singular in the
+    missing direction, so a run that depends on it stops with a non-finite-state error that names it."""
+    n, d = M.shape[0], M.shape[1]
+    detM = det(M)
+    scale = np.maximum(np.abs(np.trace(M, axis1=1, axis2=2)) / d, np.finfo(float).tiny) ** d
+    bad = np.flatnonzero(~(np.abs(detM) > tol * scale))
+    safe = M.copy()
+    safe[bad] = np.eye(d)
+    L = np.swapaxes(inv(safe), 1, 2)
+    if len(bad):
+        L[bad] = np.swapaxes(np.linalg.pinv(M[bad]), 1, 2)
+    return L, bad
 
 
 def first_piola(sigma: np.ndarray, F: np.ndarray, J: np.ndarray, Finv: np.ndarray) -> np.ndarray:
     """P = J sigma F^-T (the transpose of the paper's printed J F^-1 sigma; see the module docstring)."""
-    return J[:, None, None] * sigma @ np.swapaxes(Finv, 1, 2)
+    return matmul(J[:, None, None] * sigma, transpose(Finv))
 
 
 def green_lagrange_norm(F: np.ndarray) -> np.ndarray:
     """|E|_Frobenius with E = (F^T F - I) / 2: zero for any rigid motion."""
-    E = 0.5 * (np.swapaxes(F, 1, 2) @ F)
-    idx = np.arange(F.shape[1])
-    E[:, idx, idx] -= 0.5
-    return np.sqrt(np.einsum("nab,nab->n", E, E))
+    F = component_major(F)
+    E = 0.5 * matmul(transpose(F), F)
+    for a in range(F.shape[1]):
+        E[:, a, a] -= 0.5
+    return np.sqrt(sum(E[:, a, b] ** 2 for a in range(F.shape[1]) for b in range(F.shape[1])))
+
+
+def reference_viscosity(x: np.ndarray, v: np.ndarray, m: np.ndarray, rho: np.ndarray, B: np.ndarray,
+                        op: ReferenceOperator, c0: float, prm: TLSPHParams) -> np.ndarray:
+    """Artificial viscosity of Eq. (17) in the reference frame: -sum_j m_j pi_ij (B_i + B_j)/2 grad_i W(X_ij).
+
+    pi_ij is Eqs. (12)-(13) with the current x_ij, v_ij. It is zero for receding pairs (v_ij . x_ij >= 0), so
+    v_ij . x_ij is computed on every pair and everything else only on the approaching ones (about half);
+    their pair terms are put into a per-pair array that is zero elsewhere and summed with ``op.pairs``.
+    The pair term is antisymmetric (momentum conserved to round-off). B is (N, d, d); C order is fastest
+    (its rows are gathered per pair).
+    """
+    n, d = x.shape
+    dx = np.take(x, op.I, axis=0) - np.take(x, op.J, axis=0)
+    dv = np.take(v, op.I, axis=0) - np.take(v, op.J, axis=0)
+    vr = rowdot(dx, dv)
+    k = np.flatnonzero(vr < 0.0)                            # the approaching pairs
+    I, J = np.take(op.I, k), np.take(op.J, k)
+    dx = np.take(dx, k, axis=0)
+    r2 = rowdot(dx, dx)
+    pi = artificial_viscosity(np.take(vr, k), r2, 0.5 * (np.take(rho, I) + np.take(rho, J)), c0, prm.h,
+                              prm.beta1, prm.beta2, prm.eps)
+    g = np.take(op.gW, k, axis=0)
+    Bs = np.take(B.reshape(n, d * d), I, axis=0)
+    Bs += np.take(B.reshape(n, d * d), J, axis=0)           # (B_i + B_j) on each pair, row-major (a, b)
+    pi *= -0.5
+    a = np.empty((n, d))
+    q = np.zeros(op.n_pairs)
+    for c in range(d):
+        np.put(q, k, pi * rowdot(Bs[:, c * d:(c + 1) * d], g))      # -pi_ij/2 ((B_i + B_j) grad_i W_ij)_c
+        a[:, c] = op.pairs.antisymmetric(q, m)
+    return a
 
 
 def tlsph_rates(state: State, mat: ElasticMaterial, prm: TLSPHParams, op: ReferenceOperator,
-                out: dict | None = None) -> Rates:
-    """All TLSPH time derivatives. If ``out`` is a dict, F, J, P and l are stored in it (diagnostics)."""
+                out: dict | None = None, F: np.ndarray | None = None) -> Rates:
+    """All TLSPH time derivatives. If ``out`` is a dict, F, J, P and l are stored in it (diagnostics).
+
+    ``F``: the deformation gradient of ``state.x`` on ``op`` (Eq. 18), if the caller already has it."""
     n, d = state.x.shape
     x, v, m = state.x, state.v, state.m
 
-    xv = np.concatenate([x, v], axis=1)
-    G = op.gradient(xv)                                     # Eqs. (18)-(19) in one product per direction
-    F, Fdot = G[:, :d, :], G[:, d:, :]
+    if F is None:
+        F = op.deformation_gradient(x)                      # Eq. (18)
+    Fdot = op.gradient(v)                                   # Eq. (19)
     J = det(F)
     Finv = inv(F, J)
-    l = Fdot @ Finv
+    l = matmul(Fdot, Finv)
 
     rho_ref = m / op.V                                      # reference density rho_0 = m / V
     rho = rho_ref / J                                       # Eq. (2)
@@ -163,20 +239,8 @@ def tlsph_rates(state: State, mat: ElasticMaterial, prm: TLSPHParams, op: Refere
 
     # Eq. (17), artificial viscosity: a_i -= sum_j m_j pi_ij (B_i + B_j)/2 grad_i W_ij,  B = J F^-T
     if prm.beta1 > 0 or prm.beta2 > 0:
-        I, Jp = op.I, op.J
-        dx = np.take(x, I, axis=0) - np.take(x, Jp, axis=0)
-        dv = np.take(v, I, axis=0) - np.take(v, Jp, axis=0)
-        vr = np.einsum("pk,pk->p", dv, dx)
-        k = np.flatnonzero(vr < 0.0)                        # only approaching pairs are damped
-        if len(k):
-            Ik, Jk = I[k], Jp[k]
-            r2 = np.einsum("pk,pk->p", dx[k], dx[k])
-            pi = artificial_viscosity(vr[k], r2, 0.5 * (rho[Ik] + rho[Jk]), mat.c0, prm.h,
-                                      prm.beta1, prm.beta2, prm.eps)
-            B = J[:, None, None] * np.swapaxes(Finv, 1, 2)
-            Bg = np.einsum("pab,pb->pa", np.take(B, Ik, axis=0) + np.take(B, Jk, axis=0), op.gW[k])
-            q = (0.5 * pi)[:, None] * Bg
-            a -= scatter_add(Ik, m[Jk][:, None] * q, n) - scatter_add(Jk, m[Ik][:, None] * q, n)
+        B = np.ascontiguousarray(J[:, None, None] * transpose(Finv))   # row-major: gathered per pair
+        a += reference_viscosity(x, v, m, rho, B, op, mat.c0, prm)
 
     dS, dS_zz = jaumann_deviatoric_rate(state.S, state.S_zz, l, mat.G)
     if out is not None:

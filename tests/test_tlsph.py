@@ -237,3 +237,23 @@ def test_reference_update_keeps_volume_and_resets_F():
     assert np.allclose(new.rho, st.m / (J * st.V0), rtol=1e-13)                 # density continuous
     # the original state is untouched
     assert np.array_equal(st.X, X) and np.array_equal(st.V0, V)
+
+
+def test_singular_correction_matrix_stays_finite():
+    """A particle whose neighbours do not span the plane (a single row; an isolated particle) gets the
+    pseudo-inverse correction instead of inf/NaN, and is reported as degenerate."""
+    from refsph.kernels import get_kernel
+    from refsph.tlsph import ReferenceOperator
+
+    dp = 1e-3
+    row = np.stack([np.arange(10) * dp, np.zeros(10)], axis=1)
+    lonely = np.array([[0.1, 0.1]])
+    block = np.stack(np.meshgrid(np.arange(6) * dp, np.arange(6) * dp + 0.05), -1).reshape(-1, 2)
+    X = np.concatenate([row, lonely, block])
+    op = ReferenceOperator(X, np.full(len(X), dp * dp), 1.5 * dp, get_kernel("cubic"), True)
+    assert np.isfinite(op.L).all()
+    assert set(op.degenerate.tolist()) == set(range(11))
+    # along the row the correction still reproduces an affine field exactly
+    F = op.deformation_gradient(2.0 * X)
+    np.testing.assert_allclose(F[:10, 0, 0], 2.0, rtol=1e-12)
+    np.testing.assert_allclose(F[11:], np.broadcast_to(2.0 * np.eye(2), F[11:].shape), atol=1e-12)

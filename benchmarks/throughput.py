@@ -1,0 +1,135 @@
+"""Throughput of one full elastic time step, ESPH and TLSPH, on one core.
+
+A 2D square-lattice block of AISI 4340 (rho0 = 7830 kg/m^3, E = 207 GPa, nu = 0.3), spacing dp = 0.1 mm,
+h = 1.5 dp, cubic kernel, with small random velocities (1 m/s rms per component, fixed seed, so that about
+half of the pairs approach and the artificial viscosity works), is advanced with ``predictor_corrector_step``
+(two rate evaluations + the solver's after-step work) at its CFL time step. The solvers are built exactly
+as a run builds them (``refsph.simulate.make_solver`` with the default ``refsph.scenes.Numerics``):
+artificial viscosity beta1 = beta2 = 1.5, ESPH artificial pressure gamma = 0.3, TLSPH kernel-gradient
+correction, ESPH Verlet skin 0.1 h.
+
+One warm-up step (it builds the ESPH pair list / the TLSPH reference operator) is not timed; its time is
+the column ``setup s``. Then ``--steps`` steps are timed ``--repeats`` times and the best repetition is
+reported: other work on the machine can only make a repetition slower. With velocities this small the pair
+list is not rebuilt and the reference configuration is not updated inside the timed steps.
+
+    particle-steps/s = particles x steps / wall time
+    ns/pair/step     = wall time / (steps x half pairs), half pair = (i < j) with |x_i - x_j| < 2h
+
+Usage:  python benchmarks/throughput.py [--sizes 100 200] [--steps N] [--repeats R] [--json PATH]
+"""
+from __future__ import annotations
+
+import os
+
+# one core: pin the BLAS / OpenMP thread pools before NumPy is imported (scipy.sparse is single-threaded)
+for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "BLIS_NUM_THREADS",
+             "VECLIB_MAXIMUM_THREADS", "NUMEXPR_NUM_THREADS"):
+    os.environ[_var] = "1"
+
+import argparse  # noqa: E402
+import json  # noqa: E402
+import platform  # noqa: E402
+import time  # noqa: E402
+from pathlib import Path  # noqa: E402
+
+import numpy as np  # noqa: E402
+import scipy  # noqa: E402
+
+import refsph  # noqa: E402
+from refsph.integrate import cfl_time_step, predictor_corrector_step  # noqa: E402
+from refsph.material import ElasticMaterial  # noqa: E402
+from refsph.neighbours import find_pairs  # noqa: E402
+from refsph.scenes import AISI4340_ELASTIC, Numerics, Setup, lattice  # noqa: E402
+from refsph.simulate import make_solver  # noqa: E402
+from refsph.state import make_state  # noqa: E402
+
+METHODS = ("esph", "tlsph")
+
+
+def block_setup(n_side: int, dp: float = 1.0e-4, v_rms: float = 1.0, seed: int = 2024) -> Setup:
+    """n_side x n_side lattice block of AISI 4340 with random velocities of rms ``v_rms`` per component."""
+    mat = ElasticMaterial(**AISI4340_ELASTIC)
+    x = lattice([n_side * dp, n_side * dp], dp)
+    v = v_rms * np.random.default_rng(seed).standard_normal(x.shape)
+    state = make_state(x, v, mat.rho0, dp * dp)
+    return Setup(state=state, material=mat, dp=dp, numerics=Numerics(), t_end=1.0, n_snapshots=0)
+
+
+def half_pairs_within_support(setup: Setup) -> int:
+    """Half pairs (i < j) with |x_i - x_j| < 2h: the pairs with a non-zero kernel."""
+    x = setup.state.x
+    I, J = find_pairs(x, 2.0 * setup.h)
+    r2 = np.sum((x[I] - x[J]) ** 2, axis=1)
+    return int(np.count_nonzero(r2 < (2.0 * setup.h) ** 2))
+
+
+def time_method(method: str, setup: Setup, steps: int, repeats: int) -> dict:
+    """Best-of-``repeats`` wall (and CPU) time of ``steps`` predictor-corrector steps, after one warm-up step."""
+    solver = make_solver(method, setup)
+    state = setup.state.copy()
+    dt = cfl_time_step(state, setup.material, setup.h, setup.numerics.courant)
+    t0 = time.perf_counter()
+    state = predictor_corrector_step(state, solver, dt)        # warm-up: builds the pairs / the operator
+    t_setup = time.perf_counter() - t0
+    wall, cpu = np.inf, np.inf
+    for _ in range(repeats):
+        t0, c0 = time.perf_counter(), time.process_time()
+        for _ in range(steps):
+            state = predictor_corrector_step(state, solver, dt)
+        wall = min(wall, time.perf_counter() - t0)
+        cpu = min(cpu, time.process_time() - c0)
+    if not (np.isfinite(state.v).all() and np.isfinite(state.x).all()):
+        raise RuntimeError(f"{method}: non-finite state in the benchmark run")
+    n, n_half = state.n, half_pairs_within_support(setup)
+    return dict(method=method, n_particles=n, half_pairs=n_half, pairs_per_particle=n_half / n,
+                steps=steps, repeats=repeats, wall_s=wall, cpu_s=cpu, s_per_step=wall / steps,
+                particle_steps_per_s=n * steps / wall, ns_per_pair_step=1e9 * wall / (steps * n_half),
+                setup_s=t_setup, diagnostics=solver.diagnostics())
+
+
+def main(argv=None) -> list[dict]:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--sizes", type=int, nargs="+", default=[100, 200],
+                    help="lattice side lengths (particles = side^2); default: 100 200")
+    ap.add_argument("--steps", type=int, default=None,
+                    help="timed steps per repetition (default: about 4e5 particle-steps, at least 2)")
+    ap.add_argument("--repeats", type=int, default=5, help="repetitions, the best is reported (default 5)")
+    ap.add_argument("--methods", nargs="+", default=list(METHODS), choices=METHODS)
+    ap.add_argument("--json", type=Path, default=Path(__file__).with_name("throughput.json"),
+                    help="where to write the results (default: benchmarks/throughput.json)")
+    args = ap.parse_args(argv)
+
+    print(f"refsph {refsph.__version__}, NumPy {np.__version__}, SciPy {scipy.__version__}, "
+          f"Python {platform.python_version()} on {platform.machine()}, single core "
+          f"(BLAS/OpenMP pools pinned to 1 thread; scipy.sparse is single-threaded);")
+    print("2D AISI 4340 block, h = 1.5 dp, cubic kernel, artificial viscosity 1.5/1.5, ESPH artificial "
+          "pressure 0.3, TLSPH corrected; one step = predictor-corrector (2 rate evaluations + after-step)")
+    print("pair = half pair (i < j) with |x_i - x_j| < 2h; best of the repetitions\n")
+    header = (f"{'method':6s} {'particles':>9s} {'pairs/part':>10s} {'steps':>5s} {'particle-steps/s':>16s} "
+              f"{'ns/pair/step':>12s} {'wall s':>7s} {'cpu s':>7s} {'setup s':>7s}")
+    print(header)
+    print("-" * len(header))
+    results = []
+    for side in args.sizes:
+        setup = block_setup(side)
+        n = setup.state.n
+        steps = args.steps or max(2, int(round(4e5 / n)))
+        for method in args.methods:
+            r = time_method(method, setup, steps, args.repeats)
+            results.append(r)
+            print(f"{method:6s} {n:9d} {r['pairs_per_particle']:10.2f} {steps:5d} "
+                  f"{r['particle_steps_per_s']:16.3e} {r['ns_per_pair_step']:12.1f} {r['wall_s']:7.3f} "
+                  f"{r['cpu_s']:7.3f} {r['setup_s']:7.3f}", flush=True)
+    meta = dict(refsph=refsph.__version__, numpy=np.__version__, scipy=scipy.__version__,
+                python=platform.python_version(), machine=platform.machine(), threads=1,
+                pair_definition="half pair (i < j) with |x_i - x_j| < 2h in the initial lattice",
+                timing="best of `repeats` repetitions of `steps` predictor-corrector steps, after one warm-up "
+                       "step; particle_steps_per_s and ns_per_pair_step from the wall time")
+    args.json.write_text(json.dumps(dict(meta=meta, results=results), indent=2) + "\n")
+    print(f"\nwritten {args.json}")
+    return results
+
+
+if __name__ == "__main__":
+    main()

@@ -68,8 +68,10 @@ def _repo_root() -> Path:
 
 
 ROOT = _repo_root()
-FIGDIR = ROOT / "figures"
-FIGDIR.mkdir(exist_ok=True)
+# Figures go to figures/ in the repo, or to $REFSPH_FIGURES when that is set (the tests set it to a temporary
+# folder, so a quick-mode run never overwrites the committed full-resolution figures).
+FIGDIR = Path(os.environ["REFSPH_FIGURES"]) if os.environ.get("REFSPH_FIGURES") else ROOT / "figures"
+FIGDIR.mkdir(parents=True, exist_ok=True)
 cubic, wendland = get_kernel("cubic"), get_kernel("wendland")
 KERNELS = {"cubic": cubic, "wendland": wendland}
 print(f"QUICK = {QUICK}; figures go to {FIGDIR}")

@@ -182,7 +182,7 @@ def _tension_default_dp(dim, quick):
 
 def _tension_build(dim, dp, quick):
     """Square (cubic) block in free flight with a uniform expansion v = rate (x - x_c) (edge speed 300 m/s)
-    that puts it in tension (about -9 GPa at first); a 1 % random lattice perturbation (fixed seed) seeds the
+    that puts it in tension (down to about -15 GPa in the first breathing cycle); a 1 % random lattice perturbation (fixed seed) seeds the
     tensile instability. Artificial viscosity beta1 = beta2 = 0.5 (the paper's Tables 4-5): with 1.5 the
     breathing is damped out before clumping can grow. t_end = 24 side / c_L (about 40 us)."""
     side = 10e-3

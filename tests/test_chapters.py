@@ -18,6 +18,7 @@ def test_chapter_runs_quick(path, tmp_path, monkeypatch):
     nbclient = pytest.importorskip("nbclient")
     monkeypatch.setenv("REFSPH_QUICK", "1")
     monkeypatch.setenv("MPLBACKEND", "Agg")
+    monkeypatch.setenv("REFSPH_FIGURES", str(tmp_path))      # quick-mode figures must not replace figures/
     nb = jupytext.read(path)
     client = nbclient.NotebookClient(nb, timeout=120, kernel_name="python3",
                                      resources={"metadata": {"path": str(path.parent)}})

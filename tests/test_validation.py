@@ -19,7 +19,7 @@ def test_bar_wave_speed_within_3_percent(method, dp, dim):
     strain) or sqrt(E / rho) (3D).
 
     ESPH needs 16 particles across the bar: its free-surface layers are soft (Eq. 23 is not corrected)."""
-    # artificial pressure (a tensile-instability remedy) off: it stiffens the bar in its tensile half-cycle
+    # artificial pressure (a tensile-instability remedy) off: it softens the bar in its tensile half-cycle
     res = run("bar", method, dim=dim, dp=dp, t_end=2.05 * _period(dim), numerics={"gamma": 0.0},
               progress=False)
     m = res.summary["metrics"]

@@ -31,12 +31,13 @@ __all__ = ["ESPHSolver", "TLSPHSolver", "predictor_corrector_step", "cfl_time_st
 
 
 class ESPHSolver:
-    """ESPH rates with a Verlet pair list (cutoff 2h, skin ``skin_factor * h``)."""
+    """ESPH rates with a Verlet pair list (cutoff 2h, skin ``skin_factor * h``; the scenes' value is
+    ``Numerics.skin_factor``)."""
 
     method = "esph"
     evolved = ("x", "v", "rho", "S", "S_zz")
 
-    def __init__(self, material: ElasticMaterial, params: ESPHParams, skin_factor: float = 0.3):
+    def __init__(self, material: ElasticMaterial, params: ESPHParams, skin_factor: float):
         self.material, self.params = material, params
         self.pairs = VerletList(params.kernel.support * params.h, skin_factor * params.h)
         self._pair_sum: PairSum | None = None              # sparse pattern of the current pair list
@@ -98,7 +99,7 @@ class TLSPHSolver:
         state.rho = state.m / (det(F) * state.V0)
         thr = self.params.ref_update_strain
         if thr is not None and float(np.max(green_lagrange_norm(F))) > thr:
-            state, self.op = reference_update(state, op)
+            state, self.op = reference_update(state, op, F)
             self.n_reference_updates += 1
             self._F_after_step = None
         else:

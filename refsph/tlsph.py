@@ -248,9 +248,13 @@ def tlsph_rates(state: State, mat: ElasticMaterial, prm: TLSPHParams, op: Refere
     return Rates(x=v.copy(), v=a, rho=None, S=dS, S_zz=dS_zz)
 
 
-def reference_update(state: State, op: ReferenceOperator) -> tuple[State, ReferenceOperator]:
-    """X <- x, V <- J V (Section 3); stress kept. Returns the new state and the rebuilt operator."""
-    F = op.deformation_gradient(state.x)
+def reference_update(state: State, op: ReferenceOperator,
+                     F: np.ndarray | None = None) -> tuple[State, ReferenceOperator]:
+    """X <- x, V <- J V (Section 3); stress kept. Returns the new state and the rebuilt operator.
+
+    ``F``: the deformation gradient of ``state.x`` on ``op`` (Eq. 18), if the caller already has it."""
+    if F is None:
+        F = op.deformation_gradient(state.x)
     J = det(F)
     new = state.copy()
     new.X = state.x.copy()

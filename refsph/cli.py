@@ -1,4 +1,4 @@
-"""Command line: ``refsph list`` and ``refsph run SCENE --method {esph,tlsph} ...``."""
+"""Command line: ``refsph list`` and ``refsph run SCENE [--method {esph,tlsph,both}] ...``."""
 from __future__ import annotations
 
 import argparse
@@ -25,41 +25,89 @@ def main(argv=None) -> int:
     sub.add_parser("list", help="list the scenes")
     r = sub.add_parser("run", help="run a scene")
     r.add_argument("scene")
-    r.add_argument("--method", choices=METHODS, default="tlsph")
-    r.add_argument("--dim", type=int, choices=(2, 3), default=2)
+    r.add_argument("--method", choices=METHODS + ("both",), default=None,
+                   help="formulation (default: the scene's; 'both' runs ESPH then TLSPH)")
+    r.add_argument("--dim", type=int, choices=(2, 3), default=None, help="dimension (default: the scene's)")
     r.add_argument("--dp", type=float, default=None, help="particle spacing [m] (default: the scene's)")
     r.add_argument("--t-end", type=float, default=None, help="end time [s] (default: the scene's)")
     r.add_argument("--dt", type=float, default=None, help="fixed time step [s] (default: CFL)")
     r.add_argument("--out", default=None, help="output directory (default: runs/SCENE-METHOD-DIMd)")
     r.add_argument("--quick", action="store_true", help="coarse, fast version of the scene")
     r.add_argument("--quiet", action="store_true", help="no progress lines")
+    r.add_argument("--option", action="append", default=[], metavar="NAME=VALUE",
+                   help="a scene option (see 'refsph list'), e.g. --option T_melt=1793; repeatable")
     args = ap.parse_args(argv)
 
     if args.cmd == "list":
         for name, sc in SCENES.items():
             print(f"{name:10s} {sc.description}")
+            print(f"{'':10s} default: {sc.default_dim}D, methods {', '.join(sc.methods)}")
+            for opt, (default, help_) in sc.options.items():
+                print(f"{'':10s} --option {opt}=VALUE  {help_} (default {default})")
         return 0
 
     if args.scene not in SCENES:
         print(f"refsph: unknown scene {args.scene!r}; available: {', '.join(sorted(SCENES))}", file=sys.stderr)
         return 2
-    out = args.out or f"runs/{args.scene}-{args.method}-{args.dim}d"
+    scene = SCENES[args.scene]
     try:
-        res = run(args.scene, args.method, dim=args.dim, dp=args.dp, t_end=args.t_end, out=out,
-                  quick=args.quick, dt=args.dt, progress=not args.quiet)
-    except SimulationError as e:
-        print(f"refsph: run failed: {e}", file=sys.stderr)
-        return 3
+        options = _parse_options(args.option, scene)
     except ValueError as e:
         print(f"refsph: {e}", file=sys.stderr)
         return 2
-    s = res.summary
-    print(f"{s['scene']} {s['method']} {s['dim']}D: {s['n_particles']} particles, {s['n_steps']} steps, "
-          f"{s['wall_time_s']:.1f} s ({s['particle_steps_per_s']:.3g} particle-steps/s)")
-    for k, v in s["metrics"].items():
-        print(f"  {k:32s} {_fmt(v)}")
-    print(f"output: {out}/summary.json, {out}/snapshots/")
+    dim = args.dim if args.dim is not None else scene.default_dim
+    methods = scene.methods if args.method is None else (METHODS if args.method == "both" else (args.method,))
+    summaries = []
+    for method in methods:
+        out = args.out or f"runs/{args.scene}-{method}-{dim}d"
+        if args.out and len(methods) > 1:
+            out = f"{args.out}/{method}"
+        try:
+            res = run(args.scene, method, dim=dim, dp=args.dp, t_end=args.t_end, out=out, quick=args.quick,
+                      dt=args.dt, progress=not args.quiet, options=options)
+        except SimulationError as e:
+            print(f"refsph: run failed: {e}", file=sys.stderr)
+            return 3
+        except ValueError as e:
+            print(f"refsph: {e}", file=sys.stderr)
+            return 2
+        s = res.summary
+        summaries.append(s)
+        print(f"{s['scene']} {s['method']} {s['dim']}D: {s['n_particles']} particles, {s['n_steps']} steps, "
+              f"{s['wall_time_s']:.1f} s ({s['particle_steps_per_s']:.3g} particle-steps/s)")
+        for k, v in s["metrics"].items():
+            if k != "reference":
+                print(f"  {k:32s} {_fmt(v)}")
+        print(f"output: {out}/summary.json, {out}/snapshots/")
+    if scene.report is not None:
+        print()
+        print(scene.report(summaries))
     return 0
+
+
+def _parse_options(items, scene) -> dict:
+    """NAME=VALUE strings -> {name: value}, the value converted like the option's default."""
+    out = {}
+    for item in items:
+        if "=" not in item:
+            raise ValueError(f"--option needs NAME=VALUE, got {item!r}")
+        name, value = item.split("=", 1)
+        if name not in scene.options:
+            known = ", ".join(sorted(scene.options)) or "none"
+            raise ValueError(f"unknown option {name!r} for scene {scene.name!r} (known: {known})")
+        default = scene.options[name][0]
+        if isinstance(default, bool):
+            if value.lower() not in ("true", "false", "1", "0", "yes", "no"):
+                raise ValueError(f"option {name} must be true or false, got {value!r}")
+            out[name] = value.lower() in ("true", "1", "yes")
+        elif isinstance(default, (int, float)):
+            try:
+                out[name] = float(value)
+            except ValueError:
+                raise ValueError(f"option {name} must be a number, got {value!r}") from None
+        else:
+            out[name] = value
+    return out
 
 
 if __name__ == "__main__":

@@ -50,13 +50,15 @@ class ESPHParams:
 
 @dataclass
 class Rates:
-    """Time derivatives of the evolved fields. ``rho`` is None where density is not integrated (TLSPH)."""
+    """Time derivatives of the evolved fields. ``rho`` is None where density is not integrated (TLSPH).
+    ``l`` is the velocity gradient the stress rate came from (used by the plastic update for the strain rate)."""
 
     x: np.ndarray
     v: np.ndarray
     rho: np.ndarray | None
     S: np.ndarray
     S_zz: np.ndarray
+    l: np.ndarray | None = None
 
 
 def artificial_viscosity(vr, r2, rho_bar, c_bar, h, beta1, beta2, eps):
@@ -161,4 +163,4 @@ def esph_rates(state: State, mat: ElasticMaterial, prm: ESPHParams, I: np.ndarra
             a[c] += s[:, c, b] * mgW[b] + pairs.antisymmetric(gW[b], m * s[:, c, b])
 
     dS, dS_zz = jaumann_deviatoric_rate(state.S, state.S_zz, l, mat.G)
-    return Rates(x=v.copy(), v=a.T, rho=drho, S=dS, S_zz=dS_zz)
+    return Rates(x=v.copy(), v=a.T, rho=drho, S=dS, S_zz=dS_zz, l=l)

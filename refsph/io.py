@@ -20,6 +20,10 @@ Snapshot arrays (N particles, d dimensions):
 | sigma_vm  | (N,)      | Pa            | von Mises stress sqrt(3 J2), S_zz included           |
 | X, V0     | (N, d), (N,) | m, m^d     | reference position and volume (TLSPH)                |
 | F         | (N, d, d) | -             | deformation gradient (TLSPH only)                    |
+| eps_p     | (N,)      | -             | effective plastic strain (Johnson-Cook runs only)    |
+| eps_dot_p | (N,)      | 1/s           | effective plastic strain rate of the last step (J-C) |
+| W_p       | (N,)      | J/m^3         | plastic work density (J-C)                           |
+| T         | (N,)      | K             | temperature (J-C)                                    |
 | units     | ()        | -             | JSON string: unit of every key                       |
 """
 from __future__ import annotations
@@ -49,6 +53,8 @@ def save_snapshot(path, state: State, material, F: np.ndarray | None = None) -> 
     )
     if F is not None:
         arrays["F"] = F
+    if state.plastic:
+        arrays.update(eps_p=state.eps_p, eps_dot_p=state.eps_dot_p, W_p=state.W_p, T=state.T)
     units = {k: SNAPSHOT_UNITS[k] for k in arrays}
     tmp = path.with_name(path.name + ".tmp.npz")
     np.savez(tmp, units=json.dumps(units), **arrays)

@@ -11,7 +11,9 @@ from typing import Callable
 
 import numpy as np
 
+from .boundaries import MirrorPlanes
 from .material import ElasticMaterial, eos_pressure
+from .plasticity import JohnsonCook
 from .neighbours import find_pairs
 from .state import State, make_state
 
@@ -47,6 +49,11 @@ class Numerics:
 
 @dataclass
 class Setup:
+    """Everything a run needs. ``plasticity``: Johnson-Cook constants (None: elastic); ``mirror``: symmetry
+    planes (:class:`~refsph.boundaries.MirrorPlanes`, None: none); ``walls``: rigid walls
+    (:class:`~refsph.boundaries.RigidWall`); ``snapshot_times``: extra output times [s] besides the
+    ``n_snapshots`` evenly spaced ones."""
+
     state: State
     material: ElasticMaterial
     dp: float
@@ -54,6 +61,10 @@ class Setup:
     t_end: float
     n_snapshots: int
     info: dict = field(default_factory=dict)
+    plasticity: JohnsonCook | None = None
+    mirror: MirrorPlanes | None = None
+    walls: tuple = ()
+    snapshot_times: tuple = ()
 
     @property
     def h(self) -> float:
@@ -62,12 +73,20 @@ class Setup:
 
 @dataclass(frozen=True)
 class Scene:
+    """A scene as data. ``build(dim, dp, quick, **options)``; ``options``: the scene's own settings,
+    {name: (default, help)}; ``default_dim``: the dimension a plain ``refsph run SCENE`` uses;
+    ``methods``: what a plain ``refsph run SCENE`` runs."""
+
     name: str
     description: str
     default_dp: Callable[[int, bool], float]
-    build: Callable[[int, float, bool], Setup]
+    build: Callable[..., Setup]
     record: Callable[[State, Setup], dict]
     metrics: Callable[[dict, State, Setup], dict]
+    options: dict = field(default_factory=dict)
+    default_dim: int = 2
+    methods: tuple = ("tlsph",)
+    report: Callable[[list], str] | None = None
 
 
 def lattice(lengths, dp: float) -> np.ndarray:
@@ -226,6 +245,11 @@ SCENES: dict[str, Scene] = {
         "elastic AISI 4340 block 10 x 10 mm expanding in free flight: tensile instability (min pair distance)",
         _tension_default_dp, _tension_build, _tension_record, _tension_metrics),
 }
+
+
+from .taylor import make_scene as _make_taylor  # noqa: E402  (the Taylor scene uses the classes above)
+
+SCENES["taylor"] = _make_taylor()
 
 
 def get_scene(name: str) -> Scene:

@@ -48,11 +48,13 @@ def make_solver(method: str, setup: Setup):
     if method == "esph":
         prm = ESPHParams(h=h, dp=setup.dp, beta1=nm.beta1, beta2=nm.beta2, gamma=nm.gamma, n_ap=nm.n_ap,
                          eps=nm.eps, kernel=kernel)
-        return ESPHSolver(setup.material, prm, skin_factor=nm.skin_factor)
+        return ESPHSolver(setup.material, prm, skin_factor=nm.skin_factor, plasticity=setup.plasticity,
+                          mirror=setup.mirror, walls=setup.walls)
     if method == "tlsph":
         prm = TLSPHParams(h=h, beta1=nm.beta1, beta2=nm.beta2, eps=nm.eps, kernel=kernel,
                           corrected=nm.corrected, ref_update_strain=nm.ref_update_strain)
-        return TLSPHSolver(setup.material, prm)
+        return TLSPHSolver(setup.material, prm, plasticity=setup.plasticity, mirror=setup.mirror,
+                           walls=setup.walls)
     raise ValueError(f"unknown method {method!r}; choose one of {', '.join(METHODS)}")
 
 
@@ -96,6 +98,8 @@ def simulate(setup: Setup, method: str, *, scene=None, out=None, dt: float | Non
                 history.setdefault(k, []).append(val)
 
     snap_times = np.linspace(0.0, setup.t_end, setup.n_snapshots + 1)
+    extra = [t for t in setup.snapshot_times if 0.0 < t < setup.t_end]
+    snap_times = np.unique(np.concatenate([snap_times, extra]))
     snap_next = 0
     snapshots = []
 
@@ -115,7 +119,11 @@ def simulate(setup: Setup, method: str, *, scene=None, out=None, dt: float | Non
                    dp=setup.dp, h=setup.h, n_particles=state.n, t_end=setup.t_end, n_steps=0,
                    dt_mode="fixed" if dt is not None else "cfl", courant=setup.numerics.courant,
                    numerics=dataclasses.asdict(setup.numerics),
-                   material=dataclasses.asdict(setup.material), refsph_version=__version__,
+                   material=dataclasses.asdict(setup.material),
+                   plasticity=dataclasses.asdict(setup.plasticity) if setup.plasticity is not None else None,
+                   boundaries=dict(symmetry_axes=list(setup.mirror.axes) if setup.mirror is not None else [],
+                                   walls=[dataclasses.asdict(w) for w in setup.walls]),
+                   snapshot_times=[float(t) for t in snap_times], refsph_version=__version__,
                    status="running", metrics={})
 
     t0 = time.perf_counter()
@@ -137,12 +145,12 @@ def simulate(setup: Setup, method: str, *, scene=None, out=None, dt: float | Non
         while state.t < setup.t_end * (1 - 1e-12):
             step_dt = dt if dt is not None else cfl_time_step(state, setup.material, setup.h,
                                                                setup.numerics.courant)
+            dts.append(step_dt)                             # the step size chosen (before any cut to land on t_end)
             step_dt = min(step_dt, setup.t_end - state.t)
             prev = state
             with np.errstate(divide="ignore", invalid="ignore", over="ignore"):  # non-finite: caught below
                 state = predictor_corrector_step(state, solver, step_dt)
             n_steps += 1
-            dts.append(step_dt)
             if not (np.isfinite(state.v).all() and np.isfinite(state.x).all()):
                 bad = state.first_nonfinite() or ("x/v", -1)
                 msg = (f"non-finite {bad[0]} at particle {bad[1]} in step {n_steps} "
@@ -183,15 +191,24 @@ def simulate(setup: Setup, method: str, *, scene=None, out=None, dt: float | Non
     return RunResult(summary=summary, state=state, history=history, setup=setup)
 
 
-def run(scene_name: str, method: str, *, dim: int = 2, dp: float | None = None, t_end: float | None = None,
-        out=None, quick: bool = False, dt: float | None = None, progress: bool = True,
-        numerics: dict | None = None) -> RunResult:
-    """Build scene ``scene_name`` and run it. ``numerics`` overrides fields of the scene's Numerics."""
+def run(scene_name: str, method: str, *, dim: int | None = None, dp: float | None = None,
+        t_end: float | None = None, out=None, quick: bool = False, dt: float | None = None, progress: bool = True,
+        numerics: dict | None = None, options: dict | None = None) -> RunResult:
+    """Build scene ``scene_name`` and run it. ``dim``: None = the scene's default; ``numerics`` overrides
+    fields of the scene's Numerics; ``options`` sets the scene's own options (``Scene.options``)."""
     scene = get_scene(scene_name)
+    if dim is None:
+        dim = scene.default_dim
     _validate(method, dim, dp, None, t_end, dt)
+    options = dict(options or {})
+    unknown = set(options) - set(scene.options)
+    if unknown:
+        known = ", ".join(sorted(scene.options)) or "none"
+        raise ValueError(f"unknown option(s) for scene {scene_name!r}: {', '.join(sorted(unknown))} "
+                         f"(known: {known})")
     if dp is None:
         dp = scene.default_dp(dim, quick)
-    setup = scene.build(dim, dp, quick)
+    setup = scene.build(dim, dp, quick, **options)
     if numerics:
         unknown = set(numerics) - {f.name for f in dataclasses.fields(setup.numerics)}
         if unknown:

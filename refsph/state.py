@@ -16,6 +16,15 @@ out-of-plane normal stress is not, so the deviatoric stress carries its zz compo
 | X     | (N, d)    | m               | reference position (TLSPH; the initial position for ESPH)|
 | V0    | (N,)      | m^3 (2D: m^2)   | reference volume (TLSPH; V <- J V at a reference update) |
 | t     | scalar    | s               | time                                                     |
+
+Thermo-mechanical fields, present (arrays) only when the scene's material is Johnson-Cook (else None):
+
+| field     | shape | unit    | meaning                                                          |
+|-----------|-------|---------|------------------------------------------------------------------|
+| eps_p     | (N,)  | -       | accumulated effective plastic strain (Eq. 30 summed)             |
+| eps_dot_p | (N,)  | 1/s     | effective plastic strain rate of the last step, d eps_p / dt     |
+| W_p       | (N,)  | J/m^3   | accumulated plastic work density (Eq. 31 summed)                 |
+| T         | (N,)  | K       | temperature (Eq. 28, adiabatic)                                  |
 """
 from __future__ import annotations
 
@@ -23,7 +32,7 @@ from dataclasses import dataclass, fields, replace
 
 import numpy as np
 
-__all__ = ["State", "FIELD_UNITS", "make_state"]
+__all__ = ["State", "FIELD_UNITS", "THERMAL_FIELDS", "make_state"]
 
 FIELD_UNITS = {
     "x": "m",
@@ -35,7 +44,13 @@ FIELD_UNITS = {
     "X": "m",
     "V0": "m^3 (2D: m^2)",
     "t": "s",
+    "eps_p": "1",
+    "eps_dot_p": "1/s",
+    "W_p": "J/m^3",
+    "T": "K",
 }
+
+THERMAL_FIELDS = ("eps_p", "eps_dot_p", "W_p", "T")
 
 
 @dataclass
@@ -49,6 +64,15 @@ class State:
     X: np.ndarray
     V0: np.ndarray
     t: float = 0.0
+    eps_p: np.ndarray | None = None
+    eps_dot_p: np.ndarray | None = None
+    W_p: np.ndarray | None = None
+    T: np.ndarray | None = None
+
+    @property
+    def plastic(self) -> bool:
+        """True if the state carries the Johnson-Cook fields (eps_p, eps_dot_p, W_p, T)."""
+        return self.eps_p is not None
 
     @property
     def n(self) -> int:
@@ -60,7 +84,7 @@ class State:
 
     def copy(self) -> "State":
         return replace(self, **{f.name: np.array(getattr(self, f.name), copy=True)
-                                for f in fields(self) if f.name != "t"})
+                                for f in fields(self) if f.name != "t" and getattr(self, f.name) is not None})
 
     def check(self) -> None:
         """Shapes and finiteness; raises ValueError naming the offending field."""
@@ -73,13 +97,22 @@ class State:
             a = getattr(self, name)
             if a.shape != shape:
                 raise ValueError(f"state field {name} must have shape {shape}, got {a.shape}")
+        present = [getattr(self, k) is not None for k in THERMAL_FIELDS]
+        if any(present) and not all(present):
+            raise ValueError(f"state fields {', '.join(THERMAL_FIELDS)} must be all present or all None")
+        if all(present):
+            for name in THERMAL_FIELDS:
+                if getattr(self, name).shape != (n,):
+                    raise ValueError(f"state field {name} must have shape {(n,)}, got {getattr(self, name).shape}")
+            if np.any(self.T <= 0):
+                raise ValueError("state field T must be positive (kelvin)")
         for name in ("m", "rho", "V0"):
             if np.any(getattr(self, name) <= 0):
                 raise ValueError(f"state field {name} must be positive everywhere")
 
     def first_nonfinite(self) -> tuple[str, int] | None:
         """(field, particle index) of the first NaN/inf in an evolving field, or None."""
-        for name in ("x", "v", "rho", "S", "S_zz"):
+        for name in ("x", "v", "rho", "S", "S_zz") + (THERMAL_FIELDS if self.plastic else ()):
             a = getattr(self, name)
             bad = ~np.isfinite(a.reshape(a.shape[0], -1)).all(axis=1)
             if bad.any():
@@ -87,8 +120,12 @@ class State:
         return None
 
 
-def make_state(x: np.ndarray, v: np.ndarray, rho0: float, volume: np.ndarray | float) -> State:
-    """A stress-free state at rest density ``rho0``: m = rho0 V, X = x, V0 = V."""
+def make_state(x: np.ndarray, v: np.ndarray, rho0: float, volume: np.ndarray | float,
+               T0: float | None = None) -> State:
+    """A stress-free state at rest density ``rho0``: m = rho0 V, X = x, V0 = V.
+
+    ``T0`` (kelvin): give it for a Johnson-Cook material; the state then carries eps_p = eps_dot_p = W_p = 0
+    and T = T0. Without it those fields are None (elastic material)."""
     x = np.array(x, dtype=float)
     n, d = x.shape
     V = np.broadcast_to(np.asarray(volume, dtype=float), (n,)).copy()
@@ -96,6 +133,10 @@ def make_state(x: np.ndarray, v: np.ndarray, rho0: float, volume: np.ndarray | f
         raise ValueError("particle volume must be positive")
     if not rho0 > 0:
         raise ValueError(f"rho0 must be positive, got {rho0!r}")
+    if T0 is not None and not (np.isfinite(T0) and T0 > 0):
+        raise ValueError(f"initial temperature T0 must be positive (kelvin), got {T0!r}")
+    thermal = {} if T0 is None else dict(eps_p=np.zeros(n), eps_dot_p=np.zeros(n), W_p=np.zeros(n),
+                                         T=np.full(n, float(T0)))
     return State(
         x=x,
         v=np.broadcast_to(np.asarray(v, dtype=float), (n, d)).copy(),
@@ -105,4 +146,5 @@ def make_state(x: np.ndarray, v: np.ndarray, rho0: float, volume: np.ndarray | f
         S_zz=np.zeros(n),
         X=x.copy(),
         V0=V,
+        **thermal,
     )

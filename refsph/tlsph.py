@@ -45,7 +45,7 @@ from .state import State
 from .tensor import component_major, det, identity, inv, matmul, rowdot, transpose
 
 __all__ = ["TLSPHParams", "ReferenceOperator", "tlsph_rates", "first_piola", "green_lagrange_norm",
-           "reference_update", "reference_viscosity"]
+           "reference_update", "reset_reference", "reference_viscosity"]
 
 
 @dataclass(frozen=True)
@@ -78,13 +78,19 @@ class ReferenceOperator:
     kernel (about 0.5 ns per stored entry), faster than its multi-vector one.
     """
 
-    def __init__(self, X: np.ndarray, V: np.ndarray, h: float, kernel: Kernel, corrected: bool):
+    def __init__(self, X: np.ndarray, V: np.ndarray, h: float, kernel: Kernel, corrected: bool,
+                 ghosts=None):
         X = np.asarray(X, dtype=float)
         n, d = X.shape
         self.n, self.dim, self.h, self.kernel, self.corrected = n, d, float(h), kernel, bool(corrected)
         self.X = X.copy()
         self.V = np.asarray(V, dtype=float).copy()
+        self.ghosts = ghosts
         self.I, self.J = find_pairs(X, kernel.support * h)
+        if ghosts is not None:
+            # X = [real; mirror ghosts] (refsph.boundaries): ghost-ghost pairs act on ghosts only; dropped
+            keep = self.I < ghosts.n_real
+            self.I, self.J = self.I[keep], self.J[keep]
         I, J = self.I, self.J
         self.n_pairs = len(I)
         self.gW = kernel.grad(X[I] - X[J], h, d)            # grad_i W(X_ij) on half pairs (i < j)
@@ -96,8 +102,14 @@ class ReferenceOperator:
         Vg = self.V[cols][:, None] * g
         dXd = X[cols] - X[rows]
         self.M = scatter_add(rows, (dXd[:, :, None] * Vg[:, None, :]).reshape(len(rows), d * d), n).reshape(n, d, d)
+        if ghosts is not None:
+            # a ghost's own neighbourhood is cut off; its moment matrix is the mirror image of its source's
+            nr = ghosts.n_real
+            self.M[nr:] = ghosts.tensors(self.M[:nr])
         self.L, self.degenerate = (correction_matrix(self.M) if corrected
                                    else (identity(n, d), np.zeros(0, dtype=np.intp)))
+        if ghosts is not None:
+            self.degenerate = self.degenerate[self.degenerate < ghosts.n_real]
         gc = np.einsum("pab,pb->pa", self.L[rows], g)     # corrected gradient L_row grad W
         Vgc = self.V[cols][:, None] * gc
         self.G = [sp.csr_matrix((Vgc[:, k], (rows, cols)), shape=(n, n)) for k in range(d)]
@@ -245,7 +257,17 @@ def tlsph_rates(state: State, mat: ElasticMaterial, prm: TLSPHParams, op: Refere
     dS, dS_zz = jaumann_deviatoric_rate(state.S, state.S_zz, l, mat.G)
     if out is not None:
         out.update(F=F, J=J, P=P, l=l, rho=rho, p=p)
-    return Rates(x=v.copy(), v=a, rho=None, S=dS, S_zz=dS_zz)
+    return Rates(x=v.copy(), v=a, rho=None, S=dS, S_zz=dS_zz, l=l)
+
+
+def reset_reference(state: State, F: np.ndarray) -> State:
+    """X <- x, V <- J V (Section 3), J = det F; stress and every other field kept. A new state."""
+    J = det(F)
+    new = state.copy()
+    new.X = state.x.copy()
+    new.V0 = J * state.V0
+    new.rho = state.m / new.V0
+    return new
 
 
 def reference_update(state: State, op: ReferenceOperator,
@@ -255,10 +277,6 @@ def reference_update(state: State, op: ReferenceOperator,
     ``F``: the deformation gradient of ``state.x`` on ``op`` (Eq. 18), if the caller already has it."""
     if F is None:
         F = op.deformation_gradient(state.x)
-    J = det(F)
-    new = state.copy()
-    new.X = state.x.copy()
-    new.V0 = J * state.V0
-    new.rho = state.m / new.V0
+    new = reset_reference(state, F)
     new_op = ReferenceOperator(new.X, new.V0, op.h, op.kernel, op.corrected)
     return new, new_op

@@ -30,5 +30,5 @@ def test_chapter_runs_quick(path, tmp_path, monkeypatch):
 
 def test_chapters_exist():
     names = {p.stem for p in CHAPTERS}
-    for stem in ("01_kernel", "02_esph", "03_tlsph"):
+    for stem in ("01_kernel", "02_esph", "03_tlsph", "04_johnson_cook", "06_taylor"):
         assert stem in names

@@ -1,0 +1,206 @@
+"""Taylor impact benchmark (Section 3.1 of Islam, Bansal & Peng): every Taylor number and figure of refsph.
+
+    python benchmarks/taylor.py                 # all runs (about 35 CPU-minutes; --jobs 2 halves the wall time)
+    python benchmarks/taylor.py --plot-only     # figures and table again from runs/benchmarks/taylor/
+
+Runs (3D quarter model, both methods):
+  convergence  dp = 1.0, 0.75, 0.5 mm, CFL time step (Courant 0.3)
+  tmelt        dp = 0.5 mm with T_melt = 1793 K (Table 1 prints 1293 K)
+  fixed_dt     dp = 0.5 mm with the paper's fixed dt = 1e-8 s
+  sensitivity  dp = 0.75 mm: artificial viscosity beta = 0.5 (both), TLSPH reference update at |E| > 0.1,
+               ESPH without artificial pressure
+Writes benchmarks/taylor.json (one record per run: method, dp, dt mode, T_melt, final length and diameter,
+rest time, peaks, wall time, particle count, steps) and the figures
+  figures/06_taylor_work_precision.png   error against wall time (the work-precision plot)
+  figures/06_taylor_length_history.png   length against time (cf. the paper's Fig. 3)
+  figures/06_taylor_sections.png         plastic strain and temperature on the section at 15 and 30 us (Figs. 4-5)
+Wall times are single-core (each run is one process); with --jobs 2 two runs share the machine's two cores.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import time
+from concurrent.futures import ProcessPoolExecutor
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parent.parent
+RUNS = ROOT / "runs" / "benchmarks" / "taylor"
+OUT_JSON = ROOT / "benchmarks" / "taylor.json"
+FIG = ROOT / "figures"
+METHODS = ("esph", "tlsph")
+
+
+def job_list(finest: float | None):
+    jobs = []
+    dps = [1.0e-3, 0.75e-3, 0.5e-3] + ([finest] if finest else [])
+    for dp in dps:
+        for m in METHODS:
+            jobs.append(dict(name=f"conv-{m}-{dp * 1e3:g}mm", method=m, dp=dp, dt=None, T_melt=1293.0))
+    for m in METHODS:
+        jobs.append(dict(name=f"tmelt1793-{m}-0.5mm", method=m, dp=0.5e-3, dt=None, T_melt=1793.0))
+        jobs.append(dict(name=f"dt1e-8-{m}-0.5mm", method=m, dp=0.5e-3, dt=1e-8, T_melt=1293.0))
+    # sensitivity to numerical choices the paper fixes or leaves open, at dp = 0.75 mm (compare conv-*-0.75mm)
+    for m in METHODS:
+        jobs.append(dict(name=f"sens-beta0.5-{m}-0.75mm", method=m, dp=0.75e-3, dt=None, T_melt=1293.0,
+                         numerics=dict(beta1=0.5, beta2=0.5)))
+    jobs.append(dict(name="sens-refupdate0.1-tlsph-0.75mm", method="tlsph", dp=0.75e-3, dt=None, T_melt=1293.0,
+                     numerics=dict(ref_update_strain=0.1)))
+    jobs.append(dict(name="sens-gamma0-esph-0.75mm", method="esph", dp=0.75e-3, dt=None, T_melt=1293.0,
+                     numerics=dict(gamma=0.0)))
+    return jobs
+
+
+def run_job(job):
+    from refsph.simulate import run
+    t0 = time.perf_counter()
+    res = run("taylor", job["method"], dim=3, dp=job["dp"], dt=job["dt"], out=RUNS / job["name"], progress=False,
+              options=dict(T_melt=job["T_melt"]), numerics=job.get("numerics"))
+    s = res.summary
+    print(f"{job['name']}: {time.perf_counter() - t0:.0f} s, L = {s['metrics']['final_length_mm']:.2f} mm, "
+          f"D = {s['metrics']['final_diameter_mm']:.2f} mm", flush=True)
+    return job["name"]
+
+
+def record(name):
+    with open(RUNS / name / "summary.json") as f:
+        s = json.load(f)
+    m = s["metrics"]
+    return dict(name=name, method=s["method"], dp_mm=1e3 * s["dp"], dt_mode=s["dt_mode"],
+                dt_s=s["dt_max"] if s["dt_mode"] == "fixed" else None, courant=s["courant"], T_melt_K=m["T_melt_K"],
+                final_length_mm=m["final_length_mm"], final_diameter_mm=m["final_diameter_mm"],
+                length_oscillation_mm=m["length_oscillation_mm"], rest_time_us=1e6 * m["rest_time_s"],
+                end_time_us=1e6 * m["end_time_s"], max_plastic_strain=m["max_plastic_strain"],
+                max_temperature_K=m["max_temperature_K"], wall_time_s=s["wall_time_s"],
+                n_particles=s["n_particles"], n_ghosts=s["diagnostics"].get("n_ghosts"), n_steps=s["n_steps"],
+                numerics=dict(beta1=s["numerics"]["beta1"], beta2=s["numerics"]["beta2"], gamma=s["numerics"]["gamma"],
+                              ref_update_strain=s["numerics"]["ref_update_strain"]),
+                diagnostics=s["diagnostics"])
+
+
+def plots(records):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from refsph.io import load_run, load_snapshot
+    from refsph.reference import TAYLOR_RESULTS
+
+    FIG.mkdir(exist_ok=True)
+    Lexp = TAYLOR_RESULTS["final_length_mm"]["experiment"]
+    Dexp = TAYLOR_RESULTS["final_diameter_mm"]["experiment"]
+    conv = [r for r in records if r["name"].startswith("conv-")]
+    colors = dict(esph="C0", tlsph="C3")
+
+    # work-precision: error against wall time
+    fig, axs = plt.subplots(1, 2, figsize=(10, 4))
+    for ax, key, ref, label in ((axs[0], "final_length_mm", Lexp, "length"),
+                                (axs[1], "final_diameter_mm", Dexp, "diameter")):
+        for m in METHODS:
+            rs = sorted([r for r in conv if r["method"] == m], key=lambda r: -r["dp_mm"])
+            w = [r["wall_time_s"] for r in rs]
+            e = [100 * abs(r[key] - ref) / ref for r in rs]
+            ax.loglog(w, e, "o-", color=colors[m], label=m.upper())
+            for r, wi, ei in zip(rs, w, e):
+                ax.annotate(f"{r['dp_mm']:g} mm", (wi, ei), textcoords="offset points", xytext=(4, 4), fontsize=8)
+        styles = {"paper_esph": ("C0", "paper ESPH"), "paper_tlsph": ("C3", "paper TLSPH"),
+                  "ls_dyna": ("gray", "LS-DYNA")}
+        for k, (c, lab) in styles.items():
+            ax.axhline(100 * abs(TAYLOR_RESULTS[key][k] - ref) / ref, ls=":", color=c, lw=1, label=lab)
+        ax.axhline(2.0 if key == "final_length_mm" else 5.0, color="k", lw=0.8, ls="--", label="issue target")
+        ax.set_xlabel("wall time [s] (one core)")
+        ax.set_ylabel(f"|{label} - experiment| / experiment [%]")
+        ax.set_title(f"Taylor bar, 3D quarter model: final {label}")
+        ax.legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(FIG / "06_taylor_work_precision.png", dpi=120)
+    plt.close(fig)
+
+    # length against time (Fig. 3)
+    fig, ax = plt.subplots(figsize=(6, 4))
+    for r in records:
+        if r["dp_mm"] != 0.5 or not r["name"].startswith(("conv-", "dt1e-8-")):
+            continue
+        s, _ = load_run(RUNS / r["name"])
+        h = np.asarray(s["metrics"]["length_history"])
+        ls = "-" if r["dt_mode"] == "cfl" else "--"
+        ax.plot(1e6 * h[:, 0], 1e3 * h[:, 1], ls, color=colors[r["method"]],
+                label=f"{r['method'].upper()} ({'CFL' if r['dt_mode'] == 'cfl' else 'dt = 1e-8 s'})")
+    ax.axhline(Lexp, color="k", ls=":", label="experiment (final)")
+    ax.axhline(TAYLOR_RESULTS["final_length_mm"]["ls_dyna"], color="gray", ls="-.", label="LS-DYNA (final)")
+    ax.set_xlabel("t [us]")
+    ax.set_ylabel("length [mm]")
+    ax.set_title("Taylor bar length, dp = 0.5 mm (cf. Fig. 3)")
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(FIG / "06_taylor_length_history.png", dpi=120)
+    plt.close(fig)
+
+    # sections at 15 and 30 us (Figs. 4-5): the particles next to the symmetry plane y = 0, mirrored to x < 0
+    fig, axs = plt.subplots(2, 4, figsize=(12, 7), sharey=True)
+    for col, (m, tt) in enumerate([(m, tt) for m in METHODS for tt in (15e-6, 30e-6)]):
+        _, snaps = load_run(RUNS / f"conv-{m}-0.5mm")
+        snap = min((load_snapshot(p) for p in snaps), key=lambda z: abs(z["t"] - tt))
+        x = snap["x"]
+        sec = np.abs(x[:, 1]) < 0.5e-3                      # the first layer of particles off the plane y = 0
+        xs, zs = np.concatenate([x[sec, 0], -x[sec, 0]]), np.concatenate([x[sec, 2], x[sec, 2]])
+        for row, (key, label, vmax) in enumerate((("eps_p", "effective plastic strain", None),
+                                                  ("T", "temperature [K]", None))):
+            val = np.concatenate([snap[key][sec], snap[key][sec]])
+            ax = axs[row, col]
+            sc = ax.scatter(1e3 * xs, 1e3 * zs, c=val, s=9, cmap="jet", vmin=0 if key == "eps_p" else 293.0)
+            ax.set_aspect("equal")
+            ax.set_xlim(-7, 7)
+            ax.set_ylim(0, 16)
+            ax.set_title(f"{m.upper()}, t = {1e6 * snap['t']:.0f} us", fontsize=9)
+            fig.colorbar(sc, ax=ax, shrink=0.7, label=label)
+            ax.set_xlabel("x [mm]")
+    axs[0, 0].set_ylabel("z [mm]")
+    axs[1, 0].set_ylabel("z [mm]")
+    fig.suptitle("Taylor bar, section through the axis (lower 16 mm), dp = 0.5 mm (cf. Figs. 4-5)")
+    fig.tight_layout()
+    fig.savefig(FIG / "06_taylor_sections.png", dpi=120)
+    plt.close(fig)
+
+
+def table(records) -> str:
+    lines = [f"{'run':24s} {'dp':>5s} {'dt':>8s} {'T_m':>5s} {'L [mm]':>7s} {'D [mm]':>7s} {'rest us':>7s} "
+             f"{'eps_p':>5s} {'T K':>5s} {'wall s':>7s} {'N':>6s} {'steps':>6s}"]
+    for r in records:
+        lines.append(f"{r['name']:24s} {r['dp_mm']:5.3g} {('%.0e' % r['dt_s']) if r['dt_s'] else 'CFL':>8s} "
+                     f"{r['T_melt_K']:5.0f} {r['final_length_mm']:7.2f} {r['final_diameter_mm']:7.2f} "
+                     f"{r['rest_time_us']:7.1f} {r['max_plastic_strain']:5.2f} {r['max_temperature_K']:5.0f} "
+                     f"{r['wall_time_s']:7.0f} {r['n_particles']:6d} {r['n_steps']:6d}")
+    lines.append("experiment 34.6 / 9.5 mm; LS-DYNA 34.4 / 10.6; paper ESPH 34.19 / 9.80; paper TLSPH 34.18 / 9.83")
+    return "\n".join(lines)
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--jobs", type=int, default=1, help="runs at a time (default 1)")
+    ap.add_argument("--plot-only", action="store_true", help="no runs: figures and table from earlier runs")
+    ap.add_argument("--only", default=None, help="run only the jobs whose name contains this string")
+    ap.add_argument("--finest", type=float, default=None, help="an extra, finer spacing [m] for the convergence study")
+    args = ap.parse_args(argv)
+    jobs = job_list(args.finest)
+    if args.only:
+        jobs = [j for j in jobs if args.only in j["name"]]
+    if not args.plot_only:
+        jobs.sort(key=lambda j: (j["dp"], j["dt"] is None))       # longest first
+        with ProcessPoolExecutor(max_workers=args.jobs) as ex:
+            list(ex.map(run_job, jobs))
+    # every run that exists (the 0.375 mm ones too, if an earlier call made them with --finest)
+    names = [j["name"] for j in job_list(args.finest or 0.375e-3) if (RUNS / j["name"] / "summary.json").exists()]
+    records = [record(n) for n in names]
+    OUT_JSON.write_text(json.dumps(records, indent=1) + "\n")
+    print(table(records))
+    if all((RUNS / f"conv-{m}-0.5mm" / "summary.json").exists() for m in METHODS):
+        plots(records)
+        print(f"figures written to {FIG}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,133 @@
+"""Boundaries that a scene may need: symmetry planes (mirror ghosts) and a rigid frictionless wall.
+
+The paper does not say how its Taylor bar meets the wall or whether it uses symmetry; these are the standard
+choices, stated here and in chapter 06.
+
+**Symmetry plane** x_a = 0 (the body on the side x_a > 0), imposed with mirror ghost particles (Libersky et al.
+1993, "High strain Lagrangian hydrodynamics", J. Comput. Phys. 109, 67; the usual SPH symmetry condition).
+Every particle within ``cutoff`` of the plane gets an image with
+
+    x_g = R x_s,  v_g = R v_s,  S_g = R S_s R,  F_g = R F_s R,  m_g = m_s, rho_g = rho_s, ...
+
+R = diag(+-1) flipping the axis of the plane. With two planes (a quarter model) the particles near both
+planes also get the image through the edge (R flips both axes). The ghosts take part in the SPH sums of the real
+particles exactly as the missing half (quarter) of the body would; their own rates are not used. The
+condition this gives is the symmetry one: zero normal velocity and zero shear traction on the plane, with the
+normal traction the other half would exert.
+
+**Rigid frictionless wall** x_a = c (the body on the side x_a > c), imposed as a unilateral kinematic
+constraint: a particle that moves towards the wall and whose centre is, or within the next step would be,
+closer than half a spacing to it (x_a + dt v_a < c + gap, gap = dp / 2, so that the body's face -- centres
+minus half a spacing -- touches the wall) gets x_a <- max(x_a, c + gap) and v_a <- 0. The tangential velocity
+is left free (no friction) and a particle moving away is left alone, so the body can rebound. The impulse the
+wall gives is the sum of m (v_a,after - v_a,before).
+Issue 4 brings proper contact (tools, pinball); this wall is the simplest thing that a Taylor impact needs.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+from itertools import combinations
+
+import numpy as np
+
+from .state import State
+
+__all__ = ["MirrorPlanes", "Ghosts", "RigidWall"]
+
+
+@dataclass(frozen=True)
+class Ghosts:
+    """Mirror images of some real particles: ``src`` (index of each ghost's source) and ``sign`` (R as a
+    (N_g, d) array of +-1). Extended arrays are [real; ghosts]."""
+
+    n_real: int
+    src: np.ndarray
+    sign: np.ndarray
+
+    @property
+    def n(self) -> int:
+        return len(self.src)
+
+    def vectors(self, a: np.ndarray) -> np.ndarray:
+        """R a_s for each ghost (N_g, d)."""
+        return a[self.src] * self.sign
+
+    def tensors(self, T: np.ndarray) -> np.ndarray:
+        """R T_s R for each ghost (N_g, d, d)."""
+        return T[self.src] * self.sign[:, :, None] * self.sign[:, None, :]
+
+    def scalars(self, s: np.ndarray) -> np.ndarray:
+        return s[self.src]
+
+    def extend_vectors(self, a: np.ndarray) -> np.ndarray:
+        return np.concatenate([a, self.vectors(a)])
+
+    def extend_tensors(self, T: np.ndarray) -> np.ndarray:
+        return np.concatenate([np.asarray(T), self.tensors(np.asarray(T))])
+
+    def extend_scalars(self, s: np.ndarray) -> np.ndarray:
+        return np.concatenate([s, self.scalars(s)])
+
+    def extend_state(self, state: State) -> State:
+        """The state of real particles and ghosts (mechanical fields only; thermal fields are per particle
+        and never summed over neighbours)."""
+        return State(x=self.extend_vectors(state.x), v=self.extend_vectors(state.v),
+                     m=self.extend_scalars(state.m), rho=self.extend_scalars(state.rho),
+                     S=self.extend_tensors(state.S), S_zz=self.extend_scalars(state.S_zz),
+                     X=self.extend_vectors(state.X), V0=self.extend_scalars(state.V0), t=state.t)
+
+
+@dataclass(frozen=True)
+class MirrorPlanes:
+    """Symmetry planes x_a = 0 for each a in ``axes`` (the body lies at x_a > 0)."""
+
+    axes: tuple[int, ...]
+
+    def __post_init__(self):
+        if len(set(self.axes)) != len(self.axes):
+            raise ValueError(f"symmetry axes must be distinct, got {self.axes!r}")
+
+    def ghosts(self, x: np.ndarray, cutoff: float) -> Ghosts:
+        """Images of every particle within ``cutoff`` of a plane (and of the edges/corner where planes meet)."""
+        n, d = x.shape
+        for a in self.axes:
+            if not 0 <= a < d:
+                raise ValueError(f"symmetry axis {a} does not exist in {d}D")
+        if n and np.any(x[:, list(self.axes)] < 0):
+            raise ValueError("a particle lies on the wrong side of a symmetry plane (x_a < 0)")
+        srcs, signs = [], []
+        for k in range(1, len(self.axes) + 1):
+            for subset in combinations(self.axes, k):
+                near = np.all(x[:, list(subset)] < cutoff, axis=1)
+                idx = np.flatnonzero(near)
+                sign = np.ones((len(idx), d))
+                sign[:, list(subset)] = -1.0
+                srcs.append(idx)
+                signs.append(sign)
+        src = np.concatenate(srcs) if srcs else np.zeros(0, dtype=np.intp)
+        sign = np.concatenate(signs) if signs else np.ones((0, d))
+        return Ghosts(n_real=n, src=src.astype(np.intp), sign=sign)
+
+
+@dataclass(frozen=True)
+class RigidWall:
+    """Rigid frictionless wall x_axis = position, body on the side x_axis > position; ``gap``: half a spacing."""
+
+    axis: int
+    position: float
+    gap: float
+
+    def apply(self, state: State, dt: float) -> float:
+        """Unilateral constraint in place on ``state`` (positions and velocities); returns the impulse the wall
+        gave along +axis (per unit thickness in 2D).
+
+        A particle is stopped (v_a <- 0) if it moves towards the wall and would be closer than the gap within
+        ``dt`` (x_a + dt v_a < c + gap): testing the position alone misses a particle that sits a rounding
+        error above the gap while its velocity keeps growing towards the wall."""
+        a = self.axis
+        z0 = self.position + self.gap
+        hit = np.flatnonzero((state.v[:, a] < 0.0) & (state.x[:, a] + dt * state.v[:, a] < z0))
+        impulse = float(-np.sum(state.m[hit] * state.v[hit, a]))
+        state.v[hit, a] = 0.0
+        state.x[:, a] = np.maximum(state.x[:, a], z0)
+        return impulse

@@ -1,0 +1,181 @@
+"""Johnson-Cook viscoplasticity and adiabatic heating (Section 2.3.1, Eqs. 25-31).
+
+    Eq. (25)  sigma_y = [A + B eps_p^n] [1 + C ln(epsdot*)] [1 - T*^m]
+    Eq. (26)  epsdot* = epsdot / epsdot_0
+    Eq. (27)  T*      = (T - T_r) / (T_m - T_r)
+              y_f     = sqrt(J2) - sigma_y / sqrt(3),  J2 = s:s / 2           (von Mises yield function)
+              s_n     = c_f s,   c_f = min(sigma_y / sqrt(3 J2), 1)          (Wilkins radial return)
+    Eq. (29)  d eps_pl  = (1 - c_f) / (2 mu) s                               (plastic strain increment)
+    Eq. (30)  d eps_p   = sqrt(2/3 d eps_pl : d eps_pl) = (1 - c_f) / (3 mu) sqrt(3/2 s : s)
+    Eq. (31)  d w_p     = d eps_pl : s_n                                     (plastic work density)
+    Eq. (28)  d T       = chi d w_p / (rho C_p),  chi = 0.9                  (adiabatic heating)
+
+Here s is the *trial* deviatoric stress (the elastic update of the step), s_n the returned one, eps_p the
+accumulated effective plastic strain. Eq. (31) gives d w_p = sigma_y d eps_p once s_n is on the yield surface.
+
+Where the paper is silent or loose, refsph does the standard thing:
+
+* **Eq. (28)** is printed as dT/dt = chi W_p / (rho C_p) with W_p the accumulated work; dimensionally it is
+  the increment form dT = chi dw_p / (rho C_p) (the issue's and every code's form), which is what refsph uses.
+* **log** in Eq. (25) is the natural logarithm (Johnson & Cook 1983).
+* **epsdot* < 1**: ln(epsdot*) is negative and unbounded below as the rate goes to zero (a particle that stops
+  flowing would get a yield stress that goes to -infinity). refsph uses ln(max(epsdot*, 1)): no rate effect below
+  the reference rate, as in Abaqus (Analysis User's Guide, "Johnson-Cook plasticity": the rate factor is 1 for
+  rates below epsdot_0) and in LS-DYNA's *MAT_JOHNSON_COOK.
+* **Which rate** enters Eq. (26): the paper says the effective plastic strain rate, which is not known before the
+  return map of the step. Using the previous step's plastic rate makes an explicit code chatter (no flow ->
+  low yield -> much flow -> high yield). refsph uses the equivalent deviatoric strain rate of the step,
+  epsdot = sqrt(2/3 e':e'), e' the deviatoric part of (l + l^T)/2, which is the plastic rate wherever the
+  material flows (the elastic part is O(sigma_y / E) of it). This is LS-DYNA's default (VP = 0, "scale yield
+  stress", total strain rate).
+* **T* outside [0, 1]**: T* < 0 is taken as 0 (no hardening below room temperature) and T* >= 1 gives
+  sigma_y = 0 (melted), as in Abaqus and LS-DYNA.
+* **epsdot_0** is not printed in Table 1; Johnson & Cook's 4340 data use 1 /s, which refsph uses for Taylor.
+
+The **modified** Johnson-Cook law of Rodriguez Prieto, Larsson & Afrasiabi (Eqs. 8-9 of their paper): the
+hardening term stops growing past a saturation strain (2 for AISI 1045), A + B min(eps_p, eps_sat)^n. It is
+switched on per material with ``hardening_saturation_strain`` (None = the original law).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+import math
+
+import numpy as np
+
+__all__ = ["JohnsonCook", "homologous_temperature", "yield_stress", "equivalent_strain_rate",
+           "radial_return", "plastic_strain_increment", "effective_plastic_strain_increment",
+           "plastic_work_increment", "temperature_increment", "plastic_update"]
+
+
+@dataclass(frozen=True)
+class JohnsonCook:
+    """Johnson-Cook constants, SI units; no defaults (Table 1 / Table 3 of the paper).
+
+    A, B [Pa], n, C, m [-], eps_dot_0 [1/s], T_room, T_melt [K], cp [J/(kg K)], chi (Taylor-Quinney) [-],
+    hardening_saturation_strain: None for Eq. (25) as printed, or the strain past which hardening stops
+    (the modified law of Rodriguez Prieto et al.).
+    """
+
+    A: float
+    B: float
+    n: float
+    C: float
+    m: float
+    eps_dot_0: float
+    T_room: float
+    T_melt: float
+    cp: float
+    chi: float
+    hardening_saturation_strain: float | None
+
+    def __post_init__(self):
+        for name in ("A", "B", "n", "C", "m", "eps_dot_0", "T_room", "T_melt", "cp", "chi"):
+            val = getattr(self, name)
+            if val is None or isinstance(val, bool) or not isinstance(val, (int, float)) or not math.isfinite(val):
+                raise ValueError(f"Johnson-Cook constant {name} must be a finite number, got {val!r}")
+        for name in ("A", "eps_dot_0", "T_room", "cp", "m"):
+            if not getattr(self, name) > 0:
+                raise ValueError(f"Johnson-Cook constant {name} must be positive, got {getattr(self, name)!r}")
+        for name in ("B", "n", "C"):
+            if getattr(self, name) < 0:
+                raise ValueError(f"Johnson-Cook constant {name} must not be negative, got {getattr(self, name)!r}")
+        if not self.T_melt > self.T_room:
+            raise ValueError(f"T_melt ({self.T_melt!r} K) must exceed T_room ({self.T_room!r} K)")
+        if not 0.0 <= self.chi <= 1.0:
+            raise ValueError(f"Taylor-Quinney coefficient chi must lie in [0, 1], got {self.chi!r}")
+        s = self.hardening_saturation_strain
+        if s is not None and not (isinstance(s, (int, float)) and math.isfinite(s) and s > 0):
+            raise ValueError(f"hardening_saturation_strain must be None or positive, got {s!r}")
+
+    @classmethod
+    def from_dict(cls, d: dict) -> "JohnsonCook":
+        """From a dict with every field named; a missing key is named in the error."""
+        names = [f for f in cls.__dataclass_fields__]
+        missing = [k for k in names if k not in d]
+        if missing:
+            raise ValueError(f"missing Johnson-Cook constant(s): {', '.join(missing)}")
+        return cls(**{k: d[k] for k in names})
+
+
+def homologous_temperature(T, T_room: float, T_melt: float):
+    """Eq. (27): T* = (T - T_r) / (T_m - T_r) (not clipped here; :func:`yield_stress` clips it)."""
+    return (np.asarray(T, dtype=float) - T_room) / (T_melt - T_room)
+
+
+def yield_stress(jc: JohnsonCook, eps_p, eps_dot, T):
+    """Eq. (25): sigma_y = [A + B eps_p^n] [1 + C ln(max(epsdot*, 1))] [1 - T*^m], T* clipped to [0, 1].
+
+    eps_p: accumulated effective plastic strain; eps_dot: equivalent strain rate [1/s] (Eq. 26 with
+    epsdot* = eps_dot / eps_dot_0); T: temperature [K]. With ``hardening_saturation_strain`` set, eps_p is
+    capped there (modified law, Rodriguez Prieto et al. Eq. 9). Arrays broadcast.
+    """
+    eps_p = np.maximum(np.asarray(eps_p, dtype=float), 0.0)
+    if jc.hardening_saturation_strain is not None:
+        eps_p = np.minimum(eps_p, jc.hardening_saturation_strain)
+    hardening = jc.A + jc.B * eps_p**jc.n
+    rate = 1.0 + jc.C * np.log(np.maximum(np.asarray(eps_dot, dtype=float) / jc.eps_dot_0, 1.0))
+    Ts = np.clip(homologous_temperature(T, jc.T_room, jc.T_melt), 0.0, 1.0)
+    thermal = 1.0 - Ts**jc.m
+    return hardening * rate * thermal
+
+
+def equivalent_strain_rate(l: np.ndarray) -> np.ndarray:
+    """sqrt(2/3 e':e') with e' the deviatoric part of eps_dot = (l + l^T)/2 (Eq. 21), for l (N, d, d).
+
+    In 2D plane strain eps_dot_zz = 0 but its deviatoric part -tr/3 is not, and it is included."""
+    n, d, _ = l.shape
+    D = 0.5 * (l + np.swapaxes(l, 1, 2))
+    tr = np.trace(D, axis1=1, axis2=2)
+    ee = np.einsum("nab,nab->n", D, D) - tr * tr / 3.0     # e':e' = D:D - tr^2/3 (zz included in 2D)
+    return np.sqrt(np.maximum(2.0 / 3.0 * ee, 0.0))
+
+
+def radial_return(S: np.ndarray, S_zz: np.ndarray, sigma_y: np.ndarray):
+    """Wilkins return: c_f = min(sigma_y / sqrt(3 J2), 1), s_n = c_f s. Returns (c_f, S_n, S_zz_n, sigma_vm_trial).
+
+    J2 = s:s/2 includes the plane-strain S_zz in 2D (3D: S_zz is zero and unused)."""
+    ss = np.einsum("nab,nab->n", S, S)
+    if S.shape[1] == 2:
+        ss = ss + S_zz * S_zz
+    svm = np.sqrt(1.5 * ss)                                 # sqrt(3 J2)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        cf = np.where(svm > sigma_y, sigma_y / np.where(svm > 0, svm, 1.0), 1.0)
+    return cf, S * cf[:, None, None], S_zz * cf, svm
+
+
+def plastic_strain_increment(S_trial: np.ndarray, cf: np.ndarray, G: float) -> np.ndarray:
+    """Eq. (29): d eps_pl = (1 - c_f) / (2 mu) s for the (N, d, d) stress given (in 2D the in-plane block; the
+    out-of-plane part, (1 - c_f) s_zz / (2 mu), is obtained by passing S_zz[:, None, None])."""
+    return ((1.0 - cf) / (2.0 * G))[:, None, None] * S_trial
+
+
+def effective_plastic_strain_increment(svm_trial: np.ndarray, cf: np.ndarray, G: float) -> np.ndarray:
+    """Eq. (30): d eps_p = (1 - c_f) / (3 mu) sqrt(3/2 s:s) = (1 - c_f) sigma_vm_trial / (3 mu)."""
+    return (1.0 - cf) * svm_trial / (3.0 * G)
+
+
+def plastic_work_increment(svm_trial: np.ndarray, cf: np.ndarray, G: float) -> np.ndarray:
+    """Eq. (31): d w_p = d eps_pl : s_n = (1 - c_f) c_f s:s / (2 mu) = (1 - c_f) c_f sigma_vm_trial^2 / (3 mu)."""
+    return (1.0 - cf) * cf * svm_trial * svm_trial / (3.0 * G)
+
+
+def temperature_increment(dw_p: np.ndarray, rho: np.ndarray, jc: JohnsonCook) -> np.ndarray:
+    """Eq. (28), increment form: dT = chi d w_p / (rho C_p)."""
+    return jc.chi * dw_p / (rho * jc.cp)
+
+
+def plastic_update(S: np.ndarray, S_zz: np.ndarray, eps_p: np.ndarray, T: np.ndarray, rho: np.ndarray,
+                   eps_dot: np.ndarray, jc: JohnsonCook, G: float, heating: bool = True):
+    """One return map at the end of a step, Eqs. (25)-(31).
+
+    S, S_zz: trial deviatoric stress (the elastic update); eps_p, T: values at the start of the step; rho:
+    density; eps_dot: equivalent strain rate of the step. The yield stress is evaluated with the start-of-step
+    eps_p and T (explicit, as in the paper). Returns (S_n, S_zz_n, d_eps_p, d_w_p, d_T); d_T is zero if
+    ``heating`` is False (isothermal material-point curves)."""
+    sy = yield_stress(jc, eps_p, eps_dot, T)
+    cf, S_n, S_zz_n, svm = radial_return(S, S_zz, sy)
+    deps = effective_plastic_strain_increment(svm, cf, G)
+    dw = plastic_work_increment(svm, cf, G)
+    dT = temperature_increment(dw, rho, jc) if heating else np.zeros_like(dw)
+    return S_n, S_zz_n, deps, dw, dT

@@ -17,6 +17,9 @@ Model (what the scene needs, nothing more):
   is stiffer against shortening and its "diameter" is a width.
 * ``symmetry=False`` models the whole body (a check of the symmetry planes).
 
+Numerics: Table 2 (h = 1.5 dp, beta1 = beta2 = 1.5, ESPH gamma = 0.3), Courant 0.3, t_end = 80 us; the ESPH
+Verlet skin is 0.3 h (the default 0.1 h would rebuild the list every few steps at 181 m/s).
+
 Measurements (stated in chapter 06): length L = max z + dz/2 - (min z - dz/2), from particle centres plus
 half a spacing at each end; diameter D = 2 (max r + dr/2), r = sqrt(x^2 + y^2) (2D: |x|), over all particles
 (the widest point is the foot of the mushroom). At t = 0 these give exactly 37.97 and 7.595 mm.

@@ -18,8 +18,9 @@ normal traction the other half would exert.
 **Rigid frictionless wall** x_a = c (the body on the side x_a > c), imposed as a unilateral kinematic
 constraint: a particle that moves towards the wall and whose centre is, or within the next step would be,
 closer than half a spacing to it (x_a + dt v_a < c + gap, gap = dp / 2, so that the body's face -- centres
-minus half a spacing -- touches the wall) gets x_a <- max(x_a, c + gap) and v_a <- 0. The tangential velocity
-is left free (no friction) and a particle moving away is left alone, so the body can rebound. The impulse the
+minus half a spacing -- touches the wall) gets v_a <- 0. Every particle is kept at x_a >= c + gap (a position
+projection, which only acts on particles in contact). The tangential velocity is left free (no friction) and
+the velocity of a particle moving away is left alone, so the body can rebound. The impulse the
 wall gives is the sum of m (v_a,after - v_a,before).
 Issue 4 brings proper contact (tools, pinball); this wall is the simplest thing that a Taylor impact needs.
 """
@@ -93,8 +94,11 @@ class MirrorPlanes:
         for a in self.axes:
             if not 0 <= a < d:
                 raise ValueError(f"symmetry axis {a} does not exist in {d}D")
-        if n and np.any(x[:, list(self.axes)] < 0):
-            raise ValueError("a particle lies on the wrong side of a symmetry plane (x_a < 0)")
+        if n:
+            bad = np.flatnonzero(np.any(x[:, list(self.axes)] <= 0, axis=1))
+            if len(bad):
+                raise ValueError(f"particle {bad[0]} lies on or behind a symmetry plane (x_a <= 0 for an axis in "
+                                 f"{self.axes}); the body must lie strictly on the side x_a > 0")
         srcs, signs = [], []
         for k in range(1, len(self.axes) + 1):
             for subset in combinations(self.axes, k):
@@ -116,6 +120,14 @@ class RigidWall:
     axis: int
     position: float
     gap: float
+
+    def __post_init__(self):
+        if isinstance(self.axis, bool) or not isinstance(self.axis, (int, np.integer)) or self.axis < 0:
+            raise ValueError(f"wall axis must be a non-negative integer, got {self.axis!r}")
+        if not np.isfinite(self.position):
+            raise ValueError(f"wall position must be finite, got {self.position!r}")
+        if not (np.isfinite(self.gap) and self.gap > 0):
+            raise ValueError(f"wall gap must be positive, got {self.gap!r}")
 
     def apply(self, state: State, dt: float) -> float:
         """Unilateral constraint in place on ``state`` (positions and velocities); returns the impulse the wall

@@ -47,7 +47,6 @@ class _Solver:
         self.mirror = mirror
         self.walls = tuple(walls or ())
         self.wall_impulse = np.zeros(len(self.walls))
-        self.n_plastic_updates = 0
 
     def finish_stage(self, old: State, new: State, rates: Rates, dt: float, final: bool) -> State:
         for k, wall in enumerate(self.walls):
@@ -74,6 +73,7 @@ class _Solver:
     def _common_diagnostics(self) -> dict:
         out = {}
         if self.walls:
+            # impulse of each wall on the *model* (a quarter/half of the body with symmetry planes), N s (2D: N s/m)
             out["wall_impulse"] = [float(i) for i in self.wall_impulse]
         return out
 

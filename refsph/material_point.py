@@ -1,7 +1,8 @@
 """A material-point driver: one particle, a prescribed velocity gradient, the package's own constitutive path.
 
 The same functions as in a particle run are used, in the same order: the Jaumann stress rate (Eq. 20), the
-density from continuity (rho_dot = -rho tr l, so p follows Eq. 24), the predictor-corrector step and the
+density from continuity (rho_dot = -rho tr l, integrated exactly over the step, rho exp(-dt tr l), as l is
+constant in a step; p follows Eq. 24), the predictor-corrector step and the
 Wilkins return map with Johnson-Cook hardening, rate and temperature (Eqs. 25-31), so curves from here test
 what the SPH solvers do to each particle.
 

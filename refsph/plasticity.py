@@ -40,6 +40,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 import math
+import numbers
 
 import numpy as np
 
@@ -72,7 +73,7 @@ class JohnsonCook:
     def __post_init__(self):
         for name in ("A", "B", "n", "C", "m", "eps_dot_0", "T_room", "T_melt", "cp", "chi"):
             val = getattr(self, name)
-            if val is None or isinstance(val, bool) or not isinstance(val, (int, float)) or not math.isfinite(val):
+            if val is None or isinstance(val, bool) or not isinstance(val, numbers.Real) or not math.isfinite(val):
                 raise ValueError(f"Johnson-Cook constant {name} must be a finite number, got {val!r}")
         for name in ("A", "eps_dot_0", "T_room", "cp", "m"):
             if not getattr(self, name) > 0:
@@ -85,7 +86,8 @@ class JohnsonCook:
         if not 0.0 <= self.chi <= 1.0:
             raise ValueError(f"Taylor-Quinney coefficient chi must lie in [0, 1], got {self.chi!r}")
         s = self.hardening_saturation_strain
-        if s is not None and not (isinstance(s, (int, float)) and math.isfinite(s) and s > 0):
+        if s is not None and (isinstance(s, bool) or not isinstance(s, numbers.Real) or not math.isfinite(s)
+                              or not s > 0):
             raise ValueError(f"hardening_saturation_strain must be None or positive, got {s!r}")
 
     @classmethod
@@ -95,6 +97,9 @@ class JohnsonCook:
         missing = [k for k in names if k not in d]
         if missing:
             raise ValueError(f"missing Johnson-Cook constant(s): {', '.join(missing)}")
+        unknown = sorted(set(d) - set(names))
+        if unknown:
+            raise ValueError(f"unknown Johnson-Cook constant(s): {', '.join(unknown)}")
         return cls(**{k: d[k] for k in names})
 
 

@@ -80,6 +80,16 @@ def simulate(setup: Setup, method: str, *, scene=None, out=None, dt: float | Non
     _validate(method, setup.state.dim, setup.dp, setup.numerics, setup.t_end, dt)
     state = setup.state.copy()
     state.check()
+    if setup.plasticity is not None and not state.plastic:
+        raise ValueError("a Johnson-Cook material needs a state with eps_p, eps_dot_p, W_p and T "
+                         "(make_state(..., T0=room temperature))")
+    for w in setup.walls:
+        if w.axis >= state.dim:
+            raise ValueError(f"wall axis {w.axis} does not exist in {state.dim}D")
+    if setup.mirror is not None:
+        for a in setup.mirror.axes:
+            if a >= state.dim:
+                raise ValueError(f"symmetry axis {a} does not exist in {state.dim}D")
     solver = make_solver(method, setup)
     out = Path(out) if out is not None else None
     if out is not None:
@@ -148,8 +158,16 @@ def simulate(setup: Setup, method: str, *, scene=None, out=None, dt: float | Non
             dts.append(step_dt)                             # the step size chosen (before any cut to land on t_end)
             step_dt = min(step_dt, setup.t_end - state.t)
             prev = state
-            with np.errstate(divide="ignore", invalid="ignore", over="ignore"):  # non-finite: caught below
-                state = predictor_corrector_step(state, solver, step_dt)
+            try:
+                with np.errstate(divide="ignore", invalid="ignore", over="ignore"):  # non-finite: caught below
+                    state = predictor_corrector_step(state, solver, step_dt)
+            except ValueError as e:                         # e.g. a particle crossed a symmetry plane
+                msg = f"step {n_steps + 1} (t = {prev.t:.6e} s) failed: {e}"
+                if out is not None:
+                    save_snapshot(out / "snapshots" / "last_good.npz", prev, setup.material, F_of(prev))
+                    msg += f"; last good state written to {out / 'snapshots' / 'last_good.npz'}"
+                summary.update(status="error", error=msg)
+                raise SimulationError(msg) from e
             n_steps += 1
             if not (np.isfinite(state.v).all() and np.isfinite(state.x).all()):
                 bad = state.first_nonfinite() or ("x/v", -1)
@@ -177,6 +195,10 @@ def simulate(setup: Setup, method: str, *, scene=None, out=None, dt: float | Non
         summary["status"] = "ok"
     except KeyboardInterrupt:
         summary["status"] = "interrupted"
+        raise
+    except Exception as e:
+        if summary["status"] == "running":
+            summary.update(status="error", error=f"{type(e).__name__}: {e}")
         raise
     finally:
         wall = time.perf_counter() - t0

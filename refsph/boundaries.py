@@ -69,13 +69,23 @@ class Ghosts:
     def extend_scalars(self, s: np.ndarray) -> np.ndarray:
         return np.concatenate([s, self.scalars(s)])
 
-    def extend_state(self, state: State) -> State:
+    def extend_state(self, state: State, constant: tuple | None = None) -> State:
         """The state of real particles and ghosts (mechanical fields only; thermal fields are per particle
-        and never summed over neighbours)."""
-        return State(x=self.extend_vectors(state.x), v=self.extend_vectors(state.v),
-                     m=self.extend_scalars(state.m), rho=self.extend_scalars(state.rho),
-                     S=self.extend_tensors(state.S), S_zz=self.extend_scalars(state.S_zz),
-                     X=self.extend_vectors(state.X), V0=self.extend_scalars(state.V0), t=state.t)
+        and never summed over neighbours).
+
+        ``constant``: (m, X, V0) already extended -- the fields that do not change while these ghosts are in
+        use. A solver passes the same arrays every call, so that what it caches per array (the TLSPH momentum
+        sum's sum_j m_j grad W) stays valid; without it they are extended here."""
+        if constant is None:
+            constant = self.extend_constant(state)
+        m, X, V0 = constant
+        return State(x=self.extend_vectors(state.x), v=self.extend_vectors(state.v), m=m,
+                     rho=self.extend_scalars(state.rho), S=self.extend_tensors(state.S),
+                     S_zz=self.extend_scalars(state.S_zz), X=X, V0=V0, t=state.t)
+
+    def extend_constant(self, state: State) -> tuple:
+        """(m, X, V0) of real particles and ghosts, for :meth:`extend_state`."""
+        return self.extend_scalars(state.m), self.extend_vectors(state.X), self.extend_scalars(state.V0)
 
 
 @dataclass(frozen=True)
@@ -88,12 +98,16 @@ class MirrorPlanes:
         if len(set(self.axes)) != len(self.axes):
             raise ValueError(f"symmetry axes must be distinct, got {self.axes!r}")
 
-    def ghosts(self, x: np.ndarray, cutoff: float) -> Ghosts:
-        """Images of every particle within ``cutoff`` of a plane (and of the edges/corner where planes meet)."""
-        n, d = x.shape
+    def check(self, d: int) -> None:
+        """Every axis exists in d dimensions (ValueError otherwise)."""
         for a in self.axes:
             if not 0 <= a < d:
                 raise ValueError(f"symmetry axis {a} does not exist in {d}D")
+
+    def ghosts(self, x: np.ndarray, cutoff: float) -> Ghosts:
+        """Images of every particle within ``cutoff`` of a plane (and of the edges/corner where planes meet)."""
+        n, d = x.shape
+        self.check(d)
         if n:
             bad = np.flatnonzero(np.any(x[:, list(self.axes)] <= 0, axis=1))
             if len(bad):
@@ -128,6 +142,11 @@ class RigidWall:
             raise ValueError(f"wall position must be finite, got {self.position!r}")
         if not (np.isfinite(self.gap) and self.gap > 0):
             raise ValueError(f"wall gap must be positive, got {self.gap!r}")
+
+    def check(self, d: int) -> None:
+        """The wall's axis exists in d dimensions (ValueError otherwise)."""
+        if self.axis >= d:
+            raise ValueError(f"wall axis {self.axis} does not exist in {d}D")
 
     def apply(self, state: State, dt: float) -> float:
         """Unilateral constraint in place on ``state`` (positions and velocities); returns the impulse the wall

@@ -51,7 +51,7 @@ def main(argv=None) -> int:
         return 2
     scene = SCENES[args.scene]
     try:
-        options = _parse_options(args.option, scene)
+        options = _parse_options(args.option)          # checked and converted by run() (scenes.convert_options)
     except ValueError as e:
         print(f"refsph: {e}", file=sys.stderr)
         return 2
@@ -85,28 +85,14 @@ def main(argv=None) -> int:
     return 0
 
 
-def _parse_options(items, scene) -> dict:
-    """NAME=VALUE strings -> {name: value}, the value converted like the option's default."""
+def _parse_options(items) -> dict:
+    """NAME=VALUE strings -> {name: 'VALUE'}; :func:`refsph.scenes.convert_options` checks and converts them."""
     out = {}
     for item in items:
         if "=" not in item:
             raise ValueError(f"--option needs NAME=VALUE, got {item!r}")
         name, value = item.split("=", 1)
-        if name not in scene.options:
-            known = ", ".join(sorted(scene.options)) or "none"
-            raise ValueError(f"unknown option {name!r} for scene {scene.name!r} (known: {known})")
-        default = scene.options[name][0]
-        if isinstance(default, bool):
-            if value.lower() not in ("true", "false", "1", "0", "yes", "no"):
-                raise ValueError(f"option {name} must be true or false, got {value!r}")
-            out[name] = value.lower() in ("true", "1", "yes")
-        elif isinstance(default, (int, float)):
-            try:
-                out[name] = float(value)
-            except ValueError:
-                raise ValueError(f"option {name} must be a number, got {value!r}") from None
-        else:
-            out[name] = value
+        out[name] = value
     return out
 
 

@@ -48,6 +48,17 @@ class _Solver:
         self.walls = tuple(walls or ())
         self.wall_impulse = np.zeros(len(self.walls))
 
+    def check_state(self, state: State) -> None:
+        """The state fits the solver: the Johnson-Cook fields where plasticity is on, boundaries in its
+        dimension (ValueError otherwise)."""
+        if self.plasticity is not None and not state.plastic:
+            raise ValueError("a Johnson-Cook material needs a state with eps_p, eps_dot_p, W_p and T "
+                             "(make_state(..., T0=room temperature))")
+        for w in self.walls:
+            w.check(state.dim)
+        if self.mirror is not None:
+            self.mirror.check(state.dim)
+
     def finish_stage(self, old: State, new: State, rates: Rates, dt: float, final: bool) -> State:
         for k, wall in enumerate(self.walls):
             imp = wall.apply(new, dt)
@@ -55,9 +66,7 @@ class _Solver:
                 self.wall_impulse[k] += imp
         jc = self.plasticity
         if jc is not None:
-            if not old.plastic:
-                raise ValueError("a Johnson-Cook material needs a state with eps_p, T, ... "
-                                 "(make_state(..., T0=room temperature))")
+            self.check_state(old)
             eps_dot = equivalent_strain_rate(rates.l)
             rho = new.rho if rates.rho is not None else old.rho
             S, S_zz, deps, dw, dT = plastic_update(new.S, new.S_zz, old.eps_p, old.T, rho, eps_dot, jc,
@@ -69,6 +78,12 @@ class _Solver:
                 new.T = old.T + dT
                 new.eps_dot_p = deps / dt
         return new
+
+    @staticmethod
+    def _real_rows(r: Rates, n: int) -> Rates:
+        """The rates of the first n (real) particles of an extended (real + ghost) evaluation."""
+        return Rates(x=r.x[:n], v=r.v[:n], rho=None if r.rho is None else r.rho[:n], S=r.S[:n], S_zz=r.S_zz[:n],
+                     l=r.l[:n])
 
     def _common_diagnostics(self) -> dict:
         out = {}
@@ -94,7 +109,7 @@ class ESPHSolver(_Solver):
         self._pair_sum: PairSum | None = None              # sparse pattern of the current pair list
         self._pair_sum_build = -1
         self._ghosts: Ghosts | None = None
-        self._x_ghost_build: np.ndarray | None = None
+        self._ghost_constant: tuple | None = None          # extended (m, X, V0) of the current ghosts
 
     @property
     def h(self) -> float:
@@ -104,25 +119,20 @@ class ESPHSolver(_Solver):
         if self.mirror is None:
             return self.pairs.update(state.x), state
         x = state.x
-        if (self._ghosts is None or self._x_ghost_build.shape != x.shape
-                or float(np.sqrt(np.max(np.einsum("ik,ik->i", x - self._x_ghost_build,
-                                                  x - self._x_ghost_build)))) > 0.5 * self.pairs.skin):
+        if self._ghosts is None or self.pairs.needs_rebuild(x):
             self._ghosts = self.mirror.ghosts(x, self.pairs.cutoff + self.pairs.skin)
-            I, J = self.pairs.build(self._ghosts.extend_vectors(x))
+            self._ghost_constant = self._ghosts.extend_constant(state)
+            I, J = self.pairs.build(self._ghosts.extend_vectors(x), track=x)
             keep = I < state.n                              # ghost-ghost pairs act on ghosts only
             self.pairs.I, self.pairs.J = I[keep], J[keep]
-            self._x_ghost_build = x.copy()
-        return (self.pairs.I, self.pairs.J), self._ghosts.extend_state(state)
+        return (self.pairs.I, self.pairs.J), self._ghosts.extend_state(state, self._ghost_constant)
 
     def rates(self, state: State) -> Rates:
         (I, J), ext = self._pairs_and_state(state)
         if self._pair_sum_build != self.pairs.n_builds:
             self._pair_sum, self._pair_sum_build = PairSum(I, J, ext.n), self.pairs.n_builds
         r = esph_rates(ext, self.material, self.params, I, J, pairs=self._pair_sum)
-        if ext is not state:
-            n = state.n
-            r = Rates(x=r.x[:n], v=r.v[:n], rho=r.rho[:n], S=r.S[:n], S_zz=r.S_zz[:n], l=r.l[:n])
-        return r
+        return r if ext is state else self._real_rows(r, state.n)
 
     def after_step(self, state: State) -> State:
         return state
@@ -148,6 +158,7 @@ class TLSPHSolver(_Solver):
         self._init_common(material, plasticity, mirror, walls)
         self.params = params
         self.op: ReferenceOperator | None = None
+        self._ghost_constant: tuple | None = None          # extended (m, X, V0) of the operator's ghosts
         self.n_reference_updates = 0
         self._F_after_step: tuple | None = None
 
@@ -162,12 +173,13 @@ class TLSPHSolver(_Solver):
                 self.op = ReferenceOperator(state.X, state.V0, p.h, p.kernel, p.corrected)
             else:
                 g = self.mirror.ghosts(state.X, p.kernel.support * p.h)
-                self.op = ReferenceOperator(g.extend_vectors(state.X), g.extend_scalars(state.V0), p.h, p.kernel,
-                                            p.corrected, ghosts=g)
+                self._ghost_constant = g.extend_constant(state)   # m, X, V0: fixed with the operator
+                _, X, V0 = self._ghost_constant
+                self.op = ReferenceOperator(X, V0, p.h, p.kernel, p.corrected, ghosts=g)
         return self.op
 
     def _extended(self, state: State, op: ReferenceOperator) -> State:
-        return state if op.ghosts is None else op.ghosts.extend_state(state)
+        return state if op.ghosts is None else op.ghosts.extend_state(state, self._ghost_constant)
 
     def _F(self, ext: State, op: ReferenceOperator) -> np.ndarray:
         """Eq. (18) on the (extended) state; ghost rows are the mirror images of their sources'."""
@@ -185,10 +197,7 @@ class TLSPHSolver(_Solver):
         if F is None:
             F = self._F(ext, op)
         r = tlsph_rates(ext, self.material, self.params, op, F=F)
-        if ext is not state:
-            n = state.n
-            r = Rates(x=r.x[:n], v=r.v[:n], rho=None, S=r.S[:n], S_zz=r.S_zz[:n], l=r.l[:n])
-        return r
+        return r if ext is state else self._real_rows(r, state.n)
 
     def deformation_gradient(self, state: State) -> np.ndarray:
         op = self.operator(state)

@@ -121,9 +121,12 @@ class VerletList:
         self.I = np.zeros(0, dtype=np.intp)
         self.J = np.zeros(0, dtype=np.intp)
 
-    def build(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    def build(self, x: np.ndarray, track: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """Pairs of ``x`` within cutoff + skin. ``track``: the positions whose displacement decides the next
+        rebuild, if not ``x`` itself (e.g. the real particles, when ``x`` also holds mirror ghosts that move
+        with them)."""
         self.I, self.J = find_pairs(x, self.cutoff + self.skin)
-        self._x_build = np.array(x, dtype=float, copy=True)
+        self._x_build = np.array(x if track is None else track, dtype=float, copy=True)
         self.n_builds += 1
         return self.I, self.J
 

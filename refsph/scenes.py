@@ -17,7 +17,7 @@ from .plasticity import JohnsonCook
 from .neighbours import find_pairs
 from .state import State, make_state
 
-__all__ = ["Numerics", "Setup", "Scene", "SCENES", "get_scene", "lattice", "AISI4340_ELASTIC",
+__all__ = ["Numerics", "Setup", "Scene", "SCENES", "get_scene", "convert_options", "lattice", "AISI4340_ELASTIC",
            "kinetic_energy", "elastic_energy", "linear_momentum", "min_pair_distance"]
 
 # AISI 4340, elastic constants of Table 3 (Islam, Bansal & Peng)
@@ -87,6 +87,34 @@ class Scene:
     default_dim: int = 2
     methods: tuple = ("tlsph",)
     report: Callable[[list], str] | None = None
+
+
+_TRUE, _FALSE = ("true", "1", "yes"), ("false", "0", "no")
+
+
+def convert_options(scene: Scene, options: dict) -> dict:
+    """Check a scene's options and convert each value like its default (strings from the command line
+    included): booleans from true/false/1/0/yes/no, numbers with float(). Unknown names are refused."""
+    out = {}
+    for name, value in options.items():
+        if name not in scene.options:
+            known = ", ".join(sorted(scene.options)) or "none"
+            raise ValueError(f"unknown option {name!r} for scene {scene.name!r} (known: {known})")
+        default = scene.options[name][0]
+        if isinstance(default, bool):
+            if isinstance(value, str) and value.lower() in _TRUE + _FALSE:
+                value = value.lower() in _TRUE
+            if not isinstance(value, (bool, np.bool_)):
+                raise ValueError(f"option {name} must be true or false, got {value!r}")
+            out[name] = bool(value)
+        elif isinstance(default, (int, float)):
+            try:
+                out[name] = float(value)
+            except (TypeError, ValueError):
+                raise ValueError(f"option {name} must be a number, got {value!r}") from None
+        else:
+            out[name] = value
+    return out
 
 
 def lattice(lengths, dp: float) -> np.ndarray:

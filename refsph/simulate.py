@@ -19,7 +19,7 @@ from .esph import ESPHParams
 from .integrate import ESPHSolver, TLSPHSolver, cfl_time_step, predictor_corrector_step
 from .io import save_snapshot, write_json
 from .kernels import get_kernel
-from .scenes import Setup, get_scene
+from .scenes import Setup, convert_options, get_scene
 from .state import State
 from .tlsph import TLSPHParams
 
@@ -80,17 +80,8 @@ def simulate(setup: Setup, method: str, *, scene=None, out=None, dt: float | Non
     _validate(method, setup.state.dim, setup.dp, setup.numerics, setup.t_end, dt)
     state = setup.state.copy()
     state.check()
-    if setup.plasticity is not None and not state.plastic:
-        raise ValueError("a Johnson-Cook material needs a state with eps_p, eps_dot_p, W_p and T "
-                         "(make_state(..., T0=room temperature))")
-    for w in setup.walls:
-        if w.axis >= state.dim:
-            raise ValueError(f"wall axis {w.axis} does not exist in {state.dim}D")
-    if setup.mirror is not None:
-        for a in setup.mirror.axes:
-            if a >= state.dim:
-                raise ValueError(f"symmetry axis {a} does not exist in {state.dim}D")
     solver = make_solver(method, setup)
+    solver.check_state(state)
     out = Path(out) if out is not None else None
     if out is not None:
         (out / "snapshots").mkdir(parents=True, exist_ok=True)
@@ -222,12 +213,7 @@ def run(scene_name: str, method: str, *, dim: int | None = None, dp: float | Non
     if dim is None:
         dim = scene.default_dim
     _validate(method, dim, dp, None, t_end, dt)
-    options = dict(options or {})
-    unknown = set(options) - set(scene.options)
-    if unknown:
-        known = ", ".join(sorted(scene.options)) or "none"
-        raise ValueError(f"unknown option(s) for scene {scene_name!r}: {', '.join(sorted(unknown))} "
-                         f"(known: {known})")
+    options = convert_options(scene, options or {})
     if dp is None:
         dp = scene.default_dp(dim, quick)
     setup = scene.build(dim, dp, quick, **options)

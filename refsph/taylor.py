@@ -103,10 +103,8 @@ def _build(dim, dp, quick, T_melt=TAYLOR_OPTIONS["T_melt"][0], symmetry=True, ep
     g = TAYLOR_GEOMETRY
     mat = taylor_material()
     jc = taylor_johnson_cook(T_melt, eps_dot_0)
-    if isinstance(symmetry, str):
-        if symmetry.lower() not in ("1", "true", "yes", "0", "false", "no"):
-            raise ValueError(f"option symmetry must be true or false, got {symmetry!r}")
-        symmetry = symmetry.lower() in ("1", "true", "yes")
+    if not isinstance(symmetry, (bool, np.bool_)):         # strings are converted by scenes.convert_options
+        raise ValueError(f"option symmetry must be True or False, got {symmetry!r}")
     symmetry = bool(symmetry)
     if not (np.isfinite(T_melt) and T_melt > 293.0):
         raise ValueError(f"option T_melt must exceed the room temperature 293 K, got {T_melt!r}")

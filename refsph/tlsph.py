@@ -144,7 +144,7 @@ class ReferenceOperator:
         the j-side term uses the transposed operator: m_j grad~_j W_ji = (m_j / V_i) G[k][j, i].
         The pair term is antisymmetric, so sum_i m_i dv_i/dt = 0 (momentum conserved to round-off).
         """
-        if self._sm is None or (self._sm_m is not m and not np.array_equal(self._sm_m, m)):
+        if self._sm is None or self._sm_m is not m:
             rho_ref = m / self.V
             self._sm = np.stack([Gk @ rho_ref for Gk in self.G], axis=1)  # sum_j m_j grad~_i W_ij (fixed)
             self._sm_m = m

@@ -113,17 +113,21 @@ def material_point(mat: ElasticMaterial, jc: JohnsonCook | None, l, dt: float, n
                 return ll
             a, fa = lam, lateral_stress(trial(with_lam(lam)))
             b = lam + 1e-3 * abs(l_step[0, 0]) + 1e-12
-            fb = lateral_stress(trial(with_lam(b)))
+            res = trial(with_lam(b))
+            fb = lateral_stress(res)
             for _ in range(30):                             # secant on sigma_yy(lam) = 0
                 if fb == fa:
                     break
                 a, fa, b = b, fb, b - fb * (b - a) / (fb - fa)
-                fb = lateral_stress(trial(with_lam(b)))
+                res = trial(with_lam(b))
+                fb = lateral_stress(res)
                 if abs(fb) < 1e-9 * max(mat.G * 1e-6, 1.0):
                     break
             lam = b
-            l_step = with_lam(lam)
-        S, rho, deps, dw, dT, edot = trial(l_step)
+            l_step = with_lam(lam)                          # res is the step with this l
+        else:
+            res = trial(l_step)
+        S, rho, deps, dw, dT, edot = res
         if jc is not None:                                  # the yield stress this step returned to
             out["sigma_y"][k] = float(yield_stress(jc, eps_p[0], edot, T[0]))
         eps_p = eps_p + deps

@@ -1,4 +1,5 @@
-"""Boundaries that a scene may need: symmetry planes (mirror ghosts) and a rigid frictionless wall.
+"""Boundaries that a scene may need: symmetry planes (mirror ghosts), a rigid frictionless wall, rigid bodies
+(tools) of prescribed velocity and clamps.
 
 The paper does not say how its Taylor bar meets the wall or whether it uses symmetry; these are the standard
 choices, stated here and in chapter 06.
@@ -22,7 +23,22 @@ minus half a spacing -- touches the wall) gets v_a <- 0. Every particle is kept 
 projection, which only acts on particles in contact). The tangential velocity is left free (no friction) and
 the velocity of a particle moving away is left alone, so the body can rebound. The impulse the
 wall gives is the sum of m (v_a,after - v_a,before).
-Issue 4 brings proper contact (tools, pinball); this wall is the simplest thing that a Taylor impact needs.
+It is the simplest thing that a Taylor impact needs; tools are :class:`RigidBody` particles (below).
+
+**Rigid body** (the paper's tools, Section 2.4): particles of their own body id (``State.body``) that move
+with a prescribed velocity V,
+
+    x_i(t) = x_i(0) + V t,   v_i = V,
+
+made only of the layers that can touch the workpiece. They carry no constitutive stress. How they act on the
+workpiece is the method's: in ESPH they are ordinary SPH neighbours (their density is integrated by the
+continuity equation, Eq. 10, and floored at rho0, so they push with the pressure K (rho/rho0 - 1) >= 0 and
+never pull); in TLSPH they are partners of the pinball contact (:mod:`refsph.contact`). The solvers record
+the force the rest of the system exerts on each body at every step.
+
+**Clamp** (the fixed left side of the pressing block): particles *of the deformable body* whose velocity is
+held at zero (an essential boundary condition, as on the nodes of a finite-element model). They keep their
+constitutive response; only their motion is prescribed. The force that holds them is recorded like a tool's.
 """
 from __future__ import annotations
 
@@ -33,7 +49,7 @@ import numpy as np
 
 from .state import State
 
-__all__ = ["MirrorPlanes", "Ghosts", "RigidWall"]
+__all__ = ["MirrorPlanes", "Ghosts", "RigidWall", "RigidBody", "Clamp"]
 
 
 @dataclass(frozen=True)
@@ -162,3 +178,45 @@ class RigidWall:
         state.v[hit, a] = 0.0
         state.x[:, a] = np.maximum(state.x[:, a], z0)
         return impulse
+
+
+@dataclass(frozen=True)
+class RigidBody:
+    """A rigid body of prescribed translation: the particles with ``State.body == body`` move with
+    ``velocity`` (m/s, a d-vector): x(t) = x(0) + V t. ``body`` must be a positive id (0 is the workpiece);
+    its particles must come after every deformable particle in the state (the solvers work on the leading
+    deformable rows as one block)."""
+
+    name: str
+    body: int
+    velocity: tuple
+
+    def __post_init__(self):
+        if isinstance(self.body, bool) or not isinstance(self.body, (int, np.integer)) or self.body < 1:
+            raise ValueError(f"rigid body id must be a positive integer (0 is the workpiece), got {self.body!r}")
+        v = np.asarray(self.velocity, dtype=float)
+        if v.ndim != 1 or not np.all(np.isfinite(v)):
+            raise ValueError(f"rigid body velocity must be a finite vector, got {self.velocity!r}")
+        object.__setattr__(self, "velocity", tuple(float(c) for c in v))
+
+    def check(self, d: int) -> None:
+        if len(self.velocity) != d:
+            raise ValueError(f"rigid body {self.name!r}: velocity has {len(self.velocity)} components, "
+                             f"the state is {d}D")
+
+
+@dataclass(frozen=True, eq=False)
+class Clamp:
+    """Particles ``index`` of a deformable body held at rest (v = 0, x fixed): a fixed boundary."""
+
+    name: str
+    index: np.ndarray
+
+    def __post_init__(self):
+        idx = np.asarray(self.index)
+        if idx.ndim != 1 or not np.issubdtype(idx.dtype, np.integer) or len(idx) == 0:
+            raise ValueError(f"clamp {self.name!r}: index must be a non-empty 1-D integer array")
+        object.__setattr__(self, "index", np.unique(idx).astype(np.intp))
+
+    def to_dict(self) -> dict:
+        return dict(name=self.name, n_particles=int(len(self.index)))

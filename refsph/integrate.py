@@ -16,7 +16,7 @@ A fixed dt, as in the paper's tables, is also accepted by the driver.
 """
 from __future__ import annotations
 
-from dataclasses import replace
+from dataclasses import fields, replace
 
 import numpy as np
 
@@ -26,6 +26,7 @@ from .neighbours import PairSum, VerletList
 from .state import State
 from .tensor import det
 from .boundaries import Ghosts, MirrorPlanes
+from .contact import PinballContact, pinball_contact
 from .plasticity import JohnsonCook, equivalent_strain_rate, plastic_update
 from .tlsph import ReferenceOperator, TLSPHParams, green_lagrange_norm, reset_reference, tlsph_rates
 
@@ -41,32 +42,110 @@ class _Solver:
     impulse; the predictor's half state is returned to the yield surface with the start-of-step values, so that
     the midpoint rates see an admissible stress."""
 
-    def _init_common(self, material, plasticity, mirror, walls):
+    def _init_common(self, material, plasticity, mirror, walls, rigid=(), clamps=()):
         self.material = material
         self.plasticity = plasticity
         self.mirror = mirror
         self.walls = tuple(walls or ())
         self.wall_impulse = np.zeros(len(self.walls))
+        self.rigid = tuple(rigid or ())
+        self.clamps = tuple(clamps or ())
+        names = [b.name for b in self.rigid] + [c.name for c in self.clamps]
+        if len(set(names)) != len(names):
+            raise ValueError(f"rigid bodies and clamps need distinct names, got {names}")
+        if self.rigid and mirror is not None:
+            raise ValueError("rigid bodies together with symmetry planes are not implemented")
+        self.dt: float | None = None           # size of the step being taken (set by predictor_corrector_step)
+        self.n_deformable: int | None = None   # rows [0, n_deformable) are deformable, the rest rigid
+        self._rigid_rows: list[slice] = []
+        self._reaction: list[np.ndarray] | None = None     # force on each rigid body / clamp, last evaluation
+        self.reaction_log: list[list[float]] = []          # per step: t_mid, then d components per body/clamp
+        self.reaction_impulse = [0.0 for _ in names]
+
+    @property
+    def reaction_names(self) -> list[str]:
+        """Names of the rigid bodies and clamps, in the order of the reaction log."""
+        return [b.name for b in self.rigid] + [c.name for c in self.clamps]
 
     def check_state(self, state: State) -> None:
         """The state fits the solver: the Johnson-Cook fields where plasticity is on, boundaries in its
-        dimension (ValueError otherwise)."""
-        if self.plasticity is not None and not state.plastic:
-            raise ValueError("a Johnson-Cook material needs a state with eps_p, eps_dot_p, W_p and T "
-                             "(make_state(..., T0=room temperature))")
+        dimension, rigid bodies as trailing rows of their body id, clamps on deformable particles (ValueError
+        otherwise)."""
+        self._check_plastic(state)
         for w in self.walls:
             w.check(state.dim)
         if self.mirror is not None:
             self.mirror.check(state.dim)
+        self._bind_bodies(state)
+
+    def _check_plastic(self, state: State) -> None:
+        if self.plasticity is not None and not state.plastic:
+            raise ValueError("a Johnson-Cook material needs a state with eps_p, eps_dot_p, W_p and T "
+                             "(make_state(..., T0=room temperature))")
+
+    def _bind_bodies(self, state: State) -> None:
+        n = state.n
+        if not self.rigid:
+            self.n_deformable, self._rigid_rows = n, []
+        else:
+            if state.body is None:
+                raise ValueError("rigid bodies need State.body (the body id of every particle)")
+            rows = []
+            for b in self.rigid:
+                b.check(state.dim)
+                idx = np.flatnonzero(state.body == b.body)
+                if len(idx) == 0:
+                    raise ValueError(f"rigid body {b.name!r}: no particle has body id {b.body}")
+                if idx[-1] - idx[0] + 1 != len(idx):
+                    raise ValueError(f"rigid body {b.name!r}: its particles must be consecutive rows")
+                rows.append(slice(int(idx[0]), int(idx[-1]) + 1))
+            n_def = min(r.start for r in rows)
+            if sum(r.stop - r.start for r in rows) != n - n_def:
+                raise ValueError("rigid body particles must come after every deformable particle in the state")
+            self.n_deformable, self._rigid_rows = n_def, rows
+        for c in self.clamps:
+            if c.index[-1] >= self.n_deformable:
+                raise ValueError(f"clamp {c.name!r} holds particle {c.index[-1]}, which is not a deformable one")
+
+    def _constrain(self, state: State, r: Rates) -> Rates:
+        """Prescribed motion on the rates: rigid rows move with their velocity (dv/dt = 0, no stress rate),
+        clamped rows stay (dx/dt = dv/dt = 0). The force on each body / clamp is kept first: sum m dv/dt over
+        its rows of the unconstrained rates (pairs inside one body cancel), i.e. what the rest exerts on it."""
+        if not self.rigid and not self.clamps:
+            return r
+        forces = []
+        for b, rows in zip(self.rigid, self._rigid_rows):
+            forces.append(np.sum(state.m[rows, None] * r.v[rows], axis=0))
+            r.v[rows] = 0.0
+            r.x[rows] = np.asarray(b.velocity)
+            r.S[rows] = 0.0
+            r.S_zz[rows] = 0.0
+        for c in self.clamps:
+            forces.append(np.sum(state.m[c.index, None] * r.v[c.index], axis=0))
+            r.v[c.index] = 0.0
+            r.x[c.index] = 0.0
+        self._reaction = forces
+        return r
 
     def finish_stage(self, old: State, new: State, rates: Rates, dt: float, final: bool) -> State:
         for k, wall in enumerate(self.walls):
             imp = wall.apply(new, dt)
             if final:
                 self.wall_impulse[k] += imp
+        for b, rows in zip(self.rigid, self._rigid_rows):       # exact rigid motion (no drift from round-off)
+            new.v[rows] = np.asarray(b.velocity)
+            if rates.rho is not None:                            # ESPH: a tool pushes, it never pulls
+                new.rho[rows] = np.maximum(new.rho[rows], self.material.rho0)
+        for c in self.clamps:
+            new.v[c.index] = 0.0
+            new.x[c.index] = old.x[c.index]
+        if final and self._reaction is not None:
+            self.reaction_log.append([old.t + 0.5 * dt] + [float(c) for f in self._reaction for c in f])
+            for k, f in enumerate(self._reaction):
+                self.reaction_impulse[k] = self.reaction_impulse[k] + f * dt
         jc = self.plasticity
         if jc is not None:
-            self.check_state(old)
+            self._check_plastic(old)
             eps_dot = equivalent_strain_rate(rates.l)
             rho = new.rho if rates.rho is not None else old.rho
             S, S_zz, deps, dw, dT = plastic_update(new.S, new.S_zz, old.eps_p, old.T, rho, eps_dot, jc,
@@ -79,6 +158,19 @@ class _Solver:
                 new.eps_dot_p = deps / dt
         return new
 
+    def reaction_history(self) -> dict:
+        """{'t': (n_steps,), name: (n_steps, d) force on that rigid body / clamp} (N; 2D: N per metre of
+        thickness), one row per step at the step's midpoint (the time of the rates that moved it)."""
+        log = np.asarray(self.reaction_log, dtype=float)
+        names = self.reaction_names
+        if not names:
+            return {}
+        d = (log.shape[1] - 1) // len(names) if len(log) else 0
+        out = {"t": log[:, 0] if len(log) else np.zeros(0)}
+        for k, name in enumerate(names):
+            out[name] = log[:, 1 + k * d: 1 + (k + 1) * d] if len(log) else np.zeros((0, d))
+        return out
+
     @staticmethod
     def _real_rows(r: Rates, n: int) -> Rates:
         """The rates of the first n (real) particles of an extended (real + ghost) evaluation."""
@@ -90,6 +182,10 @@ class _Solver:
         if self.walls:
             # impulse of each wall on the *model* (a quarter/half of the body with symmetry planes), N s (2D: N s/m)
             out["wall_impulse"] = [float(i) for i in self.wall_impulse]
+        if self.reaction_names:
+            # impulse the rest of the system gave each rigid body / clamp, N s (2D: N s/m)
+            out["reaction_impulse"] = {name: [float(c) for c in np.atleast_1d(imp)]
+                                       for name, imp in zip(self.reaction_names, self.reaction_impulse)}
         return out
 
 
@@ -102,8 +198,9 @@ class ESPHSolver(_Solver):
     evolved = ("x", "v", "rho", "S", "S_zz")
 
     def __init__(self, material: ElasticMaterial, params: ESPHParams, skin_factor: float, *,
-                 plasticity: JohnsonCook | None = None, mirror: MirrorPlanes | None = None, walls=()):
-        self._init_common(material, plasticity, mirror, walls)
+                 plasticity: JohnsonCook | None = None, mirror: MirrorPlanes | None = None, walls=(),
+                 rigid=(), clamps=()):
+        self._init_common(material, plasticity, mirror, walls, rigid, clamps)
         self.params = params
         self.pairs = VerletList(params.kernel.support * params.h, skin_factor * params.h)
         self._pair_sum: PairSum | None = None              # sparse pattern of the current pair list
@@ -128,11 +225,16 @@ class ESPHSolver(_Solver):
         return (self.pairs.I, self.pairs.J), self._ghosts.extend_state(state, self._ghost_constant)
 
     def rates(self, state: State) -> Rates:
+        """Eqs. (10)-(14), (23) over all particles, rigid ones included (they are ordinary SPH neighbours:
+        velocity V, density by Eq. 10 floored at rho0, stress -p I with p = K (rho/rho0 - 1) >= 0)."""
+        if self.n_deformable is None:
+            self._bind_bodies(state)
         (I, J), ext = self._pairs_and_state(state)
         if self._pair_sum_build != self.pairs.n_builds:
             self._pair_sum, self._pair_sum_build = PairSum(I, J, ext.n), self.pairs.n_builds
         r = esph_rates(ext, self.material, self.params, I, J, pairs=self._pair_sum)
-        return r if ext is state else self._real_rows(r, state.n)
+        r = r if ext is state else self._real_rows(r, state.n)
+        return self._constrain(state, r)
 
     def after_step(self, state: State) -> State:
         return state
@@ -148,15 +250,26 @@ class ESPHSolver(_Solver):
 class TLSPHSolver(_Solver):
     """TLSPH rates with a fixed sparse operator, rebuilt at reference-configuration updates. With symmetry
     planes the ghosts are the mirror images of the reference configuration (fixed with the operator); a
-    ghost's F is the mirror image of its source's."""
+    ghost's F is the mirror image of its source's. With rigid bodies the operator covers the deformable rows
+    only, and the bodies meet through the pinball ``contact`` (:mod:`refsph.contact`; ``dp`` gives the 2D
+    force per unit thickness)."""
 
     method = "tlsph"
     evolved = ("x", "v", "S", "S_zz")
 
     def __init__(self, material: ElasticMaterial, params: TLSPHParams, *, plasticity: JohnsonCook | None = None,
-                 mirror: MirrorPlanes | None = None, walls=()):
-        self._init_common(material, plasticity, mirror, walls)
+                 mirror: MirrorPlanes | None = None, walls=(), rigid=(), clamps=(),
+                 contact: PinballContact | None = None, dp: float | None = None):
+        self._init_common(material, plasticity, mirror, walls, rigid, clamps)
+        if self.rigid and contact is None:
+            raise ValueError("TLSPH with rigid bodies needs a contact model (PinballContact)")
+        if contact is not None and not (dp is not None and dp > 0):
+            raise ValueError("the pinball contact needs the particle spacing dp (2D: force per unit thickness)")
+        self.dp = dp
         self.params = params
+        self.contact = contact
+        self.max_penetration = 0.0
+        self.n_contacts = 0
         self.op: ReferenceOperator | None = None
         self._ghost_constant: tuple | None = None          # extended (m, X, V0) of the operator's ghosts
         self.n_reference_updates = 0
@@ -190,37 +303,89 @@ class TLSPHSolver(_Solver):
             F[g.n_real:] = g.tensors(F[:g.n_real])
         return F
 
+    def _deformable(self, state: State) -> State:
+        """The deformable rows [0, n_deformable) as a state of views (the whole state if there is no tool)."""
+        if self.n_deformable is None:
+            self._bind_bodies(state)
+        n = self.n_deformable
+        if n == state.n:
+            return state
+        return State(**{f.name: (getattr(state, f.name)[:n] if isinstance(getattr(state, f.name), np.ndarray)
+                                 else getattr(state, f.name)) for f in fields(State)})
+
     def rates(self, state: State) -> Rates:
-        op = self.operator(state)
-        ext = self._extended(state, op)
-        F = self._F_from_after_step(state, op)
+        """Eqs. (16)-(23) on the deformable body; with rigid bodies, the pinball contact (Eqs. 32-36)."""
+        body = self._deformable(state)
+        op = self.operator(body)
+        ext = self._extended(body, op)
+        F = self._F_from_after_step(body, op)
         if F is None:
             F = self._F(ext, op)
         r = tlsph_rates(ext, self.material, self.params, op, F=F)
-        return r if ext is state else self._real_rows(r, state.n)
+        r = r if ext is body else self._real_rows(r, body.n)
+        if body is not state:
+            r = self._with_rigid(state, r)
+        return self._constrain(state, r)
+
+    def _with_rigid(self, state: State, r: Rates) -> Rates:
+        """Rates of all rows: the deformable ones plus the pinball contact, the rigid ones carrying the reaction
+        (dv/dt = contact force / m, turned into the recorded force and then zeroed by ``_constrain``)."""
+        if self.dt is None:
+            raise ValueError("the pinball contact needs the step size (solver.dt; set by predictor_corrector_step)")
+        n, N, d = self.n_deformable, state.n, state.dim
+        R = self.contact.k * self.params.h
+        c = pinball_contact(state.x[:n], state.v[:n], state.m[:n], state.x[n:], state.v[n:], np.inf, R,
+                            self.material.G, np.inf, self.dt, self.contact,
+                            thickness=self.dp if d == 2 else 1.0,
+                            T_a=None if state.T is None else state.T[:n])
+        self.max_penetration = max(self.max_penetration, c.max_penetration)
+        self.n_contacts = c.n_contacts
+        v = np.empty((N, d))
+        v[:n] = r.v + c.a
+        v[n:] = c.force_on_b / state.m[n:, None]
+        S = np.zeros((N, d, d))
+        S[:n] = r.S
+        S_zz = np.zeros(N)
+        S_zz[:n] = r.S_zz
+        l = np.zeros((N, d, d))
+        l[:n] = r.l
+        return Rates(x=state.v.copy(), v=v, rho=None, S=S, S_zz=S_zz, l=l)
 
     def deformation_gradient(self, state: State) -> np.ndarray:
-        op = self.operator(state)
-        return self._F(self._extended(state, op), op)[:state.n]
+        body = self._deformable(state)
+        op = self.operator(body)
+        F = self._F(self._extended(body, op), op)[:body.n]
+        if body is state:
+            return F
+        out = np.broadcast_to(np.eye(state.dim), (state.n, state.dim, state.dim)).copy()
+        out[:body.n] = F
+        return out
 
     def after_step(self, state: State) -> State:
         """rho = m / (J V0) (Eq. 2); reference update when max |E| > ref_update_strain.
 
         The F computed here is kept for the first rate evaluation of the next step, which starts from this
         very configuration (it is used only if x is unchanged, checked element by element)."""
-        op = self.operator(state)
-        F_ext = self._F(self._extended(state, op), op)
-        F = F_ext[:state.n]
-        state.rho = state.m / (det(F) * state.V0)
+        body = self._deformable(state)
+        op = self.operator(body)
+        F_ext = self._F(self._extended(body, op), op)
+        F = F_ext[:body.n]
+        rho = state.rho.copy()                  # (not in place: rho is not evolved, so shared with the old state)
+        rho[:body.n] = body.m / (det(F) * body.V0)
+        state.rho = rho
         thr = self.params.ref_update_strain
         if thr is not None and float(np.max(green_lagrange_norm(F))) > thr:
-            state = reset_reference(state, F)
+            F_all = F
+            if body is not state:
+                F_all = np.broadcast_to(np.eye(state.dim), (state.n, state.dim, state.dim)).copy()
+                F_all[:body.n] = F
+            state = reset_reference(state, F_all)
             self.op = None
-            self.operator(state)
+            self.operator(self._deformable(state))
             self.n_reference_updates += 1
             self._F_after_step = None
         else:
-            self._F_after_step = (op, state.x.copy(), F_ext)
+            self._F_after_step = (op, body.x.copy(), F_ext)
         return state
 
     def _F_from_after_step(self, state: State, op: ReferenceOperator) -> np.ndarray | None:
@@ -236,6 +401,9 @@ class TLSPHSolver(_Solver):
                "degenerate_correction_particles": int(len(self.op.degenerate)) if self.op is not None else 0}
         if self.op is not None and self.op.ghosts is not None:
             out["n_ghosts"] = int(self.op.ghosts.n)
+        if self.contact is not None:
+            out["max_pinball_penetration_m"] = self.max_penetration
+            out["pinball_contacts_last_step"] = self.n_contacts
         out.update(self._common_diagnostics())
         return out
 
@@ -251,6 +419,7 @@ def predictor_corrector_step(state: State, solver, dt: float) -> State:
     """One predictor-corrector step (two rate evaluations), then the solver's after-step work.
 
     Each stage ends with ``solver.finish_stage`` (walls, plastic return map; see :class:`_Solver`)."""
+    solver.dt = dt
     r0 = solver.rates(state)
     half = solver.finish_stage(state, _advance(state, r0, 0.5 * dt, solver.evolved), r0, 0.5 * dt, final=False)
     half.t = state.t + 0.5 * dt

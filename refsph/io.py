@@ -5,6 +5,7 @@ A run directory holds
     summary.json              scene, method, dim, dp, h, n_particles, n_steps, wall_time_s, status, metrics, ...
     snapshots/snap_00000.npz  one file per output time (NumPy .npz, arrays below, SI units)
     snapshots/last_good.npz   only after a failure: the last state that was finite
+    reaction_forces.csv       scenes with rigid bodies or clamps: the force on each, every step (below)
 
 Snapshot arrays (N particles, d dimensions):
 
@@ -24,7 +25,12 @@ Snapshot arrays (N particles, d dimensions):
 | eps_dot_p | (N,)      | 1/s           | effective plastic strain rate of the last step (J-C) |
 | W_p       | (N,)      | J/m^3         | plastic work density (J-C)                           |
 | T         | (N,)      | K             | temperature (J-C)                                    |
+| body      | (N,)      | -             | body id (scenes with tools: 0 workpiece, see summary["boundaries"]) |
 | units     | ()        | -             | JSON string: unit of every key                       |
+
+``reaction_forces.csv``: a comment line, a header ``t,<name>_x,<name>_y[,<name>_z],...`` and one row per
+time step: the midpoint time of the step [s] and the force the rest of the system exerted on each rigid body
+or clamp during it [N; 2D: N per metre of thickness]. ``load_reactions`` reads it back.
 """
 from __future__ import annotations
 
@@ -37,7 +43,8 @@ import numpy as np
 from .material import eos_pressure, von_mises
 from .state import FIELD_UNITS, State
 
-__all__ = ["save_snapshot", "load_snapshot", "load_run", "write_json", "SNAPSHOT_UNITS"]
+__all__ = ["save_snapshot", "load_snapshot", "load_run", "write_json", "save_reactions", "load_reactions",
+           "SNAPSHOT_UNITS"]
 
 SNAPSHOT_UNITS = dict(FIELD_UNITS, p="Pa", sigma_vm="Pa", F="1")
 
@@ -55,6 +62,8 @@ def save_snapshot(path, state: State, material, F: np.ndarray | None = None) -> 
         arrays["F"] = F
     if state.plastic:
         arrays.update(eps_p=state.eps_p, eps_dot_p=state.eps_dot_p, W_p=state.W_p, T=state.T)
+    if state.body is not None:
+        arrays["body"] = state.body
     units = {k: SNAPSHOT_UNITS[k] for k in arrays}
     tmp = path.with_name(path.name + ".tmp.npz")
     np.savez(tmp, units=json.dumps(units), **arrays)
@@ -96,3 +105,30 @@ def write_json(path, data: dict) -> None:
         json.dump(data, f, indent=2, default=_default)
         f.write("\n")
     os.replace(tmp, path)
+
+
+def save_reactions(path, reactions: dict, dim: int) -> None:
+    """Write the reaction history (``{'t': (n,), name: (n, d)}``) as CSV, atomically."""
+    path = Path(path)
+    names = [k for k in reactions if k != "t"]
+    axes = "xyz"[:dim]
+    cols = [reactions["t"][:, None]] + [np.asarray(reactions[k]).reshape(-1, dim) for k in names]
+    header = ",".join(["t"] + [f"{k}_{a}" for k in names for a in axes])
+    tmp = path.with_name(path.name + ".tmp")
+    np.savetxt(tmp, np.hstack(cols), delimiter=",", fmt="%.9e",
+               header="refsph reaction forces: t [s] (step midpoint), force on each body [N; 2D: N/m]\n" + header,
+               comments="# ")
+    os.replace(tmp, path)
+
+
+def load_reactions(path) -> dict:
+    """``reaction_forces.csv`` back as {'t': (n,), name: (n, d)}."""
+    with open(path) as f:
+        f.readline()
+        header = f.readline().lstrip("# ").strip().split(",")
+    data = np.loadtxt(path, delimiter=",", comments="#", ndmin=2)
+    out = {"t": data[:, 0]}
+    for k, col in enumerate(header[1:], start=1):
+        name = col.rsplit("_", 1)[0]
+        out.setdefault(name, []).append(data[:, k])
+    return {k: (np.stack(v, axis=1) if k != "t" else v) for k, v in out.items()}

@@ -7,7 +7,8 @@ files outside it at run time.
 """
 from __future__ import annotations
 
-__all__ = ["TAYLOR_TABLE1", "TAYLOR_TABLE2", "TAYLOR_GEOMETRY", "TAYLOR_RESULTS", "AISI1045_RLA"]
+__all__ = ["TAYLOR_TABLE1", "TAYLOR_TABLE2", "TAYLOR_GEOMETRY", "TAYLOR_RESULTS", "AISI4340_TABLE3",
+           "PRESSING_TABLE4", "PRESSING_GEOMETRY", "PRESSING_RESOLUTIONS_M", "AISI1045_RLA"]
 
 # Table 1: Johnson-Cook parameters of low-strength 4340 steel, as printed (T_m = 1293 K; 1793 K is usual)
 TAYLOR_TABLE1 = dict(rho=7830.0, shear_modulus_Pa=82.9e9, bulk_modulus_Pa=169.1e9, A_Pa=792e6, B_Pa=510e6,
@@ -24,6 +25,20 @@ TAYLOR_RESULTS = {
     "final_length_mm": {"experiment": 34.6, "ls_dyna": 34.4, "paper_esph": 34.19, "paper_tlsph": 34.18},
     "final_diameter_mm": {"experiment": 9.5, "ls_dyna": 10.6, "paper_esph": 9.80, "paper_tlsph": 9.83},
 }
+
+# Table 3: Johnson-Cook parameters of the AISI 4340 workpiece (pressing and cutting), as printed. The
+# Taylor-Quinney coefficient chi = 0.9 is stated in Section 2.3 (Eq. 28), not in the table.
+AISI4340_TABLE3 = dict(rho=7830.0, E_Pa=207e9, nu=0.3, A_Pa=792e6, B_Pa=510e6, n=0.26, C=0.014, m=1.03,
+                       T_room_K=298.0, T_melt_K=1573.0, cp_J_kgK=480.0, taylor_quinney=0.9)
+# Table 4: computational parameters of the pressing (h / dp = 1.5)
+PRESSING_TABLE4 = dict(particle_spacing_m=0.00667e-3, smoothing_length_m=0.01e-3, time_step_s=1e-10,
+                       beta1=0.5, beta2=0.5, artificial_pressure_gamma_esph=0.3)
+# Section 3.2: a block 1.0 x 0.5 (x 0.1) mm, left side fixed, a rigid tool 0.1 x 0.7 (x 0.1) mm pressed from
+# the free right side at 200 m/s. The paper's 3D run used 184,624 workpiece and 25,199 tool particles.
+PRESSING_GEOMETRY = dict(block_m=(1.0e-3, 0.5e-3), tool_m=(0.1e-3, 0.7e-3), tool_speed_m_s=200.0,
+                         thickness_3d_m=0.1e-3)
+# Section 3.2, Fig. 10: the resolution study (h / dp = 1.5 kept); 0.0167 = 1/60 mm, 0.0133 = 1/75 mm, ...
+PRESSING_RESOLUTIONS_M = (0.0167e-3, 0.0133e-3, 0.01e-3, 0.00667e-3)
 
 # Rodriguez Prieto, Larsson & Afrasiabi, "Thermomechanical Simulation of Orthogonal Metal Cutting with PFEM and
 # SPH Using a Temperature-Dependent Friction Coefficient", Tables 1-2: AISI 1045 with the *modified*

@@ -31,7 +31,9 @@ class Numerics:
     h_over_dp: smoothing length / spacing; beta1, beta2: artificial viscosity (Eq. 12); gamma: ESPH
     artificial pressure (Eq. 14; 0 = off); n_ap: its exponent; eps: Eq. (13); kernel: 'cubic' | 'wendland';
     courant: CFL number; corrected: TLSPH kernel-gradient correction; ref_update_strain: TLSPH reference
-    update trigger on max |E| (None = never); skin_factor: ESPH Verlet skin in units of h.
+    update trigger on max |E| (None = never); skin_factor: ESPH Verlet skin in units of h; contact_k: TLSPH
+    pinball radius R = contact_k h (Eq. 32; None = dp / (2h), pinballs of neighbouring bodies touch at one
+    spacing); contact_Kp: the pinball scaling factor K_p (Eq. 33).
     """
 
     h_over_dp: float = 1.5
@@ -45,6 +47,8 @@ class Numerics:
     corrected: bool = True
     ref_update_strain: float | None = 0.5
     skin_factor: float = 0.1
+    contact_k: float | None = None
+    contact_Kp: float = 50.0
 
 
 @dataclass
@@ -52,7 +56,10 @@ class Setup:
     """Everything a run needs. ``plasticity``: Johnson-Cook constants (None: elastic); ``mirror``: symmetry
     planes (:class:`~refsph.boundaries.MirrorPlanes`, None: none); ``walls``: rigid walls
     (:class:`~refsph.boundaries.RigidWall`); ``snapshot_times``: extra output times [s] besides the
-    ``n_snapshots`` evenly spaced ones."""
+    ``n_snapshots`` evenly spaced ones; ``rigid``: tools (:class:`~refsph.boundaries.RigidBody`, their
+    particles the last rows of ``state``); ``clamps``: held particles (:class:`~refsph.boundaries.Clamp`);
+    ``friction``: a :class:`~refsph.contact.CoulombFriction` for the TLSPH pinball contact (None: frictionless,
+    as in the paper)."""
 
     state: State
     material: ElasticMaterial
@@ -65,6 +72,9 @@ class Setup:
     mirror: MirrorPlanes | None = None
     walls: tuple = ()
     snapshot_times: tuple = ()
+    rigid: tuple = ()
+    clamps: tuple = ()
+    friction: object = None
 
     @property
     def h(self) -> float:
@@ -278,6 +288,10 @@ SCENES: dict[str, Scene] = {
 from .taylor import make_scene as _make_taylor  # noqa: E402  (the Taylor scene uses the classes above)
 
 SCENES["taylor"] = _make_taylor()
+
+from .pressing import make_scene as _make_pressing  # noqa: E402
+
+SCENES["pressing"] = _make_pressing()
 
 
 def get_scene(name: str) -> Scene:

@@ -15,9 +15,10 @@ from pathlib import Path
 import numpy as np
 
 from . import __version__
+from .contact import PinballContact
 from .esph import ESPHParams
 from .integrate import ESPHSolver, TLSPHSolver, cfl_time_step, predictor_corrector_step
-from .io import save_snapshot, write_json
+from .io import save_reactions, save_snapshot, write_json
 from .kernels import get_kernel
 from .scenes import Setup, convert_options, get_scene
 from .state import State
@@ -49,12 +50,17 @@ def make_solver(method: str, setup: Setup):
         prm = ESPHParams(h=h, dp=setup.dp, beta1=nm.beta1, beta2=nm.beta2, gamma=nm.gamma, n_ap=nm.n_ap,
                          eps=nm.eps, kernel=kernel)
         return ESPHSolver(setup.material, prm, skin_factor=nm.skin_factor, plasticity=setup.plasticity,
-                          mirror=setup.mirror, walls=setup.walls)
+                          mirror=setup.mirror, walls=setup.walls, rigid=setup.rigid, clamps=setup.clamps)
     if method == "tlsph":
         prm = TLSPHParams(h=h, beta1=nm.beta1, beta2=nm.beta2, eps=nm.eps, kernel=kernel,
                           corrected=nm.corrected, ref_update_strain=nm.ref_update_strain)
+        contact = None
+        if setup.rigid:
+            k = nm.contact_k if nm.contact_k is not None else setup.dp / (2.0 * h)
+            contact = PinballContact(k=k, K_p=nm.contact_Kp, friction=setup.friction)
         return TLSPHSolver(setup.material, prm, plasticity=setup.plasticity, mirror=setup.mirror,
-                           walls=setup.walls)
+                           walls=setup.walls, rigid=setup.rigid, clamps=setup.clamps, contact=contact,
+                           dp=setup.dp)
     raise ValueError(f"unknown method {method!r}; choose one of {', '.join(METHODS)}")
 
 
@@ -123,7 +129,11 @@ def simulate(setup: Setup, method: str, *, scene=None, out=None, dt: float | Non
                    material=dataclasses.asdict(setup.material),
                    plasticity=dataclasses.asdict(setup.plasticity) if setup.plasticity is not None else None,
                    boundaries=dict(symmetry_axes=list(setup.mirror.axes) if setup.mirror is not None else [],
-                                   walls=[dataclasses.asdict(w) for w in setup.walls]),
+                                   walls=[dataclasses.asdict(w) for w in setup.walls],
+                                   rigid_bodies=[dataclasses.asdict(b) for b in setup.rigid],
+                                   clamps=[c.to_dict() for c in setup.clamps],
+                                   friction=(dataclasses.asdict(setup.friction) if setup.friction is not None
+                                             else None)),
                    snapshot_times=[float(t) for t in snap_times], refsph_version=__version__,
                    status="running", metrics={})
 
@@ -197,6 +207,12 @@ def simulate(setup: Setup, method: str, *, scene=None, out=None, dt: float | Non
                        dt_min=float(min(dts)) if dts else None, dt_max=float(max(dts)) if dts else None,
                        particle_steps_per_s=state.n * n_steps / wall if wall > 0 else None,
                        snapshots=snapshots, diagnostics=solver.diagnostics())
+        reactions = solver.reaction_history()
+        if reactions:
+            history["reaction"] = reactions
+            if out is not None:
+                save_reactions(out / "reaction_forces.csv", reactions, state.dim)
+                summary["reaction_forces_file"] = "reaction_forces.csv"
         if scene is not None and history and summary["status"] == "ok":
             summary["metrics"] = scene.metrics(history, state, setup)
         if out is not None:

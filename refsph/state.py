@@ -25,6 +25,12 @@ Thermo-mechanical fields, present (arrays) only when the scene's material is Joh
 | eps_dot_p | (N,)  | 1/s     | effective plastic strain rate of the last step, d eps_p / dt     |
 | W_p       | (N,)  | J/m^3   | accumulated plastic work density (Eq. 31 summed)                 |
 | T         | (N,)  | K       | temperature (Eq. 28, adiabatic)                                  |
+
+Scenes with several bodies (a workpiece and rigid tools) also carry
+
+| field | shape | unit | meaning                                                                        |
+|-------|-------|------|--------------------------------------------------------------------------------|
+| body  | (N,)  | -    | body id of each particle (0: the deformable workpiece; rigid tools: their own id, see :class:`~refsph.boundaries.RigidBody`); None means every particle is body 0 |
 """
 from __future__ import annotations
 
@@ -32,7 +38,7 @@ from dataclasses import dataclass, fields, replace
 
 import numpy as np
 
-__all__ = ["State", "FIELD_UNITS", "THERMAL_FIELDS", "make_state"]
+__all__ = ["State", "FIELD_UNITS", "THERMAL_FIELDS", "make_state", "concatenate_states"]
 
 FIELD_UNITS = {
     "x": "m",
@@ -48,6 +54,7 @@ FIELD_UNITS = {
     "eps_dot_p": "1/s",
     "W_p": "J/m^3",
     "T": "K",
+    "body": "1 (body id)",
 }
 
 THERMAL_FIELDS = ("eps_p", "eps_dot_p", "W_p", "T")
@@ -68,6 +75,7 @@ class State:
     eps_dot_p: np.ndarray | None = None
     W_p: np.ndarray | None = None
     T: np.ndarray | None = None
+    body: np.ndarray | None = None
 
     @property
     def plastic(self) -> bool:
@@ -106,6 +114,9 @@ class State:
                     raise ValueError(f"state field {name} must have shape {(n,)}, got {getattr(self, name).shape}")
             if np.any(self.T <= 0):
                 raise ValueError("state field T must be positive (kelvin)")
+        if self.body is not None and (self.body.shape != (n,) or not np.issubdtype(self.body.dtype, np.integer)):
+            raise ValueError(f"state field body must be an integer array of shape {(n,)}, "
+                             f"got {self.body.dtype} {self.body.shape}")
         for name in ("m", "rho", "V0"):
             if np.any(getattr(self, name) <= 0):
                 raise ValueError(f"state field {name} must be positive everywhere")
@@ -121,11 +132,12 @@ class State:
 
 
 def make_state(x: np.ndarray, v: np.ndarray, rho0: float, volume: np.ndarray | float,
-               T0: float | None = None) -> State:
+               T0: float | None = None, body: np.ndarray | None = None) -> State:
     """A stress-free state at rest density ``rho0``: m = rho0 V, X = x, V0 = V.
 
     ``T0`` (kelvin): give it for a Johnson-Cook material; the state then carries eps_p = eps_dot_p = W_p = 0
-    and T = T0. Without it those fields are None (elastic material)."""
+    and T = T0. Without it those fields are None (elastic material). ``body``: body id per particle (see the
+    table above), or None for a single body."""
     x = np.array(x, dtype=float)
     n, d = x.shape
     V = np.broadcast_to(np.asarray(volume, dtype=float), (n,)).copy()
@@ -146,5 +158,25 @@ def make_state(x: np.ndarray, v: np.ndarray, rho0: float, volume: np.ndarray | f
         S_zz=np.zeros(n),
         X=x.copy(),
         V0=V,
+        body=None if body is None else np.asarray(body, dtype=np.int32).copy(),
         **thermal,
     )
+
+
+def concatenate_states(*states: State) -> State:
+    """One state holding the particles of several (same dimension, same time, all with or all without the
+    thermal fields); ``body`` of a part without one is 0."""
+    if not states:
+        raise ValueError("nothing to concatenate")
+    if len({s.dim for s in states}) != 1 or len({s.plastic for s in states}) != 1:
+        raise ValueError("states to concatenate must have the same dimension and the same fields")
+    out = {}
+    for f in fields(State):
+        if f.name == "t":
+            continue
+        if f.name == "body":
+            out["body"] = np.concatenate([s.body if s.body is not None else np.zeros(s.n, dtype=np.int32)
+                                          for s in states]).astype(np.int32)
+        elif getattr(states[0], f.name) is not None:
+            out[f.name] = np.concatenate([getattr(s, f.name) for s in states])
+    return State(t=states[0].t, **out)

@@ -1,17 +1,38 @@
-"""Writes tests/regression/taylor_3d_1mm.json: the quick 3D Taylor run (dp = 1 mm) of both methods.
+"""Writes the regression files of tests/test_taylor.py and tests/test_pressing.py:
+
+* ``taylor_3d_1mm.json``: the quick 3D Taylor run (dp = 1 mm) of both methods;
+* ``pressing_quick.json``: the quick pressing run (dp = 1/60 mm, CFL step) of both methods.
 
 Run it only when a change of the numbers is intended (and say why in the commit):
-    python tests/regression/make_regression.py
+    python tests/regression/make_regression.py            # both
+    python tests/regression/make_regression.py pressing   # one of them
 """
 import json
+import sys
 from pathlib import Path
 
 from refsph.simulate import run
 
-out = {}
-for m in ("esph", "tlsph"):
-    met = run("taylor", m, dim=3, dp=1.0e-3, progress=False).summary["metrics"]
-    out[m] = {k: met[k] for k in ("final_length_mm", "final_diameter_mm", "max_plastic_strain", "max_temperature_K")}
-path = Path(__file__).parent / "taylor_3d_1mm.json"
-path.write_text(json.dumps(out, indent=1) + "\n")
-print(path, out)
+HERE = Path(__file__).parent
+which = sys.argv[1:] or ["taylor", "pressing"]
+
+if "taylor" in which:
+    out = {}
+    for m in ("esph", "tlsph"):
+        met = run("taylor", m, dim=3, dp=1.0e-3, progress=False).summary["metrics"]
+        out[m] = {k: met[k] for k in ("final_length_mm", "final_diameter_mm", "max_plastic_strain",
+                                      "max_temperature_K")}
+    path = HERE / "taylor_3d_1mm.json"
+    path.write_text(json.dumps(out, indent=1) + "\n")
+    print(path, out)
+
+if "pressing" in which:
+    out = {}
+    for m in ("esph", "tlsph"):
+        met = run("pressing", m, quick=True, progress=False).summary["metrics"]
+        out[m] = {k: met[k] for k in ("tool_force_peak_N_per_m", "tool_force_mean_N_per_m",
+                                      "clamp_force_mean_N_per_m", "max_plastic_strain", "max_temperature_K")}
+        out[m]["plastic_strain_line_eps_p"] = [float(e) for e in met["plastic_strain_line"][:, 1]]
+    path = HERE / "pressing_quick.json"
+    path.write_text(json.dumps(out, indent=1) + "\n")
+    print(path, {m: {k: v for k, v in d.items() if k != "plastic_strain_line_eps_p"} for m, d in out.items()})

@@ -42,7 +42,7 @@ constitutive response; only their motion is prescribed. The force that holds the
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from itertools import combinations
 
 import numpy as np

@@ -76,6 +76,8 @@ class _Solver:
             w.check(state.dim)
         if self.mirror is not None:
             self.mirror.check(state.dim)
+        if getattr(self, "contact", None) is not None and self.contact.friction is not None and state.T is None:
+            raise ValueError("friction with mu(T) needs a state with temperatures (make_state(..., T0=...))")
         self._bind_bodies(state)
 
     def _check_plastic(self, state: State) -> None:

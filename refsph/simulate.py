@@ -47,6 +47,9 @@ def make_solver(method: str, setup: Setup):
     kernel = get_kernel(nm.kernel)
     h = setup.h
     if method == "esph":
+        if setup.friction is not None:
+            raise ValueError("friction is a law of the TLSPH pinball contact; ESPH tools act through the SPH "
+                             "sums and have no friction model (run TLSPH, or set friction=None)")
         prm = ESPHParams(h=h, dp=setup.dp, beta1=nm.beta1, beta2=nm.beta2, gamma=nm.gamma, n_ap=nm.n_ap,
                          eps=nm.eps, kernel=kernel)
         return ESPHSolver(setup.material, prm, skin_factor=nm.skin_factor, plasticity=setup.plasticity,

@@ -167,7 +167,7 @@ def correction_matrix(M: np.ndarray, tol: float = 1e-6) -> tuple[np.ndarray, np.
     instead (Bonet & Lok's correction restricted to the directions the neighbours span), so the operator stays
     finite. Returns (L, indices of those degenerate particles); F of such a particle is singular in the
     missing direction, so a run that depends on it stops with a non-finite-state error that names it."""
-    n, d = M.shape[0], M.shape[1]
+    d = M.shape[1]
     detM = det(M)
     scale = np.maximum(np.abs(np.trace(M, axis1=1, axis2=2)) / d, np.finfo(float).tiny) ** d
     bad = np.flatnonzero(~(np.abs(detM) > tol * scale))

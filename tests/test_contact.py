@@ -211,3 +211,12 @@ def test_rigid_body_input_errors():
     wrong = dataclasses.replace(setup, rigid=(RigidBody("wall", 1, (0.0, 0.0, 0.0)),))
     with pytest.raises(ValueError, match="components"):
         simulate(wrong, "esph", progress=False)
+
+
+def test_friction_input_errors():
+    setup, n = _disc_on_wall()
+    fr = CoulombFriction(mu0=0.81, q=2.09, T_room=293.0, T_melt=1773.0)
+    with pytest.raises(ValueError, match="ESPH"):
+        simulate(dataclasses.replace(setup, friction=fr), "esph", progress=False)
+    with pytest.raises(ValueError, match="temperature"):                  # the disc state has no T
+        simulate(dataclasses.replace(setup, friction=fr), "tlsph", progress=False)

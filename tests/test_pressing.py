@@ -7,7 +7,6 @@ import pytest
 
 from refsph.cli import main
 from refsph.io import load_run, load_snapshot
-from refsph.plasticity import yield_stress
 from refsph.pressing import TOOL_BODY
 from refsph.reference import AISI4340_TABLE3, PRESSING_GEOMETRY
 from refsph.scenes import get_scene
@@ -120,3 +119,18 @@ def test_cli_pressing(tmp_path, capsys):
     text = capsys.readouterr().out
     assert "Metal pressing" in text and "tlsph" in text
     assert main(["run", "pressing", "--dim", "3", "--quick", "--quiet", "--out", str(tmp_path / "q")]) == 2
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("method", ["esph", "tlsph"])
+def test_paper_resolution_under_ten_minutes(method):
+    """dp = 0.00667 mm (Table 4), the whole 0.2 mm of tool travel, one core: under 10 minutes, and the same
+    physics checks as the quick run."""
+    res = run("pressing", method, progress=False)
+    assert res.summary["status"] == "ok"
+    assert res.summary["wall_time_s"] < 600.0
+    met = res.summary["metrics"]
+    H = PRESSING_GEOMETRY["block_m"][1]
+    assert 2 / np.sqrt(3) * AISI4340_TABLE3["A_Pa"] * H < met["tool_force_mean_N_per_m"]
+    assert met["plastic_strain_line"][:, 1].max() > 0.3
+    assert met["min_tool_gap_over_dp"] > 0.5

@@ -28,8 +28,11 @@ What is implemented, exactly, where the printed equations leave a choice:
   spacing dp through the thickness, so the force per unit thickness is F2 / dp (Eq. 34 is per unit thickness
   already, through the masses).
 - **Influence radius.** R = k h with k = dp / (2 h) (1/3 for h = 1.5 dp): two bodies whose surface particles
-  sit one spacing apart are just touching, as their faces (centres +- dp/2) are. K_p = 1. Both are chosen in
-  chapter 05, by the bounce test there (penetration, impulse, rebound against k and K_p).
+  sit one spacing apart are just touching, as their faces (centres +- dp/2) are. K_p = 50 (``Numerics.contact_Kp``).
+  Both are chosen in chapter 05 by the bounce test there (penetration, impulse, rebound against k and K_p):
+  because Eq. (34) acts only while the particles approach, K_p = 1 dissipates nearly all of an elastic
+  rebound; the rebound converges from K_p ~ 20 on, and from K_p ~ 500 the contact spring is too stiff for
+  the CFL step. K_p > 1 also makes the on/off switch of Eq. (34) amplify round-off (chapter 07).
 - **Time step.** dt in Eq. (34) is the step size of the step being taken (both rate evaluations of the
   predictor-corrector step use it).
 

@@ -27,9 +27,11 @@ Measurements (``summary.json`` metrics):
 * ``tool_force_history``: [t, F] with F the force of the block on the tool against its motion, per metre of
   thickness [N/m], averaged over 400 equal time bins (each step's value is in ``reaction_forces.csv``; the
   pinball contact force comes in impulses a step long, which the bins average); also its peak and its mean
-  over the second half of the run, and the same for the clamp (``clamp_force_mean_N_per_m``).
-* ``plastic_strain_line`` (Fig. 8): [x, eps_p] of the row of particles that starts at mid-height, sorted by
-  their current x [mm, -] (a Lagrangian line: the same particles at every dp and in both methods).
+  over the second half of the run, and the same for the clamp (``clamp_force_mean_N_per_m``). The peak of
+  the binned TLSPH force depends on how many steps fall in a bin (so on dp and dt): compare mean forces.
+* ``plastic_strain_line`` (Fig. 8): [x, eps_p] of the row of particles that starts nearest to mid-height
+  (on it for an odd number of rows, as at the paper's spacing; half a spacing below it for an even number),
+  sorted by their current x [mm, -] (a Lagrangian line: the same particles in both methods).
 * ``max_plastic_strain``, ``max_temperature_K`` (block only), ``min_tool_gap_over_dp``: the smallest
   distance between a block and a tool particle over the run, in spacings (1 = the faces touch; less =
   penetration).

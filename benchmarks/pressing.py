@@ -1,0 +1,346 @@
+"""Metal pressing benchmark (Section 3.2 of Islam, Bansal & Peng): the resolution study of Fig. 10 and more.
+
+    python benchmarks/pressing.py                 # all runs, one at a time (about 9 CPU-minutes)
+    python benchmarks/pressing.py --jobs 2        # two runs at a time (two cores)
+    python benchmarks/pressing.py --only conv-    # only the jobs whose name contains 'conv-'
+    python benchmarks/pressing.py --plot-only     # JSON, table and figures again from runs/benchmarks/pressing/
+
+Runs (2D plane strain, the scene `refsph.pressing`, tool travel 0.2 mm = 1 us, both methods unless stated):
+  conv       dp = 0.0167, 0.0133, 0.01, 0.00667 mm (the paper's Fig. 10; h/dp = 1.5), CFL step (Courant 0.3)
+  dt1e-10    dp = 0.01 mm with the paper's fixed dt = 1e-10 s (Table 4)
+  kp10/kp200 TLSPH at dp = 0.01 mm with the pinball scaling factor K_p = 10 and 200 (default 50)
+Each run is one process; its run folder runs/benchmarks/pressing/NAME keeps summary.json, reaction_forces.csv
+and the final snapshot (the others are deleted). Writes benchmarks/pressing.json, one record per run (a line
+each): method, spacing, particle count, steps, wall time, the scalar metrics of the scene, the binned tool
+force history [ns, MN/m], the plastic-strain line [mm, -], and the differences to a reference run
+(`vs_finest`: the finest conv run of the same method; `vs_base`: the conv run of the same method and dp).
+Figures:
+  figures/07_pressing_work_precision.png   difference to the finest run against wall time (work-precision)
+  figures/07_pressing_resolution.png       final plastic strain at the four spacings, both methods (Fig. 10)
+  figures/07_pressing_force.png            tool force against time at the four spacings
+Wall times are single-core (the BLAS/OpenMP pools are pinned to one thread) and each run starts in a fresh
+process, as `refsph run` would (a reused worker process runs ESPH up to ~1.8x faster after a large run, because
+its heap has grown already); with --jobs 2 two runs share the machine's two cores.
+"""
+from __future__ import annotations
+
+import os
+
+# one core per run: pin the BLAS / OpenMP thread pools before NumPy is imported (inherited by the workers)
+for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "BLIS_NUM_THREADS",
+             "VECLIB_MAXIMUM_THREADS", "NUMEXPR_NUM_THREADS"):
+    os.environ[_var] = "1"
+
+import argparse  # noqa: E402
+import json  # noqa: E402
+import sys  # noqa: E402
+import time  # noqa: E402
+from concurrent.futures import ProcessPoolExecutor  # noqa: E402
+from pathlib import Path  # noqa: E402
+
+import numpy as np  # noqa: E402
+
+ROOT = Path(__file__).resolve().parent.parent
+RUNS = ROOT / "runs" / "benchmarks" / "pressing"
+OUT_JSON = ROOT / "benchmarks" / "pressing.json"
+FIG = ROOT / "figures"
+METHODS = ("esph", "tlsph")
+DP_SENS = 0.01e-3                    # spacing of the dt and K_p sensitivity runs
+N_LINE_GRID = 400                    # points of the common x grid on which two plastic-strain lines are compared
+
+
+def resolutions():
+    from refsph.reference import PRESSING_RESOLUTIONS_M
+    return tuple(PRESSING_RESOLUTIONS_M)
+
+
+def dp_tag(dp: float) -> str:
+    """0.0167e-3 -> '16.7um' (the spacing in micrometres, 3 digits)."""
+    return f"{dp * 1e6:.3g}um"
+
+
+def job_list():
+    jobs = []
+    for dp in resolutions():
+        for m in METHODS:
+            jobs.append(dict(name=f"conv-{m}-{dp_tag(dp)}", method=m, dp=dp, dt=None, numerics=None))
+    for m in METHODS:
+        jobs.append(dict(name=f"dt1e-10-{m}-{dp_tag(DP_SENS)}", method=m, dp=DP_SENS, dt=1e-10, numerics=None))
+    for kp in (10.0, 200.0):
+        jobs.append(dict(name=f"kp{kp:g}-tlsph-{dp_tag(DP_SENS)}", method="tlsph", dp=DP_SENS, dt=None,
+                         numerics=dict(contact_Kp=kp)))
+    return jobs
+
+
+def run_job(job):
+    from refsph.simulate import run
+    t0 = time.perf_counter()
+    out = RUNS / job["name"]
+    res = run("pressing", job["method"], dp=job["dp"], dt=job["dt"], out=out, progress=False,
+              numerics=job["numerics"])
+    snaps = sorted((out / "snapshots").glob("snap_*.npz"))
+    for p in snaps[:-1]:                                   # keep the final snapshot only
+        p.unlink()
+    s, m = res.summary, res.summary["metrics"]
+    print(f"{job['name']}: {s['n_particles']} particles, {s['n_steps']} steps, {time.perf_counter() - t0:.0f} s; "
+          f"F mean {m['tool_force_mean_N_per_m'] * 1e-6:.3f} MN/m, max eps_p {m['max_plastic_strain']:.2f}",
+          flush=True)
+    return job["name"]
+
+
+def _r(a, nd):
+    return np.round(np.asarray(a, dtype=float), nd).tolist()
+
+
+def record(job):
+    from refsph.io import load_snapshot
+    name = job["name"]
+    with open(RUNS / name / "summary.json") as f:
+        s = json.load(f)
+    m, nm = s["metrics"], s["numerics"]
+    final = sorted((RUNS / name / "snapshots").glob("snap_*.npz"))[-1]
+    z = load_snapshot(final)
+    block = z["body"] == 0
+    eps = z["eps_p"][block]
+    fh = np.asarray(m["tool_force_history"])
+    line = np.asarray(m["plastic_strain_line"])
+    imp = s["diagnostics"]["reaction_impulse"]
+    return dict(
+        name=name, method=s["method"], dp_nominal_mm=1e3 * job["dp"], dp_mm=1e3 * s["dp"], h_mm=1e3 * s["h"],
+        n_particles=s["n_particles"], n_block=int(block.sum()), n_steps=s["n_steps"],
+        wall_time_s=s["wall_time_s"], dt_mode=s["dt_mode"], dt_s=s["dt_max"] if s["dt_mode"] == "fixed" else None,
+        dt_max_s=s["dt_max"], dt_min_s=s["dt_min"], courant=s["courant"],
+        contact_Kp=nm["contact_Kp"] if s["method"] == "tlsph" else None, status=s["status"],
+        t_final_us=1e6 * s["t_final"], tool_travel_mm=m["tool_travel_mm"],
+        tool_force_peak_MN_per_m=1e-6 * m["tool_force_peak_N_per_m"],
+        tool_force_mean_MN_per_m=1e-6 * m["tool_force_mean_N_per_m"],
+        clamp_force_mean_MN_per_m=1e-6 * m["clamp_force_mean_N_per_m"],
+        tool_impulse_N_s_per_m=imp["tool"][0], clamp_impulse_N_s_per_m=imp["left_side"][0],
+        max_plastic_strain=m["max_plastic_strain"], plastic_strain_p99=float(np.percentile(eps, 99)),
+        max_temperature_K=m["max_temperature_K"], min_tool_gap_over_dp=m["min_tool_gap_over_dp"],
+        kinetic_energy_final_J_per_m=m["kinetic_energy_final_J_per_m"],
+        line_peak=float(line[:, 1].max()), line_peak_x_mm=float(line[np.argmax(line[:, 1]), 0]),
+        line_peak_width_mm=peak_width(line),
+        reference_updates=s["diagnostics"].get("reference_updates"),
+        max_pinball_penetration_over_dp=(s["diagnostics"]["max_pinball_penetration_m"] / s["dp"]
+                                         if "max_pinball_penetration_m" in s["diagnostics"] else None),
+        tool_force_history_ns_MN_per_m=np.column_stack([_r(1e9 * fh[:, 0], 3), _r(1e-6 * fh[:, 1], 5)]).tolist(),
+        plastic_strain_line_mm=np.column_stack([_r(line[:, 0], 6), _r(line[:, 1], 5)]).tolist(),
+    )
+
+
+def peak_width(line) -> float:
+    """Width [mm] of the strain peak along the line: the x extent of the particles around the peak (contiguous,
+    in x order) whose eps_p is above half the peak. The line crosses the X of the shear bands there, so this is
+    a measure of how wide the bands are where they cross."""
+    line = np.asarray(line)
+    e = line[:, 1]
+    k = int(np.argmax(e))
+    i = j = k
+    while i > 0 and e[i - 1] > 0.5 * e[k]:
+        i -= 1
+    while j < len(e) - 1 and e[j + 1] > 0.5 * e[k]:
+        j += 1
+    return float(line[j, 0] - line[i, 0])
+
+
+def line_difference(a, b) -> float:
+    """Relative L2 difference of two plastic-strain lines [[x, eps_p], ...] (different particle rows):
+    ||a - b|| / ||b|| on N_LINE_GRID points spread over the x range both cover, linear interpolation."""
+    a, b = np.asarray(a), np.asarray(b)
+    x = np.linspace(max(a[0, 0], b[0, 0]), min(a[-1, 0], b[-1, 0]), N_LINE_GRID)
+    ea, eb = np.interp(x, a[:, 0], a[:, 1]), np.interp(x, b[:, 0], b[:, 1])
+    return float(np.sqrt(np.mean((ea - eb) ** 2) / np.mean(eb**2)))
+
+
+def differences(r, ref) -> dict:
+    """Three scalar results of r against a reference run: relative differences (not percent)."""
+    return dict(ref=ref["name"],
+                force_mean_rel=r["tool_force_mean_MN_per_m"] / ref["tool_force_mean_MN_per_m"] - 1.0,
+                line_peak_rel=r["line_peak"] / ref["line_peak"] - 1.0,
+                line_L2_rel=line_difference(r["plastic_strain_line_mm"], ref["plastic_strain_line_mm"]),
+                line_width_rel=r["line_peak_width_mm"] / ref["line_peak_width_mm"] - 1.0,
+                wall_time_ratio=r["wall_time_s"] / ref["wall_time_s"])
+
+
+def add_differences(records):
+    """vs_finest: against the finest conv run of the method; vs_base: against the conv run of the method at
+    the same nominal spacing (for the dt and K_p runs)."""
+    conv = {(r["method"], r["dp_nominal_mm"]): r for r in records if r["name"].startswith("conv-")}
+    for r in records:
+        own = [c for (m, _), c in conv.items() if m == r["method"]]
+        if own:
+            finest = min(own, key=lambda c: c["dp_nominal_mm"])
+            r["vs_finest"] = differences(r, finest)
+        base = conv.get((r["method"], r["dp_nominal_mm"]))
+        if base is not None and not r["name"].startswith("conv-"):
+            r["vs_base"] = differences(r, base)
+    return records
+
+
+def write_json(records):
+    """One record per line (compact arrays), so that a change shows in git as the runs that changed."""
+    OUT_JSON.write_text("[\n" + ",\n".join(json.dumps(r) for r in records) + "\n]\n")
+
+
+def table(records) -> str:
+    lines = [f"{'run':22s} {'dp um':>6s} {'N':>6s} {'steps':>6s} {'wall s':>7s} {'F peak':>7s} {'F mean':>7s} "
+             f"{'clamp':>7s} {'eps max':>7s} {'eps p99':>7s} {'line pk':>7s} {'at x':>5s} {'T max':>6s} "
+             f"{'gap/dp':>6s} {'dF fin':>7s} {'dpk fin':>7s} {'L2 fin':>6s}"]
+    for r in records:
+        d = r.get("vs_finest", {})
+        fin = (f"{100 * d['force_mean_rel']:+6.1f}% {100 * d['line_peak_rel']:+6.1f}% {100 * d['line_L2_rel']:5.1f}%"
+               if d and d["ref"] != r["name"] else f"{'(ref)':>7s} {'':7s} {'':6s}")
+        lines.append(f"{r['name']:22s} {1e3 * r['dp_mm']:6.2f} {r['n_particles']:6d} {r['n_steps']:6d} "
+                     f"{r['wall_time_s']:7.1f} {r['tool_force_peak_MN_per_m']:7.3f} {r['tool_force_mean_MN_per_m']:7.3f} "
+                     f"{r['clamp_force_mean_MN_per_m']:7.3f} {r['max_plastic_strain']:7.2f} {r['plastic_strain_p99']:7.3f} "
+                     f"{r['line_peak']:7.3f} {r['line_peak_x_mm']:5.2f} {r['line_peak_width_mm']:5.3f} {r['max_temperature_K']:6.0f} "
+                     f"{r['min_tool_gap_over_dp']:6.2f} {fin}")
+    lines.append("F: force of the block on the tool [MN/m = kN per mm of thickness], peak of the 400-bin history "
+                 "and mean over the 2nd half; clamp: force on the clamped column (mean, 2nd half); eps p99: 99th "
+                 "percentile of eps_p in the block; line pk: peak of eps_p along the mid-height row, at x [mm], "
+                 "width [mm] where it is above half its peak; "
+                 "d.. fin: difference to the finest run of the same method")
+    return "\n".join(lines)
+
+
+def _moving_average(y, k):
+    if len(y) < k:
+        return np.asarray(y)
+    return np.convolve(y, np.ones(k) / k, mode="same")
+
+
+def plots(records):
+    import matplotlib
+    import matplotlib.ticker
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from refsph.io import load_snapshot
+
+    FIG.mkdir(exist_ok=True)
+    colors = dict(esph="C0", tlsph="C3")
+    conv = {m: sorted([r for r in records if r["name"].startswith("conv-") and r["method"] == m],
+                      key=lambda r: -r["dp_mm"]) for m in METHODS}
+
+    # work-precision: difference to the finest run of the same method against wall time
+    plain = matplotlib.ticker.FuncFormatter(lambda v, _: f"{v:g}" if f"{v:.0e}"[0] in "1235" else "")
+    fig, axs = plt.subplots(2, 2, figsize=(11, 8.5), layout="constrained")
+    for ax, key, label in ((axs[0, 0], "force_mean_rel", "mean tool force, 2nd half"),
+                           (axs[0, 1], "line_peak_rel", "peak of eps_p along the mid-height row"),
+                           (axs[1, 0], "line_L2_rel", "L2 difference of the eps_p line"),
+                           (axs[1, 1], "line_width_rel", "width of the line's strain peak (half maximum)")):
+        for m in METHODS:
+            rs = [r for r in conv[m] if "vs_finest" in r and r["vs_finest"]["ref"] != r["name"]]
+            w = [r["wall_time_s"] for r in rs]
+            e = [max(100 * abs(r["vs_finest"][key]), 1e-3) for r in rs]
+            ax.loglog(w, e, "o-", color=colors[m], label=f"{m.upper()}, CFL step")
+            for r, wi, ei in zip(rs, w, e):
+                ax.annotate(f"{1e3 * r['dp_nominal_mm']:.3g} um", (wi, ei), textcoords="offset points",
+                            xytext=(4, 4), fontsize=8, color=colors[m])
+            fin = [r for r in conv[m] if r.get("vs_finest", {}).get("ref") == r["name"]]
+            for r in fin:
+                ax.axvline(r["wall_time_s"], color=colors[m], ls=":", lw=1,
+                           label=f"{m.upper()}: wall time of the finest run ({1e3 * r['dp_nominal_mm']:.3g} um), "
+                                 "the reference")
+            for r in records:
+                if r["method"] == m and r["name"].startswith("dt1e-10-") and "vs_finest" in r:
+                    ax.loglog([r["wall_time_s"]], [max(100 * abs(r["vs_finest"][key]), 1e-3)], "s", mfc="none",
+                              color=colors[m], label=f"{m.upper()}, dt = 1e-10 s, {1e3 * r['dp_nominal_mm']:.3g} um")
+        ax.set_xlabel("wall time [s] (one core)")
+        ax.set_ylabel("|difference to the finest run| [%]")
+        ax.set_title(label, fontsize=10)
+        ax.grid(alpha=0.3, which="both")
+        for axis in (ax.xaxis, ax.yaxis):
+            axis.set_major_formatter(plain)
+            axis.set_minor_formatter(plain)
+    handles, labels = axs[0, 0].get_legend_handles_labels()
+    fig.legend(handles, labels, loc="outside lower center", ncol=3, fontsize=8)
+    fig.suptitle("Metal pressing, 2D plane strain: work-precision (each method against its own finest run, "
+                 "dp = 0.00667 mm)", fontsize=11)
+    fig.savefig(FIG / "07_pressing_work_precision.png", dpi=120)
+    plt.close(fig)
+
+    # Fig. 10 analogue: final plastic strain at the four spacings
+    ncol = max(len(conv[m]) for m in METHODS)
+    fig = plt.figure(figsize=(3.3 * ncol + 1.0, 6.6))
+    axs = fig.subplots(2, ncol, squeeze=False, gridspec_kw=dict(left=0.05, right=0.9, bottom=0.08, top=0.86,
+                                                                  wspace=0.12, hspace=0.32))
+    vmax = 1.0
+    xlim, ylim = (-0.03, 0.9), (-0.15, 0.65)
+    for row, m in enumerate(METHODS):
+        for col, r in enumerate(conv[m]):
+            z = load_snapshot(sorted((RUNS / r["name"] / "snapshots").glob("snap_*.npz"))[-1])
+            ax = axs[row, col]
+            ax.set_aspect("equal")
+            ax.set_xlim(*xlim)
+            ax.set_ylim(*ylim)
+            ax.apply_aspect()
+            pt_per_mm = ax.get_position().width * fig.get_figwidth() * 72 / (xlim[1] - xlim[0])
+            size = (1.3 * pt_per_mm * r["dp_mm"]) ** 2          # marker area [pt^2]: one spacing across
+            b = z["body"] == 0
+            ax.scatter(1e3 * z["x"][~b, 0], 1e3 * z["x"][~b, 1], c="0.6", s=size, lw=0, marker="s")
+            order = np.argsort(z["eps_p"][b])
+            sc = ax.scatter(1e3 * z["x"][b][order, 0], 1e3 * z["x"][b][order, 1], c=z["eps_p"][b][order], s=size,
+                            lw=0, marker="s", cmap="jet", vmin=0.0, vmax=vmax)
+            ax.set_title(f"{m.upper()}, dp = {1e3 * r['dp_nominal_mm']:.3g} um ({r['n_block']} particles)\n"
+                         f"wall {r['wall_time_s']:.0f} s, max eps_p {r['max_plastic_strain']:.2f}", fontsize=8)
+            ax.tick_params(labelsize=7)
+            if row == 1:
+                ax.set_xlabel("x [mm]", fontsize=8)
+            if col == 0:
+                ax.set_ylabel("y [mm]", fontsize=8)
+    cax = fig.add_axes([0.92, 0.2, 0.012, 0.6])
+    fig.colorbar(sc, cax=cax, label=f"effective plastic strain (colour scale cut at {vmax:g})", extend="max")
+    fig.suptitle("Metal pressing, tool travel 0.2 mm: final plastic strain at four spacings (cf. Fig. 10); "
+                 "grey: the tool", fontsize=10)
+    fig.savefig(FIG / "07_pressing_resolution.png", dpi=130)
+    plt.close(fig)
+
+    # tool force against time
+    fig, axs = plt.subplots(1, 2, figsize=(12, 4.2), constrained_layout=True, sharey=True)
+    for ax, m in zip(axs, METHODS):
+        for k, r in enumerate(conv[m]):
+            h = np.asarray(r["tool_force_history_ns_MN_per_m"])
+            c = plt.cm.viridis(k / max(1, len(conv[m]) - 1))
+            ax.plot(h[:, 0], h[:, 1], color=c, lw=0.5, alpha=0.35)
+            ax.plot(h[:, 0], _moving_average(h[:, 1], 9), color=c, lw=1.4,
+                    label=f"dp = {1e3 * r['dp_nominal_mm']:.3g} um (mean 2nd half {r['tool_force_mean_MN_per_m']:.3f})")
+        ax.set_xlabel("t [ns]")
+        ax.set_title(f"{m.upper()}: force of the block on the tool (thin: 2.5 ns bins, thick: 22.5 ns running mean)",
+                     fontsize=9)
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=7)
+    axs[0].set_ylabel("tool force [MN/m]")
+    axs[0].set_ylim(bottom=0)
+    fig.suptitle("Metal pressing: tool force against time at the four spacings, CFL step", fontsize=10)
+    fig.savefig(FIG / "07_pressing_force.png", dpi=120)
+    plt.close(fig)
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--jobs", type=int, default=1, help="runs at a time (default 1)")
+    ap.add_argument("--plot-only", action="store_true", help="no runs: JSON, figures and table from earlier runs")
+    ap.add_argument("--only", default=None, help="run only the jobs whose name contains this string")
+    args = ap.parse_args(argv)
+    jobs = job_list()
+    todo = [j for j in jobs if args.only is None or args.only in j["name"]]
+    if not args.plot_only:
+        todo.sort(key=lambda j: (j["dp"], j["dt"] is None))      # longest first
+        # a fresh process for every run: a worker that ran a large run before starts the next one with a grown
+        # heap and runs it faster (glibc returns freed memory to the OS only at the top of the heap), so reused
+        # workers would make the wall times depend on the order of the runs
+        with ProcessPoolExecutor(max_workers=args.jobs, max_tasks_per_child=1) as ex:
+            list(ex.map(run_job, todo))
+    have = [j for j in jobs if (RUNS / j["name"] / "summary.json").exists()]
+    records = add_differences([record(j) for j in have])
+    write_json(records)
+    print(table(records))
+    if all(any(r["name"].startswith("conv-") and r["method"] == m for r in records) for m in METHODS):
+        plots(records)
+        print(f"figures written to {FIG}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -32,8 +32,8 @@ with a prescribed velocity V,
 
 made only of the layers that can touch the workpiece. They carry no constitutive stress. How they act on the
 workpiece is the method's: in ESPH they are ordinary SPH neighbours (their density is integrated by the
-continuity equation, Eq. 10, and floored at rho0, so they push with the pressure K (rho/rho0 - 1) >= 0 and
-never pull); in TLSPH they are partners of the pinball contact (:mod:`refsph.contact`). The solvers record
+continuity equation, Eq. 10, and floored at rho0, so their own pressure K (rho/rho0 - 1) is never negative;
+a workpiece particle in tension still pulls on them through its own stress term of Eq. 11); in TLSPH they are partners of the pinball contact (:mod:`refsph.contact`). The solvers record
 the force the rest of the system exerts on each body at every step.
 
 **Clamp** (the fixed left side of the pressing block): particles *of the deformable body* whose velocity is
@@ -214,8 +214,8 @@ class Clamp:
 
     def __post_init__(self):
         idx = np.asarray(self.index)
-        if idx.ndim != 1 or not np.issubdtype(idx.dtype, np.integer) or len(idx) == 0:
-            raise ValueError(f"clamp {self.name!r}: index must be a non-empty 1-D integer array")
+        if idx.ndim != 1 or not np.issubdtype(idx.dtype, np.integer) or len(idx) == 0 or idx.min() < 0:
+            raise ValueError(f"clamp {self.name!r}: index must be a non-empty 1-D array of non-negative integers")
         object.__setattr__(self, "index", np.unique(idx).astype(np.intp))
 
     def to_dict(self) -> dict:

@@ -75,6 +75,8 @@ class CoulombFriction:
             val = getattr(self, name)
             if not (np.isfinite(val) and val >= 0):
                 raise ValueError(f"friction {name} must be a non-negative number, got {val!r}")
+        if not self.q > 0:
+            raise ValueError(f"friction exponent q must be positive (q = 0 gives mu = 0), got {self.q!r}")
         if not self.T_melt > self.T_room > 0:
             raise ValueError(f"friction needs 0 < T_room < T_melt, got {self.T_room!r}, {self.T_melt!r}")
 

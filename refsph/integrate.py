@@ -53,13 +53,23 @@ class _Solver:
         names = [b.name for b in self.rigid] + [c.name for c in self.clamps]
         if len(set(names)) != len(names):
             raise ValueError(f"rigid bodies and clamps need distinct names, got {names}")
+        for name in names:
+            if name in ("t", "dt") or not name or not all(ch.isalnum() or ch in "_-" for ch in name):
+                raise ValueError(f"rigid body / clamp name {name!r}: use letters, digits, '_' or '-' "
+                                 "(not 't' or 'dt', the time columns of the reaction log)")
+        ids = [b.body for b in self.rigid]
+        if len(set(ids)) != len(ids):
+            raise ValueError(f"rigid bodies need distinct body ids, got {ids}")
         if self.rigid and mirror is not None:
             raise ValueError("rigid bodies together with symmetry planes are not implemented")
+        if self.rigid and self.walls:
+            raise ValueError("rigid bodies together with RigidWall are not implemented (make the wall a rigid "
+                             "body of particles)")
         self.dt: float | None = None           # size of the step being taken (set by predictor_corrector_step)
         self.n_deformable: int | None = None   # rows [0, n_deformable) are deformable, the rest rigid
         self._rigid_rows: list[slice] = []
         self._reaction: list[np.ndarray] | None = None     # force on each rigid body / clamp, last evaluation
-        self.reaction_log: list[list[float]] = []          # per step: t_mid, then d components per body/clamp
+        self.reaction_log: list[list[float]] = []          # per step: t_mid, dt, then d components per body/clamp
         self.reaction_impulse = [0.0 for _ in names]
 
     @property
@@ -104,7 +114,15 @@ class _Solver:
             n_def = min(r.start for r in rows)
             if sum(r.stop - r.start for r in rows) != n - n_def:
                 raise ValueError("rigid body particles must come after every deformable particle in the state")
+            for b, r in zip(self.rigid, rows):
+                if not np.all(state.v[r] == np.asarray(b.velocity)):
+                    raise ValueError(f"rigid body {b.name!r}: its particles must start with its velocity "
+                                     f"{b.velocity}")
             self.n_deformable, self._rigid_rows = n_def, rows
+        if state.body is not None and np.any(state.body[:self.n_deformable] != 0):
+            other = sorted(set(np.unique(state.body[:self.n_deformable]).tolist()) - {0})
+            raise ValueError(f"body ids {other} are not declared as rigid bodies; the deformable workpiece is "
+                             "body 0 (a second deformable body is not implemented)")
         for c in self.clamps:
             if c.index[-1] >= self.n_deformable:
                 raise ValueError(f"clamp {c.name!r} holds particle {c.index[-1]}, which is not a deformable one")
@@ -136,13 +154,13 @@ class _Solver:
                 self.wall_impulse[k] += imp
         for b, rows in zip(self.rigid, self._rigid_rows):       # exact rigid motion (no drift from round-off)
             new.v[rows] = np.asarray(b.velocity)
-            if rates.rho is not None:                            # ESPH: a tool pushes, it never pulls
+            if rates.rho is not None:                            # ESPH: the tool's own pressure is >= 0
                 new.rho[rows] = np.maximum(new.rho[rows], self.material.rho0)
         for c in self.clamps:
             new.v[c.index] = 0.0
             new.x[c.index] = old.x[c.index]
         if final and self._reaction is not None:
-            self.reaction_log.append([old.t + 0.5 * dt] + [float(c) for f in self._reaction for c in f])
+            self.reaction_log.append([old.t + 0.5 * dt, dt] + [float(c) for f in self._reaction for c in f])
             for k, f in enumerate(self._reaction):
                 self.reaction_impulse[k] = self.reaction_impulse[k] + f * dt
         jc = self.plasticity
@@ -161,16 +179,17 @@ class _Solver:
         return new
 
     def reaction_history(self) -> dict:
-        """{'t': (n_steps,), name: (n_steps, d) force on that rigid body / clamp} (N; 2D: N per metre of
-        thickness), one row per step at the step's midpoint (the time of the rates that moved it)."""
-        log = np.asarray(self.reaction_log, dtype=float)
+        """{'t': (n_steps,), 'dt': (n_steps,), name: (n_steps, d) force on that rigid body / clamp} (N; 2D: N per
+        metre of thickness), one row per step at the step's midpoint t (the time of the rates that moved it);
+        dt is the step's size, so sum(F dt) is the impulse."""
         names = self.reaction_names
         if not names:
             return {}
-        d = (log.shape[1] - 1) // len(names) if len(log) else 0
-        out = {"t": log[:, 0] if len(log) else np.zeros(0)}
+        log = np.asarray(self.reaction_log, dtype=float).reshape(len(self.reaction_log), -1)
+        d = (log.shape[1] - 2) // len(names) if len(log) else 0
+        out = {"t": log[:, 0] if len(log) else np.zeros(0), "dt": log[:, 1] if len(log) else np.zeros(0)}
         for k, name in enumerate(names):
-            out[name] = log[:, 1 + k * d: 1 + (k + 1) * d] if len(log) else np.zeros((0, d))
+            out[name] = log[:, 2 + k * d: 2 + (k + 1) * d] if len(log) else np.zeros((0, d))
         return out
 
     @staticmethod
@@ -185,7 +204,8 @@ class _Solver:
             # impulse of each wall on the *model* (a quarter/half of the body with symmetry planes), N s (2D: N s/m)
             out["wall_impulse"] = [float(i) for i in self.wall_impulse]
         if self.reaction_names:
-            # impulse the rest of the system gave each rigid body / clamp, N s (2D: N s/m)
+            # impulse the rest of the system gave each rigid body / clamp, N s (2D: N s/m); note the sign
+            # convention differs from wall_impulse, which is the impulse the wall gave the model
             out["reaction_impulse"] = {name: [float(c) for c in np.atleast_1d(imp)]
                                        for name, imp in zip(self.reaction_names, self.reaction_impulse)}
         return out

@@ -28,9 +28,10 @@ Snapshot arrays (N particles, d dimensions):
 | body      | (N,)      | -             | body id (scenes with tools: 0 workpiece, see summary["boundaries"]) |
 | units     | ()        | -             | JSON string: unit of every key                       |
 
-``reaction_forces.csv``: a comment line, a header ``t,<name>_x,<name>_y[,<name>_z],...`` and one row per
-time step: the midpoint time of the step [s] and the force the rest of the system exerted on each rigid body
-or clamp during it [N; 2D: N per metre of thickness]. ``load_reactions`` reads it back.
+``reaction_forces.csv``: a comment line, a header ``t,dt,<name>_x,<name>_y[,<name>_z],...`` and one row per
+time step: the midpoint time of the step [s], its size [s] and the force the rest of the system exerted on each
+rigid body or clamp during it [N; 2D: N per metre of thickness] (sum of force x dt = impulse).
+``load_reactions`` reads it back.
 """
 from __future__ import annotations
 
@@ -110,13 +111,15 @@ def write_json(path, data: dict) -> None:
 def save_reactions(path, reactions: dict, dim: int) -> None:
     """Write the reaction history (``{'t': (n,), name: (n, d)}``) as CSV, atomically."""
     path = Path(path)
-    names = [k for k in reactions if k != "t"]
+    names = [k for k in reactions if k not in ("t", "dt")]
     axes = "xyz"[:dim]
-    cols = [reactions["t"][:, None]] + [np.asarray(reactions[k]).reshape(-1, dim) for k in names]
-    header = ",".join(["t"] + [f"{k}_{a}" for k in names for a in axes])
+    cols = [reactions["t"][:, None], reactions["dt"][:, None]] + [np.asarray(reactions[k]).reshape(-1, dim)
+                                                                  for k in names]
+    header = ",".join(["t", "dt"] + [f"{k}_{a}" for k in names for a in axes])
     tmp = path.with_name(path.name + ".tmp")
     np.savetxt(tmp, np.hstack(cols), delimiter=",", fmt="%.9e",
-               header="refsph reaction forces: t [s] (step midpoint), force on each body [N; 2D: N/m]\n" + header,
+               header="refsph reaction forces: t [s] (step midpoint), dt [s] (step size), force on each body "
+                      "[N; 2D: N/m]\n" + header,
                comments="# ")
     os.replace(tmp, path)
 
@@ -127,8 +130,8 @@ def load_reactions(path) -> dict:
         f.readline()
         header = f.readline().lstrip("# ").strip().split(",")
     data = np.loadtxt(path, delimiter=",", comments="#", ndmin=2)
-    out = {"t": data[:, 0]}
-    for k, col in enumerate(header[1:], start=1):
+    out = {"t": data[:, 0], "dt": data[:, 1]}
+    for k, col in enumerate(header[2:], start=2):
         name = col.rsplit("_", 1)[0]
         out.setdefault(name, []).append(data[:, k])
-    return {k: (np.stack(v, axis=1) if k != "t" else v) for k, v in out.items()}
+    return {k: (np.stack(v, axis=1) if k not in ("t", "dt") else v) for k, v in out.items()}

@@ -25,16 +25,16 @@ ESPH gamma = 0.3), Courant 0.3 (the paper's fixed dt = 1e-10 s is ``--dt 1e-10``
 Measurements (``summary.json`` metrics):
 
 * ``tool_force_history``: [t, F] with F the force of the block on the tool against its motion, per metre of
-  thickness [N/m], averaged over 400 equal time bins (each step's value is in ``reaction_forces.csv``; the
-  pinball contact force comes in impulses a step long, which the bins average); also its peak and its mean
-  over the second half of the run, and the same for the clamp (``clamp_force_mean_N_per_m``). The peak of
+  thickness [N/m], time-averaged over 400 equal time bins (each step's value and size are in
+  ``reaction_forces.csv``; the pinball contact force comes in impulses a step long, which the bins average);
+  also its peak and its time average over the second half of the run, and the same for the clamp (``clamp_force_mean_N_per_m``). The peak of
   the binned TLSPH force depends on how many steps fall in a bin (so on dp and dt): compare mean forces.
 * ``plastic_strain_line`` (Fig. 8): [x, eps_p] of the row of particles that starts nearest to mid-height
   (on it for an odd number of rows, as at the paper's spacing; half a spacing below it for an even number),
   sorted by their current x [mm, -] (a Lagrangian line: the same particles in both methods).
 * ``max_plastic_strain``, ``max_temperature_K`` (block only), ``min_tool_gap_over_dp``: the smallest
-  distance between a block and a tool particle over the run, in spacings (1 = the faces touch; less =
-  penetration).
+  distance between a block and a tool particle, in spacings (1 = the faces touch; less = penetration),
+  sampled at the recorded steps (about 400 per run, as every history of ``refsph.simulate``).
 """
 from __future__ import annotations
 
@@ -134,32 +134,39 @@ def _record(state, setup):
                 min_tool_gap_over_dp=gap / setup.dp)
 
 
-def _binned(t, f, t_end, n_bins):
+def _binned(t, dt, f, t_end, n_bins):
+    """Time average of a per-step force over equal time bins (each step weighted by its size dt, put in the
+    bin of its midpoint t): (bin centres, means) of the bins that hold a step."""
     edges = np.linspace(0.0, t_end, n_bins + 1)
     k = np.clip(np.searchsorted(edges, t, side="right") - 1, 0, n_bins - 1)
-    cnt = np.bincount(k, minlength=n_bins)
-    s = np.bincount(k, weights=f, minlength=n_bins)
-    ok = cnt > 0
-    return 0.5 * (edges[1:] + edges[:-1])[ok], s[ok] / cnt[ok]
+    w = np.bincount(k, weights=dt, minlength=n_bins)
+    s = np.bincount(k, weights=f * dt, minlength=n_bins)
+    ok = w > 0
+    return 0.5 * (edges[1:] + edges[:-1])[ok], s[ok] / w[ok]
+
+
+def _time_mean(t, dt, f, t_from):
+    """(1 / duration) * integral of f dt over the steps whose midpoint lies after t_from."""
+    sel = t > t_from
+    return float(np.sum(f[sel] * dt[sel]) / np.sum(dt[sel])) if sel.any() else float("nan")
 
 
 def _metrics(hist, state, setup):
     n = setup.info["n_block"]
     rh = hist["reaction"]
-    t = np.asarray(rh["t"])
+    t, dt = np.asarray(rh["t"]), np.asarray(rh["dt"])
     tool = np.asarray(rh["tool"])[:, 0]                # force of the block on the tool, +x: against its motion
     clamp = np.asarray(rh["left_side"])[:, 0]          # force of the block on the clamped column
     nb = min(N_FORCE_BINS, max(1, len(t)))
-    tb, fb = _binned(t, tool, setup.t_end, nb)
-    _, cb = _binned(t, clamp, setup.t_end, nb)
-    second = t > 0.5 * setup.t_end
+    tb, fb = _binned(t, dt, tool, setup.t_end, nb)
+    _, cb = _binned(t, dt, clamp, setup.t_end, nb)
     line = setup.info["line_index"]
     order = np.argsort(state.x[line, 0])
     return dict(
         tool_force_history=np.stack([tb, fb], axis=1),
         tool_force_peak_N_per_m=float(np.max(fb)),
-        tool_force_mean_N_per_m=float(np.mean(tool[second])) if second.any() else float("nan"),
-        clamp_force_mean_N_per_m=float(np.mean(clamp[second])) if second.any() else float("nan"),
+        tool_force_mean_N_per_m=_time_mean(t, dt, tool, 0.5 * setup.t_end),
+        clamp_force_mean_N_per_m=_time_mean(t, dt, clamp, 0.5 * setup.t_end),
         clamp_force_history=np.stack([tb, cb], axis=1),
         max_plastic_strain=float(np.max(state.eps_p[:n])),
         max_temperature_K=float(np.max(state.T[:n])),

@@ -58,6 +58,8 @@ def make_solver(method: str, setup: Setup):
         prm = TLSPHParams(h=h, beta1=nm.beta1, beta2=nm.beta2, eps=nm.eps, kernel=kernel,
                           corrected=nm.corrected, ref_update_strain=nm.ref_update_strain)
         contact = None
+        if setup.friction is not None and not setup.rigid:
+            raise ValueError("friction acts in the contact with rigid bodies, and this setup has none")
         if setup.rigid:
             k = nm.contact_k if nm.contact_k is not None else setup.dp / (2.0 * h)
             contact = PinballContact(k=k, K_p=nm.contact_Kp, friction=setup.friction)

@@ -168,8 +168,8 @@ def concatenate_states(*states: State) -> State:
     thermal fields); ``body`` of a part without one is 0."""
     if not states:
         raise ValueError("nothing to concatenate")
-    if len({s.dim for s in states}) != 1 or len({s.plastic for s in states}) != 1:
-        raise ValueError("states to concatenate must have the same dimension and the same fields")
+    if len({s.dim for s in states}) != 1 or len({s.plastic for s in states}) != 1 or len({s.t for s in states}) != 1:
+        raise ValueError("states to concatenate must have the same dimension, the same fields and the same time")
     out = {}
     for f in fields(State):
         if f.name == "t":

@@ -220,3 +220,101 @@ def test_friction_input_errors():
         simulate(dataclasses.replace(setup, friction=fr), "esph", progress=False)
     with pytest.raises(ValueError, match="temperature"):                  # the disc state has no T
         simulate(dataclasses.replace(setup, friction=fr), "tlsph", progress=False)
+
+
+def test_bodies_input_errors():
+    setup, n = _disc_on_wall()
+    with pytest.raises(ValueError, match="non-negative"):
+        Clamp("c", np.array([-1, 0, 1]))
+    with pytest.raises(ValueError, match="not declared"):                 # tool ids without a RigidBody
+        simulate(dataclasses.replace(setup, rigid=()), "tlsph", progress=False)
+    with pytest.raises(ValueError, match="start with its velocity"):
+        simulate(dataclasses.replace(setup, rigid=(RigidBody("wall", 1, (-5.0, 0.0)),)), "esph", progress=False)
+    with pytest.raises(ValueError, match="distinct body ids"):
+        simulate(dataclasses.replace(setup, rigid=(RigidBody("a", 1, (0.0, 0.0)), RigidBody("b", 1, (0.0, 0.0)))),
+                 "esph", progress=False)
+    with pytest.raises(ValueError, match="name"):
+        simulate(dataclasses.replace(setup, rigid=(RigidBody("t", 1, (0.0, 0.0)),)), "esph", progress=False)
+    from refsph.boundaries import RigidWall
+    with pytest.raises(ValueError, match="RigidWall"):
+        simulate(dataclasses.replace(setup, walls=(RigidWall(0, -1e-3, 0.5 * DP),)), "esph", progress=False)
+    fr = CoulombFriction(mu0=0.5, q=2.0, T_room=293.0, T_melt=1773.0)
+    with pytest.raises(ValueError, match="rigid"):
+        simulate(dataclasses.replace(setup, rigid=(), state=make_state(setup.state.x[:n], setup.state.v[:n],
+                                                                        MAT.rho0, DP * DP, T0=293.0),
+                                     friction=fr), "tlsph", progress=False)
+    with pytest.raises(ValueError, match="q"):
+        CoulombFriction(mu0=0.5, q=0.0, T_room=293.0, T_melt=1773.0)
+
+
+def test_esph_tool_density_floor_and_pressure():
+    """ESPH tool particles: density integrated by Eq. (10) but never below rho0 (pressure >= 0); they did
+    get compressed during the impact (the floor is not all they do)."""
+    setup, n = _disc_on_wall()
+    setup = dataclasses.replace(setup, t_end=0.5e-6)                 # stop during the contact (about 1.7 us)
+    res = simulate(setup, "esph", progress=False)
+    rho_tool = res.state.rho[n:]
+    assert np.all(rho_tool >= MAT.rho0)
+    assert rho_tool.max() > MAT.rho0 * (1 + 1e-4)
+
+
+def test_tlsph_friction_run_balances_momentum():
+    """A block sliding and pressing on a particle wall, TLSPH with friction: the wall's impulse equals the
+    block's change of momentum, and the sliding slows down more than without friction."""
+    x = lattice([2e-3, 1e-3], DP)                                      # faces touch: bottom row 1 dp above the wall
+    wx = np.arange(-8 * DP, 4e-3, DP) + 0.5 * DP
+    W = np.stack(np.meshgrid(wx, -(np.arange(2) + 0.5) * DP, indexing="ij"), axis=-1).reshape(-1, 2)
+    out = {}
+    for label, fr in (("free", None), ("friction", CoulombFriction(mu0=0.5, q=2.0, T_room=293.0, T_melt=1773.0))):
+        block = make_state(x, [30.0, -20.0], MAT.rho0, DP * DP, T0=293.0)
+        wall = make_state(W, [0.0, 0.0], MAT.rho0, DP * DP, T0=293.0, body=np.ones(len(W), dtype=int))
+        setup = Setup(state=concatenate_states(block, wall), material=MAT, dp=DP,
+                      numerics=Numerics(beta1=0.5, beta2=0.5), t_end=1.0e-6, n_snapshots=1,
+                      rigid=(RigidBody("wall", 1, (0.0, 0.0)),), friction=fr)
+        res = simulate(setup, "tlsph", progress=False)
+        nb = block.n
+        dP = np.sum(res.state.m[:nb, None] * (res.state.v[:nb] - block.v), axis=0)
+        imp = np.array(res.summary["diagnostics"]["reaction_impulse"]["wall"])
+        assert np.allclose(dP, -imp, atol=1e-10 * np.sum(block.m) * 30.0), label
+        out[label] = np.sum(res.state.m[:nb] * res.state.v[:nb, 0]) / np.sum(block.m)
+        if fr is not None:                                            # Coulomb: |tangential| <= mu |normal|
+            assert 0 < imp[0] <= 1.05 * fr.mu0 * abs(imp[1])           # (5 %: the wall of particles is bumpy)
+    assert out["friction"] < out["free"] - 5.0                        # friction slowed the sliding (30 -> 15 m/s)
+
+
+def _cube_on_plate(method):
+    dp = 0.5e-3
+    cube = make_state(lattice([2.5e-3] * 3, dp) + np.array([1.5e-3, 1.5e-3, 0.0]), [0.0, 0.0, -100.0],
+                      MAT.rho0, dp**3)
+    g = (np.arange(-2, 13) + 0.5) * dp
+    P = np.stack(np.meshgrid(g, g, -(np.arange(3) + 0.5) * dp, indexing="ij"), axis=-1).reshape(-1, 3)
+    plate = make_state(P, [0.0, 0.0, 0.0], MAT.rho0, dp**3, body=np.ones(len(P), dtype=int))
+    setup = Setup(state=concatenate_states(cube, plate), material=MAT, dp=dp,
+                  numerics=Numerics(beta1=0.5, beta2=0.5), t_end=6e-6, n_snapshots=1,
+                  rigid=(RigidBody("plate", 1, (0.0, 0.0, 0.0)),))
+    return cube, simulate(setup, method, progress=False)
+
+
+@pytest.mark.parametrize("method", ["esph", "tlsph"])
+def test_3d_cube_on_plate_balance(method):
+    """3D: a cube (5^3 particles) thrown at a plate of 3 particle layers: nothing passes the plate, and the
+    plate's impulse equals the cube's change of momentum."""
+    cube, res = _cube_on_plate(method)
+    n = cube.n
+    dP = np.sum(res.state.m[:n, None] * (res.state.v[:n] - cube.v), axis=0)
+    imp = np.array(res.summary["diagnostics"]["reaction_impulse"]["plate"])
+    assert np.allclose(dP, -imp, atol=1e-10 * np.sum(cube.m) * 100.0)
+    assert np.all(res.state.x[:n, 2] > 0.0)
+    assert np.sum(res.state.m[:n] * res.state.v[:n, 2]) > -0.25 * np.sum(cube.m) * 100.0   # stopped, at least
+
+
+@pytest.mark.parametrize("method", [
+    pytest.param("esph", marks=pytest.mark.xfail(strict=True, reason=(
+        "known limitation: the ESPH tool couples through Eq. (11), so the cube's bottom layer, in tension as it "
+        "unloads (p = -0.7 GPa, sigma_zz = +2.2 GPa at 6 us), pulls on the plate and the cube sticks; its momentum "
+        "decays from -100 to -4 m/s by 12 us without a rebound (the 2D disc does rebound)"))),
+    "tlsph"])
+def test_3d_cube_on_plate_rebounds(method):
+    cube, res = _cube_on_plate(method)
+    n = cube.n
+    assert np.sum(res.state.m[:n] * res.state.v[:n, 2]) > 0.5 * np.sum(cube.m) * 100.0

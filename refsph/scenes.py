@@ -293,6 +293,10 @@ from .pressing import make_scene as _make_pressing  # noqa: E402
 
 SCENES["pressing"] = _make_pressing()
 
+from .cutting import make_scene as _make_cutting  # noqa: E402
+
+SCENES["cutting"] = _make_cutting()
+
 
 def get_scene(name: str) -> Scene:
     try:

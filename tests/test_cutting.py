@@ -1,0 +1,63 @@
+"""Orthogonal cutting scene (Section 3.3), preliminary: geometry and a coarse smoke run of both methods."""
+import numpy as np
+import pytest
+
+from refsph.cutting import CUTTING_GEOMETRY, TOOL_BODY, chip_thickness
+from refsph.scenes import get_scene
+from refsph.simulate import run
+
+
+@pytest.mark.parametrize("feed", [0.3e-3, 0.5e-3])
+def test_geometry(feed):
+    setup = get_scene("cutting").build(2, 0.01e-3, False, feed=feed)
+    s, info = setup.state, setup.info
+    n = info["n_work"]
+    (Lx, Ly) = CUTTING_GEOMETRY["workpiece_m"]
+    assert np.sum(s.m[:n]) == pytest.approx(7830.0 * Lx * Ly, rel=1e-12)
+    assert setup.h == pytest.approx(0.018e-3)                          # Table 5
+    xt = s.x[n:]
+    assert np.all(s.body[n:] == TOOL_BODY)
+    assert xt[:, 0].min() - info["dx"] / 2 == pytest.approx(Lx)         # rake face touches the workpiece
+    assert xt[:, 1].min() - info["dy"] / 2 == pytest.approx(Ly - feed)  # cutting edge at the depth of cut
+    assert xt[:, 1].max() + info["dy"] / 2 == pytest.approx(Ly - feed + 1e-3)
+    assert setup.t_end == pytest.approx(1e-3 / 50.0)
+    held = setup.clamps[0].index
+    assert np.all((s.x[held, 0] < info["dx"]) | (s.x[held, 1] < info["dy"]))
+
+
+def test_bad_input():
+    sc = get_scene("cutting")
+    with pytest.raises(ValueError, match="2D"):
+        sc.build(3, 0.01e-3, False)
+    with pytest.raises(ValueError, match="feed"):
+        sc.build(2, 0.01e-3, False, feed=1.2e-3)
+    with pytest.raises(ValueError, match="travel"):
+        sc.build(2, 0.01e-3, False, travel=-1.0)
+
+
+def test_chip_thickness_of_a_slab():
+    """A vertical slab of chip 0.2 mm wide against the rake face measures 0.2 mm."""
+    dy = 0.01e-3
+    x = np.stack(np.meshgrid(np.arange(2.8e-3, 3.0e-3, dy) + dy / 2, np.arange(1.0e-3, 1.4e-3, dy) + dy / 2,
+                             indexing="ij"), axis=-1).reshape(-1, 2)
+    X0 = x.copy()
+    X0[:, 1] = 0.9e-3                                                     # all of it came from above the cut line
+    assert chip_thickness(x, X0, 0.7e-3, 1e-3, 0.3e-3, 3.0e-3, dy) == pytest.approx(0.2e-3 - dy / 2, rel=1e-9)
+
+
+@pytest.mark.parametrize("method", ["esph", "tlsph"])
+def test_coarse_smoke_run(method):
+    """dp = 0.05 mm, 0.2 mm of cut: the tool meets a cutting force larger than the flow stress times the feed,
+    the workpiece's momentum balances the impulses of tool and clamps, nothing passes the rake face."""
+    res = run("cutting", method, dp=0.05e-3, progress=False, options=dict(travel=0.2e-3))
+    assert res.summary["status"] == "ok"
+    met, s, info = res.summary["metrics"], res.state, res.setup.info
+    n = info["n_work"]
+    assert met["cutting_force_mean_N_per_m"] > 792e6 * info["feed_m"]
+    assert met["thrust_force_mean_N_per_m"] > 0
+    imp = res.summary["diagnostics"]["reaction_impulse"]
+    P = np.sum(s.m[:n, None] * s.v[:n], axis=0)
+    assert np.allclose(P, -(np.array(imp["tool"]) + np.array(imp["held"])), atol=1e-9 * imp["tool"][0])
+    face = s.x[n:, 0].min()
+    above = s.x[:n, 1] > info["y0"] + info["dy"]
+    assert np.all(s.x[:n][above, 0] < face)

@@ -2,11 +2,12 @@
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import sys
 
 import numpy as np
 
-from .scenes import SCENES
+from .scenes import SCENES, Numerics
 from .simulate import METHODS, SimulationError, run
 
 
@@ -34,8 +35,14 @@ def main(argv=None) -> int:
     r.add_argument("--quick", action="store_true", help="coarse, fast version of the scene")
     r.add_argument("--quiet", action="store_true", help="no progress lines")
     r.add_argument("--option", action="append", default=[], metavar="NAME=VALUE",
-                   help="a scene option (see 'refsph list'), e.g. --option T_melt=1793; repeatable")
-    args = ap.parse_args(argv)
+                   help="a scene option (see 'refsph list'), e.g. --option T_melt=1793 (or --T_melt 1793); "
+                        "repeatable")
+    r.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
+                   help="a numerical parameter (a field of refsph.scenes.Numerics), e.g. --set contact_Kp=10, "
+                        "--set ref_update_strain=none; repeatable")
+    args, extra = ap.parse_known_args(argv)
+    if extra and args.cmd != "run":
+        ap.error(f"unrecognized arguments: {' '.join(extra)}")
 
     if args.cmd == "list":
         for name, sc in SCENES.items():
@@ -51,6 +58,8 @@ def main(argv=None) -> int:
     scene = SCENES[args.scene]
     try:
         options = _parse_options(args.option)          # checked and converted by run() (scenes.convert_options)
+        options.update(_option_flags(extra, scene))
+        numerics = _parse_numerics(args.set)
     except ValueError as e:
         print(f"refsph: {e}", file=sys.stderr)
         return 2
@@ -63,7 +72,7 @@ def main(argv=None) -> int:
             out = f"{args.out}/{method}"
         try:
             res = run(args.scene, method, dim=dim, dp=args.dp, t_end=args.t_end, out=out, quick=args.quick,
-                      dt=args.dt, progress=not args.quiet, options=options)
+                      dt=args.dt, progress=not args.quiet, options=options, numerics=numerics)
         except SimulationError as e:
             print(f"refsph: run failed: {e}", file=sys.stderr)
             return 3
@@ -92,6 +101,55 @@ def _parse_options(items) -> dict:
             raise ValueError(f"--option needs NAME=VALUE, got {item!r}")
         name, value = item.split("=", 1)
         out[name] = value
+    return out
+
+
+def _option_flags(tokens, scene) -> dict:
+    """Scene options given as their own flags: ``--feed 0.3e-3`` or ``--feed=0.3e-3`` (``-`` read as ``_``)."""
+    out, k = {}, 0
+    while k < len(tokens):
+        tok = tokens[k]
+        if not tok.startswith("--"):
+            raise ValueError(f"unrecognized argument {tok!r}")
+        name, eq, value = tok[2:].partition("=")
+        name = name.replace("-", "_")
+        if name not in scene.options:
+            known = ", ".join(f"--{o}" for o in scene.options) or "none"
+            raise ValueError(f"unrecognized argument {tok!r} (scene {scene.name!r} options: {known})")
+        if not eq:
+            if k + 1 >= len(tokens):
+                raise ValueError(f"{tok} needs a value")
+            k += 1
+            value = tokens[k]
+        out[name] = value
+        k += 1
+    return out
+
+
+def _parse_numerics(items) -> dict:
+    """NAME=VALUE strings -> Numerics overrides, each converted like the field's default ('none' for None)."""
+    defaults = {f.name: f.default for f in dataclasses.fields(Numerics)}
+    out = {}
+    for item in items:
+        name, eq, value = item.partition("=")
+        if not eq:
+            raise ValueError(f"--set needs NAME=VALUE, got {item!r}")
+        if name not in defaults:
+            raise ValueError(f"unknown numerical parameter {name!r} (known: {', '.join(defaults)})")
+        d = defaults[name]
+        if value.lower() == "none" and (d is None or name in ("ref_update_strain", "contact_k")):
+            out[name] = None
+        elif isinstance(d, bool):
+            if value.lower() not in ("true", "false", "1", "0", "yes", "no"):
+                raise ValueError(f"--set {name} must be true or false, got {value!r}")
+            out[name] = value.lower() in ("true", "1", "yes")
+        elif isinstance(d, str):
+            out[name] = value
+        else:
+            try:
+                out[name] = float(value)
+            except ValueError:
+                raise ValueError(f"--set {name} must be a number, got {value!r}") from None
     return out
 
 

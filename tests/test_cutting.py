@@ -61,3 +61,19 @@ def test_coarse_smoke_run(method):
     face = s.x[n:, 0].min()
     above = s.x[:n, 1] > info["y0"] + info["dy"]
     assert np.all(s.x[:n][above, 0] < face)
+
+
+def test_cli_option_flags_and_numerics(tmp_path, capsys):
+    from refsph.cli import main
+    import json
+    rc = main(["run", "cutting", "--method", "tlsph", "--dp", "0.05e-3", "--feed", "0.5e-3", "--travel=0.02e-3",
+               "--set", "ref_update_strain=none", "--set", "contact_Kp=10", "--quiet", "--out", str(tmp_path)])
+    assert rc == 0
+    s = json.loads((tmp_path / "summary.json").read_text())
+    assert s["numerics"]["ref_update_strain"] is None and s["numerics"]["contact_Kp"] == 10.0
+    assert s["diagnostics"]["reference_updates"] == 0
+    assert s["metrics"]["cut_length_mm"] == pytest.approx(0.02)
+    assert main(["run", "cutting", "--nonsense", "1", "--quiet"]) == 2
+    assert main(["run", "cutting", "--feed", "--quiet"]) == 2
+    assert main(["run", "cutting", "--set", "courant=fast", "--quiet"]) == 2
+    assert main(["run", "cutting", "--set", "nothing=1", "--quiet"]) == 2

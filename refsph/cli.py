@@ -129,6 +129,7 @@ def _option_flags(tokens, scene) -> dict:
 def _parse_numerics(items) -> dict:
     """NAME=VALUE strings -> Numerics overrides, each converted like the field's default ('none' for None)."""
     defaults = {f.name: f.default for f in dataclasses.fields(Numerics)}
+    optional = {f.name for f in dataclasses.fields(Numerics) if "None" in str(f.type)}
     out = {}
     for item in items:
         name, eq, value = item.partition("=")
@@ -137,7 +138,7 @@ def _parse_numerics(items) -> dict:
         if name not in defaults:
             raise ValueError(f"unknown numerical parameter {name!r} (known: {', '.join(defaults)})")
         d = defaults[name]
-        if value.lower() == "none" and (d is None or name in ("ref_update_strain", "contact_k")):
+        if value.lower() == "none" and name in optional:
             out[name] = None
         elif isinstance(d, bool):
             if value.lower() not in ("true", "false", "1", "0", "yes", "no"):

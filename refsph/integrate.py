@@ -67,6 +67,7 @@ class _Solver:
                              "body of particles)")
         self.dt: float | None = None           # size of the step being taken (set by predictor_corrector_step)
         self.n_deformable: int | None = None   # rows [0, n_deformable) are deformable, the rest rigid
+        self.dim: int | None = None            # of the state bound (with n_deformable)
         self._rigid_rows: list[slice] = []
         self._reaction: list[np.ndarray] | None = None     # force on each rigid body / clamp, last evaluation
         self.reaction_log: list[list[float]] = []          # per step: t_mid, dt, then d components per body/clamp
@@ -86,8 +87,6 @@ class _Solver:
             w.check(state.dim)
         if self.mirror is not None:
             self.mirror.check(state.dim)
-        if getattr(self, "contact", None) is not None and self.contact.friction is not None and state.T is None:
-            raise ValueError("friction with mu(T) needs a state with temperatures (make_state(..., T0=...))")
         self._bind_bodies(state)
 
     def _check_plastic(self, state: State) -> None:
@@ -97,6 +96,7 @@ class _Solver:
 
     def _bind_bodies(self, state: State) -> None:
         n = state.n
+        self.dim = state.dim
         if not self.rigid:
             self.n_deformable, self._rigid_rows = n, []
         else:
@@ -183,13 +183,13 @@ class _Solver:
         metre of thickness), one row per step at the step's midpoint t (the time of the rates that moved it);
         dt is the step's size, so sum(F dt) is the impulse."""
         names = self.reaction_names
-        if not names:
+        if not names or self.dim is None:
             return {}
-        log = np.asarray(self.reaction_log, dtype=float).reshape(len(self.reaction_log), -1)
-        d = (log.shape[1] - 2) // len(names) if len(log) else 0
-        out = {"t": log[:, 0] if len(log) else np.zeros(0), "dt": log[:, 1] if len(log) else np.zeros(0)}
+        d = self.dim
+        log = np.asarray(self.reaction_log, dtype=float).reshape(-1, 2 + d * len(names))
+        out = {"t": log[:, 0], "dt": log[:, 1]}
         for k, name in enumerate(names):
-            out[name] = log[:, 2 + k * d: 2 + (k + 1) * d] if len(log) else np.zeros((0, d))
+            out[name] = log[:, 2 + k * d: 2 + (k + 1) * d]
         return out
 
     @staticmethod
@@ -325,6 +325,20 @@ class TLSPHSolver(_Solver):
             F[g.n_real:] = g.tensors(F[:g.n_real])
         return F
 
+    def check_state(self, state: State) -> None:
+        super().check_state(state)
+        if self.contact is not None and self.contact.friction is not None and state.T is None:
+            raise ValueError("friction with mu(T) needs a state with temperatures (make_state(..., T0=...))")
+
+    @staticmethod
+    def _with_identity(F: np.ndarray, state: State) -> np.ndarray:
+        """F of the deformable rows extended to every row of ``state`` (rigid rows: F = I)."""
+        if len(F) == state.n:
+            return F
+        out = np.broadcast_to(np.eye(state.dim), (state.n, state.dim, state.dim)).copy()
+        out[:len(F)] = F
+        return out
+
     def _deformable(self, state: State) -> State:
         """The deformable rows [0, n_deformable) as a state of views (the whole state if there is no tool)."""
         if self.n_deformable is None:
@@ -376,12 +390,7 @@ class TLSPHSolver(_Solver):
     def deformation_gradient(self, state: State) -> np.ndarray:
         body = self._deformable(state)
         op = self.operator(body)
-        F = self._F(self._extended(body, op), op)[:body.n]
-        if body is state:
-            return F
-        out = np.broadcast_to(np.eye(state.dim), (state.n, state.dim, state.dim)).copy()
-        out[:body.n] = F
-        return out
+        return self._with_identity(self._F(self._extended(body, op), op)[:body.n], state)
 
     def after_step(self, state: State) -> State:
         """rho = m / (J V0) (Eq. 2); reference update when max |E| > ref_update_strain.
@@ -397,11 +406,7 @@ class TLSPHSolver(_Solver):
         state.rho = rho
         thr = self.params.ref_update_strain
         if thr is not None and float(np.max(green_lagrange_norm(F))) > thr:
-            F_all = F
-            if body is not state:
-                F_all = np.broadcast_to(np.eye(state.dim), (state.n, state.dim, state.dim)).copy()
-                F_all[:body.n] = F
-            state = reset_reference(state, F_all)
+            state = reset_reference(state, self._with_identity(F, state))
             self.op = None
             self.operator(self._deformable(state))
             self.n_reference_updates += 1

@@ -92,7 +92,8 @@ def _build(dim, dp, quick, feed=CUTTING_OPTIONS["feed"][0], travel=CUTTING_OPTIO
     t_end = float(travel) / speed
     return Setup(state=concatenate_states(work, tool), material=mat, dp=dx, numerics=numerics, t_end=t_end,
                  n_snapshots=8, info=dict(n_work=work.n, n_tool=tool.n, dx=dx, dy=dy, feed_m=float(feed), y0=y0,
-                                          tool_layers=layers, travel_m=float(travel), tool_speed_m_s=speed),
+                                          tool_layers=layers, travel_m=float(travel), tool_speed_m_s=speed,
+                                          eps_dot_0=float(eps_dot_0)),
                  plasticity=jc, rigid=(RigidBody("tool", TOOL_BODY, (-speed, 0.0)),),
                  clamps=(Clamp("held", clamp),))
 

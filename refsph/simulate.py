@@ -139,7 +139,8 @@ def simulate(setup: Setup, method: str, *, scene=None, out=None, dt: float | Non
                                    clamps=[c.to_dict() for c in setup.clamps],
                                    friction=(dataclasses.asdict(setup.friction) if setup.friction is not None
                                              else None)),
-                   snapshot_times=[float(t) for t in snap_times], refsph_version=__version__,
+                   scene_info=setup.info, snapshot_times=[float(t) for t in snap_times],
+                   refsph_version=__version__,
                    status="running", metrics={})
 
     t0 = time.perf_counter()

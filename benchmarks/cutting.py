@@ -28,6 +28,8 @@ import time  # noqa: E402
 from concurrent.futures import ProcessPoolExecutor  # noqa: E402
 from pathlib import Path  # noqa: E402
 
+import numpy as np  # noqa: E402
+
 ROOT = Path(__file__).resolve().parent.parent
 RUNS = ROOT / "runs" / "benchmarks" / "cutting"
 OUT_JSON = ROOT / "benchmarks" / "cutting.json"
@@ -74,16 +76,282 @@ def run_job(job):
     return job["name"]
 
 
+def _r(a, nd):
+    return np.round(np.asarray(a, dtype=float), nd).tolist()
+
+
+def load(name):
+    """(summary, snapshot paths) of a finished or failed run; the measurements are recomputed from the run's
+    files with the current code (refsph.cutting.analyse_run), so a changed measure needs no new run."""
+    from refsph.io import load_run
+    return load_run(RUNS / name)
+
+
+def record(job):
+    from refsph.cutting import analyse_run
+    from refsph.io import load_snapshot
+    name = job["name"]
+    s, snaps = load(name)
+    ok = s["status"] == "ok"
+    m = analyse_run(RUNS / name) if ok else {}
+    last = load_snapshot(snaps[-1]) if snaps else None
+    n = s["scene_info"]["n_work"]
+    diag = s.get("diagnostics", {})
+    rec = dict(name=name, method=s["method"], feed_mm=1e3 * job["feed"], dp_nominal_mm=1e3 * job["dp"],
+               dp_mm=1e3 * s["dp"], h_mm=1e3 * s["h"], n_particles=s["n_particles"], n_workpiece=n,
+               n_steps=s["n_steps"], wall_time_s=s["wall_time_s"], status=s["status"], error=s.get("error"),
+               t_final_us=1e6 * s["t_final"], cut_length_mm=50.0 * s["t_final"] * 1e3,
+               ref_update_strain=s["numerics"]["ref_update_strain"],
+               reference_updates=diag.get("reference_updates"),
+               max_pinball_penetration_over_dp=(diag["max_pinball_penetration_m"] / s["dp"]
+                                                if "max_pinball_penetration_m" in diag else None))
+    if last is not None:
+        eps, T = last["eps_p"][:n], last["T"][:n]
+        rec.update(max_plastic_strain_last_snapshot=float(eps.max()), plastic_strain_p99=float(np.percentile(eps, 99)),
+                   temperature_p99_K=float(np.percentile(T, 99)))
+    if ok:
+        fc, ft = np.asarray(m["cutting_force_history"]), np.asarray(m["thrust_force_history"])
+        q3 = fc[(fc[:, 0] > 0.5 * s["t_end"]) & (fc[:, 0] <= 0.75 * s["t_end"]), 1].mean()
+        q4 = fc[fc[:, 0] > 0.75 * s["t_end"], 1].mean()
+        rec.update({k: m[k] for k in ("chip_thickness_mm", "shear_angle_from_chip_deg", "n_shear_bands",
+                                      "band_spacing_mm", "band_spacing_material_mm", "band_angle_deg",
+                                      "band_positions_mm", "band_angles_deg", "band_angles_current_deg",
+                                      "max_plastic_strain", "max_temperature_K")})
+        rec.update(cutting_force_mean_MN_per_m=1e-6 * m["cutting_force_mean_N_per_m"],
+                   thrust_force_mean_MN_per_m=1e-6 * m["thrust_force_mean_N_per_m"],
+                   cutting_force_drift=float(q4 / q3 - 1.0),
+                   cutting_force_history_mm_MN_per_m=np.column_stack([_r(50.0 * fc[:, 0] * 1e3, 5),
+                                                                      _r(1e-6 * fc[:, 1], 4)]).tolist(),
+                   thrust_force_history_mm_MN_per_m=np.column_stack([_r(50.0 * ft[:, 0] * 1e3, 5),
+                                                                     _r(1e-6 * ft[:, 1], 4)]).tolist(),
+                   strain_along_chip_mm=np.column_stack([_r(np.asarray(m["strain_along_chip"])[:, 0], 4),
+                                                         _r(np.asarray(m["strain_along_chip"])[:, 1], 4)]).tolist())
+    return rec
+
+
+def add_differences(records):
+    """vs_paper: relative differences of the force means and the chip thickness to the dp = 0.01 mm run of the
+    same method and feed (the coarse runs' distance to the paper's resolution, for the work-precision plot)."""
+    ref = {(r["method"], r["feed_mm"]): r for r in records if r["name"].startswith("paper-") and r["status"] == "ok"}
+    for r in records:
+        p = ref.get((r["method"], r["feed_mm"]))
+        if p is None or r is p or r["status"] != "ok" or r["ref_update_strain"] is None:
+            continue
+        r["vs_paper"] = dict(ref=p["name"],
+                             cutting_force_rel=r["cutting_force_mean_MN_per_m"] / p["cutting_force_mean_MN_per_m"] - 1,
+                             thrust_force_rel=r["thrust_force_mean_MN_per_m"] / p["thrust_force_mean_MN_per_m"] - 1,
+                             chip_thickness_rel=r["chip_thickness_mm"] / p["chip_thickness_mm"] - 1,
+                             wall_time_ratio=r["wall_time_s"] / p["wall_time_s"])
+    return records
+
+
+def write_json(records):
+    """One record per line (compact arrays), so that a change shows in git as the runs that changed."""
+    OUT_JSON.write_text("[\n" + ",\n".join(json.dumps(r) for r in records) + "\n]\n")
+
+
+def table(records) -> str:
+    f = lambda v, fmt: "-" if v is None or (isinstance(v, float) and not np.isfinite(v)) else format(v, fmt)  # noqa: E731
+    lines = [f"{'run':26s} {'N':>6s} {'steps':>6s} {'wall s':>7s} {'upd':>4s} {'status':>6s} {'Fc':>6s} {'Ft':>6s} "
+             f"{'drift':>6s} {'chip':>6s} {'phi_c':>5s} {'bands':>5s} {'spac':>6s} {'spac0':>6s} {'angle':>5s} "
+             f"{'eps max':>7s} {'eps p99':>7s} {'T max':>6s}"]
+    for r in records:
+        lines.append(f"{r['name']:26s} {r['n_particles']:6d} {r['n_steps']:6d} {r['wall_time_s']:7.0f} "
+                     f"{f(r['reference_updates'], 'd'):>4s} {r['status']:>6s} "
+                     f"{f(r.get('cutting_force_mean_MN_per_m'), '.3f'):>6s} {f(r.get('thrust_force_mean_MN_per_m'), '.3f'):>6s} "
+                     f"{f(r.get('cutting_force_drift'), '+.2f'):>6s} {f(r.get('chip_thickness_mm'), '.3f'):>6s} "
+                     f"{f(r.get('shear_angle_from_chip_deg'), '.0f'):>5s} {f(r.get('n_shear_bands'), 'd'):>5s} "
+                     f"{f(r.get('band_spacing_mm'), '.3f'):>6s} {f(r.get('band_spacing_material_mm'), '.3f'):>6s} "
+                     f"{f(r.get('band_angle_deg'), '.0f'):>5s} {f(r.get('max_plastic_strain'), '.1f'):>7s} "
+                     f"{f(r.get('plastic_strain_p99'), '.2f'):>7s} {f(r.get('max_temperature_K'), '.0f'):>6s}")
+    lines.append("Fc, Ft: cutting / thrust force on the tool [MN/m = kN per mm], mean over the 2nd half of the cut; "
+                 "drift: mean Fc of the 4th quarter / 3rd quarter - 1; chip: thickness [mm]; phi_c: shear angle "
+                 "atan(feed / chip) [deg]; spac / spac0: band spacing along the chip / in the uncut workpiece [mm]; "
+                 "angle: median band angle to the cutting direction [deg]; upd: TLSPH reference updates")
+    return "\n".join(lines)
+
+
+SNAP_INSTANTS = (2, 4, 6, 8)          # snapshots at 1/4, 1/2, 3/4 and all of the cut (n_snapshots = 8)
+
+
+def _picture(ax, z, dp, field, vmax, cmap="jet", vmin=0.0, xlim=(1.3, 3.6), ylim=(0.25, 2.15)):
+    from refsph.plots import particle_field
+    return particle_field(ax, z["x"], z[field], dp, body=z["body"], xlim=xlim, ylim=ylim, cmap=cmap, vmin=vmin,
+                          vmax=vmax)
+
+
+def plots(records):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from refsph.io import load_snapshot
+
+    FIG.mkdir(exist_ok=True)
+    colors = dict(esph="C0", tlsph="C3")
+    by = {r["name"]: r for r in records}
+    paper = [r for r in records if r["name"].startswith("paper-")]
+
+    # Figs. 12-13 and 17-18: plastic strain at four instants, ESPH above TLSPH, one figure per feed
+    for feed in FEEDS:
+        fig = plt.figure(figsize=(16, 7.6))
+        axs = fig.subplots(2, 4, gridspec_kw=dict(left=0.04, right=0.92, bottom=0.07, top=0.88, wspace=0.08,
+                                                  hspace=0.3))
+        sc = None
+        for row, m in enumerate(("esph", "tlsph")):
+            r = by.get(f"paper-{m}-f{feed * 1e3:g}")
+            if r is None:
+                continue
+            _, snaps = load(r["name"])
+            for col, k in enumerate(SNAP_INSTANTS):
+                ax = axs[row, col]
+                if k >= len(snaps):
+                    ax.set_title(f"{m.upper()}: no snapshot ({r['status']})", fontsize=9)
+                    continue
+                z = load_snapshot(snaps[k])
+                sc = _picture(ax, z, r["dp_mm"] * 1e-3, "eps_p", 3.0)
+                ax.set_title(f"{m.upper()}, cut {50.0 * z['t'] * 1e3:.2f} mm", fontsize=9)
+                ax.tick_params(labelsize=7)
+        if sc is not None:
+            fig.colorbar(sc, cax=fig.add_axes([0.93, 0.2, 0.01, 0.6]), extend="max",
+                         label="effective plastic strain (scale cut at 3)")
+        fig.suptitle(f"Orthogonal cutting, feed {feed * 1e3:g} mm, dp = 0.01 mm: chip and plastic strain at four "
+                     f"instants (cf. the paper's Figs. {'12-13' if feed < 0.4e-3 else '17-18'}); grey: the tool's "
+                     "surface layers [mm]", fontsize=10)
+        fig.savefig(FIG / f"08_cutting_strain_f{feed * 1e3:g}.png", dpi=110)
+        plt.close(fig)
+
+    # Figs. 14-15: temperature at the end of the cut, both methods and feeds
+    fig = plt.figure(figsize=(9, 8))
+    axs = fig.subplots(2, 2, gridspec_kw=dict(left=0.07, right=0.88, bottom=0.06, top=0.9, wspace=0.1,
+                                              hspace=0.25))
+    sc = None
+    for row, m in enumerate(("esph", "tlsph")):
+        for col, feed in enumerate(FEEDS):
+            r = by.get(f"paper-{m}-f{feed * 1e3:g}")
+            if r is None:
+                continue
+            _, snaps = load(r["name"])
+            z = load_snapshot(snaps[-1])
+            sc = _picture(axs[row, col], z, r["dp_mm"] * 1e-3, "T", 1573.0, cmap="inferno", vmin=298.0)
+            axs[row, col].set_title(f"{m.upper()}, feed {feed * 1e3:g} mm, cut {50.0 * z['t'] * 1e3:.2f} mm",
+                                    fontsize=9)
+            axs[row, col].tick_params(labelsize=7)
+    if sc is not None:
+        fig.colorbar(sc, cax=fig.add_axes([0.9, 0.2, 0.015, 0.6]), label="temperature [K] (298 K to T_melt)")
+    fig.suptitle("Temperature at the end of the cut, dp = 0.01 mm (cf. Figs. 14-15; adiabatic: 90 % of the "
+                 "plastic work heats the particle, no conduction)", fontsize=10)
+    fig.savefig(FIG / "08_cutting_temperature.png", dpi=110)
+    plt.close(fig)
+
+    # forces against cut length
+    fig, axs = plt.subplots(1, 2, figsize=(12, 4.2), constrained_layout=True, sharey=True)
+    for ax, key, label in ((axs[0], "cutting_force_history_mm_MN_per_m", "cutting force Fc"),
+                           (axs[1], "thrust_force_history_mm_MN_per_m", "thrust force Ft")):
+        for r in paper:
+            if key not in r:
+                continue
+            h = np.asarray(r[key])
+            k = min(9, len(h))
+            ax.plot(h[:, 0], np.convolve(h[:, 1], np.ones(k) / k, mode="same"), color=colors[r["method"]],
+                    ls="-" if r["feed_mm"] < 0.4 else "--", lw=1.3,
+                    label=f"{r['method'].upper()}, feed {r['feed_mm']:g} mm")
+        ax.set_xlabel("cut length [mm]")
+        ax.set_title(f"{label} on the tool (running mean over 9 bins of 2.5 um)", fontsize=9)
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=8)
+    axs[0].set_ylabel("force per unit thickness [MN/m = kN/mm]")
+    fig.suptitle("Orthogonal cutting, dp = 0.01 mm: forces (the means are taken over the 2nd half)", fontsize=10)
+    fig.savefig(FIG / "08_cutting_forces.png", dpi=120)
+    plt.close(fig)
+
+    # the band measurement: plastic strain along the chip (middle row of the cut layer) with the bands found
+    fig, axs = plt.subplots(2, 2, figsize=(12, 6.5), constrained_layout=True, sharex=True)
+    for row, m in enumerate(("esph", "tlsph")):
+        for col, feed in enumerate(FEEDS):
+            r = by.get(f"paper-{m}-f{feed * 1e3:g}")
+            ax = axs[row, col]
+            if r is None or "strain_along_chip_mm" not in r:
+                continue
+            p = np.asarray(r["strain_along_chip_mm"])
+            ax.plot(p[:, 0], p[:, 1], color=colors[m], lw=1)
+            for xb in r["band_positions_mm"]:
+                ax.axvline(xb, color="k", lw=0.6, ls=":")
+            ax.set_title(f"{m.upper()}, feed {feed * 1e3:g} mm: {r['n_shear_bands']} bands, spacing "
+                         f"{r['band_spacing_material_mm']:.3f} mm (uncut) / {r['band_spacing_mm']:.3f} mm (chip), "
+                         f"angle {r['band_angle_deg']:.0f} deg", fontsize=9)
+            ax.grid(alpha=0.3)
+            if row == 1:
+                ax.set_xlabel("initial x of the material [mm] (the tool moved from 3 to 2 mm)")
+            if col == 0:
+                ax.set_ylabel("eps_p, middle row of the cut layer")
+    fig.suptitle("Shear bands: peaks of the plastic strain along the chip (dotted: the bands counted)", fontsize=10)
+    fig.savefig(FIG / "08_cutting_bands.png", dpi=120)
+    plt.close(fig)
+
+    # work-precision: the coarse runs' distance to dp = 0.01 mm against wall time, feed 0.3 mm
+    fig, axs = plt.subplots(1, 2, figsize=(11, 4.2), constrained_layout=True)
+    for ax, key, label in ((axs[0], "cutting_force_rel", "mean cutting force"),
+                           (axs[1], "chip_thickness_rel", "chip thickness")):
+        for m in METHODS:
+            rs = sorted([r for r in records if r["method"] == m and "vs_paper" in r and abs(r["feed_mm"] - 0.3) < 1e-9],
+                        key=lambda r: r["wall_time_s"])
+            if not rs:
+                continue
+            ax.loglog([r["wall_time_s"] for r in rs], [max(100 * abs(r["vs_paper"][key]), 1e-2) for r in rs], "o-",
+                      color=colors[m], label=m.upper())
+            for r in rs:
+                ax.annotate(f"{1e3 * r['dp_nominal_mm']:.3g} um", (r["wall_time_s"], max(100 * abs(r["vs_paper"][key]), 1e-2)),
+                            textcoords="offset points", xytext=(4, 4), fontsize=8, color=colors[m])
+            p = by.get(f"paper-{m}-f0.3")
+            if p is not None:
+                ax.axvline(p["wall_time_s"], color=colors[m], ls=":", lw=1, label=f"{m.upper()} at 0.01 mm (reference)")
+        ax.set_xlabel("wall time [s] (one core)")
+        ax.set_ylabel("|difference to dp = 0.01 mm| [%]")
+        ax.set_title(f"{label}, feed 0.3 mm, 1 mm of cut", fontsize=10)
+        ax.grid(alpha=0.3, which="both")
+        ax.legend(fontsize=8)
+    fig.savefig(FIG / "08_cutting_work_precision.png", dpi=120)
+    plt.close(fig)
+
+    # TLSPH with and without reference-configuration updates (reduced size)
+    pair = [by.get("coarse-tlsph-f0.3-25um"), by.get("noupdate-tlsph-f0.3-25um")]
+    if all(pair):
+        fig = plt.figure(figsize=(10, 4.8))
+        axs = fig.subplots(1, 2, gridspec_kw=dict(left=0.06, right=0.88, bottom=0.1, top=0.85, wspace=0.12))
+        for ax, r in zip(axs, pair):
+            _, snaps = load(r["name"])
+            k = 4 if r["name"].startswith("coarse") else -1          # both at 0.5 mm of cut
+            z = load_snapshot(snaps[k])
+            sc = _picture(ax, z, r["dp_mm"] * 1e-3, "eps_p", 3.0, xlim=(1.7, 3.4), ylim=(0.3, 1.9))
+            upd = "with" if r["ref_update_strain"] is not None else "without"
+            ax.set_title(f"TLSPH {upd} reference updates ({r['reference_updates']}), cut {50.0 * z['t'] * 1e3:.2f} mm\n"
+                         f"max eps_p {z['eps_p'][:r['n_workpiece']].max():.1f}", fontsize=9)
+        fig.colorbar(sc, cax=fig.add_axes([0.9, 0.2, 0.015, 0.6]), extend="max", label="effective plastic strain")
+        fig.suptitle("Reduced size (dp = 0.025 mm, feed 0.3 mm): the chip with and without updates of the "
+                     "reference configuration", fontsize=10)
+        fig.savefig(FIG / "08_cutting_reference_updates.png", dpi=120)
+        plt.close(fig)
+
+
 def main(argv=None):
+    global RUNS
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--jobs", type=int, default=1, help="runs at a time (default 1)")
     ap.add_argument("--plot-only", action="store_true", help="no runs: JSON, figures and table from earlier runs")
     ap.add_argument("--only", default=None, help="run only the jobs whose name contains this string")
+    ap.add_argument("--runs", default=None, help=f"folder of the run folders (default {RUNS.relative_to(ROOT)})")
     args = ap.parse_args(argv)
+    if args.runs is not None:
+        RUNS = Path(args.runs).resolve()
     jobs = [j for j in job_list() if args.only is None or args.only in j["name"]]
     if not args.plot_only:
         with ProcessPoolExecutor(max_workers=args.jobs, max_tasks_per_child=1) as ex:
             list(ex.map(run_job, jobs))
+    done = [j for j in job_list() if (RUNS / j["name"] / "summary.json").exists()]
+    records = add_differences([record(j) for j in done])
+    write_json(records)
+    print(table(records))
+    plots(records)
 
 
 if __name__ == "__main__":

@@ -27,6 +27,7 @@ rises along the vertical rake face, so its thickness is horizontal there), the m
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
 
@@ -38,6 +39,9 @@ __all__ = ["make_scene", "cutting_particles", "CUTTING_GEOMETRY", "TOOL_BODY"]
 
 TOOL_BODY = 1
 N_FORCE_BINS = 400
+STEADY_FROM = 0.5             # force means over the second half of the run (t > STEADY_FROM t_end)
+BAND_REL_PROMINENCE = 0.5     # a shear band: a strain peak along the chip at least this x the median above its
+#                               surroundings (see shear_bands)
 # Section 3.3 and Table 5
 CUTTING_GEOMETRY = dict(workpiece_m=(3.0e-3, 1.0e-3), tool_m=(0.5e-3, 1.0e-3), tool_speed_m_s=50.0,
                         feeds_m=(0.3e-3, 0.5e-3), particle_spacing_m=0.01e-3, smoothing_length_m=0.018e-3,
@@ -116,30 +120,174 @@ def chip_thickness(x: np.ndarray, X0: np.ndarray, y0: float, surface: float, fee
     return float(np.median(widths)) if widths else float("nan")
 
 
-def _metrics(hist, state, setup):
-    info = setup.info
+def lattice_shape(setup_info: dict) -> tuple[int, int]:
+    """(nx, ny) of the workpiece lattice: particle k of the workpiece is column k // ny, row k % ny."""
+    (Lx, Ly) = CUTTING_GEOMETRY["workpiece_m"]
+    return round(Lx / setup_info["dx"]), round(Ly / setup_info["dy"])
+
+
+def shear_bands(x: np.ndarray, eps_p: np.ndarray, nx: int, ny: int, dx: float, dy: float, feed: float,
+                x_tip: float, rel_prominence: float = BAND_REL_PROMINENCE) -> dict:
+    """Shear bands in the cut layer, found in the plastic strain of the workpiece lattice (material coordinates).
+
+    The workpiece particles are a lattice in their initial positions X0 = ((i + 1/2) dx, (j + 1/2) dy), so
+    eps_p[i, j] is the plastic strain field over the undeformed workpiece. A shear band is a thin line of high
+    eps_p that crosses the cut layer (the rows above the cut line y0 = Ly - feed) from the cut line to the free
+    surface. Method:
+
+    1. **Profile along the chip**: eps_p(i) on the middle row of the cut layer (the row nearest y0 + feed/2), for
+       the material the tool has reached, i.e. X0_x > x_tip - feed (``x_tip``: the cutting edge's x at this
+       instant; the margin of one feed keeps the band now forming at the tool tip, which crosses the middle row
+       ahead of the edge). A 3-point running mean removes particle-scale noise.
+    2. **Bands** are the peaks of that profile (:func:`scipy.signal.find_peaks`) whose prominence is at least
+       ``rel_prominence`` times the profile's median: a band is a local strain maximum well above its
+       surroundings, not a ripple. ``n`` counts them.
+    3. **Spacing**: between neighbouring bands, in material coordinates (the uncut length of workpiece that makes
+       one chip segment, ``spacing_material_mm``) and along the chip as it is now (the arc length between the
+       bands along the middle row's current positions, ``spacing_mm``, what a picture of the chip shows).
+    4. **Angle**: each band is followed row by row from the middle row up to the surface and down to the cut
+       line (in each row the strain maximum within two columns of the row before); a straight line
+       X0_x = a + b X0_y fitted to it gives the band's angle to the cutting direction (the tool moves along -x)
+       in the undeformed workpiece, phi = atan2(1, -b): 45 deg leans ahead of the tool, 90 deg is vertical. A
+       band forms in material just ahead of the tool that has not deformed much yet, so this is close to its
+       angle when it formed; in the chip the bands have since rotated (``angles_current_deg``: the same particles'
+       line in the current configuration, angle to +x, for reference).
+    """
+    from scipy.signal import find_peaks
+
+    E = eps_p[: nx * ny].reshape(nx, ny)
+    xc = x[: nx * ny].reshape(nx, ny, 2)
+    Ly = ny * dy
+    j0 = int(math.ceil((Ly - feed) / dy - 0.5 - 1e-9))     # first row above the cut line
+    jm = int(round((Ly - 0.5 * feed) / dy - 0.5))           # middle row of the cut layer
+    X = (np.arange(nx) + 0.5) * dx
+    cols = np.flatnonzero(X > x_tip - feed)
+    empty = dict(n=0, spacing_mm=float("nan"), spacing_material_mm=float("nan"), angle_deg=float("nan"),
+                 peaks_X_mm=[], angles_deg=[], angles_current_deg=[], profile=np.zeros((0, 2)), rows=(j0, jm))
+    if len(cols) < 5:
+        return empty
+    e = np.convolve(E[cols, jm], np.ones(3) / 3.0, mode="same")
+    e[0], e[-1] = E[cols[0], jm], E[cols[-1], jm]
+    med = float(np.median(e))
+    peaks, _ = find_peaks(e, prominence=rel_prominence * max(med, 1e-12))
+    out = dict(empty, profile=np.stack([X[cols] * 1e3, e], axis=1))
+    if len(peaks) == 0:
+        return out
+    ip = cols[peaks]
+    # arc length along the middle row's current positions (material order)
+    mid = xc[cols, jm]
+    arc = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(mid, axis=0), axis=1))])
+    angles, angles_cur = [], []
+    for i in ip:
+        track = {jm: i}
+        for rng in (range(jm + 1, ny), range(jm - 1, j0 - 1, -1)):
+            prev = i
+            for j in rng:
+                lo, hi = max(prev - 2, 0), min(prev + 3, nx)
+                prev = lo + int(np.argmax(E[lo:hi, j]))
+                track[j] = prev
+        js = np.array(sorted(track))
+        its = np.array([track[j] for j in js])
+        b = np.polyfit((js + 0.5) * dy, (its + 0.5) * dx, 1)[0]
+        angles.append(float(np.degrees(np.arctan2(1.0, -b))))
+        pts = xc[its, js]
+        d = np.linalg.svd(pts - pts.mean(axis=0), full_matrices=False)[2][0]
+        angles_cur.append(float(np.degrees(np.arctan2(abs(d[1]), d[0] * np.sign(d[1] or 1.0))) % 180.0))
+    out.update(n=int(len(ip)), peaks_X_mm=[float(X[i] * 1e3) for i in ip], angles_deg=angles,
+               angles_current_deg=angles_cur, angle_deg=float(np.median(angles)))
+    if len(ip) >= 2:
+        out.update(spacing_material_mm=float(np.mean(np.diff(X[ip]))) * 1e3,
+                   spacing_mm=float(np.mean(np.diff(arc[peaks]))) * 1e3)
+    return out
+
+
+def cutting_metrics(reaction: dict, x: np.ndarray, eps_p: np.ndarray, T: np.ndarray, t: float, info: dict,
+                    t_end: float) -> dict:
+    """The ``metrics`` of ``summary.json`` from the tool's reaction history (``{'t', 'dt', 'tool'}``, as
+    :func:`refsph.io.load_reactions` returns it) and the final positions, plastic strain and temperature of all
+    particles (workpiece first, then the tool). :func:`analyse_run` calls it on a run folder."""
     n = info["n_work"]
-    rh = hist["reaction"]
-    t, dt = np.asarray(rh["t"]), np.asarray(rh["dt"])
-    Fc = np.asarray(rh["tool"])[:, 0]                  # against the cut (the tool moves along -x)
-    Ft = np.asarray(rh["tool"])[:, 1]                  # pushing the tool up, away from the workpiece
-    nb = min(N_FORCE_BINS, max(1, len(t)))
-    tb, cb = _binned(t, dt, Fc, setup.t_end, nb)
-    _, tb_ = _binned(t, dt, Ft, setup.t_end, nb)
-    tool_face = float(state.x[n:, 0].min()) - 0.5 * info["dx"]
-    # initial positions: the workpiece's particle order is the lattice's, rebuilt here (TLSPH updates X)
-    X0 = setup.state.x[:n]
+    t_r, dt = np.asarray(reaction["t"]), np.asarray(reaction["dt"])
+    F = np.asarray(reaction["tool"])
+    Fc, Ft = F[:, 0], F[:, 1]         # Fc against the cut (the tool moves along -x); Ft pushes the tool up (+y)
+    nb = min(N_FORCE_BINS, max(1, len(t_r)))
+    tb, cb = _binned(t_r, dt, Fc, t_end, nb)
+    _, tb_ = _binned(t_r, dt, Ft, t_end, nb)
+    x_tip = float(x[n:, 0].min()) - 0.5 * info["dx"]     # the rake face (and the cutting edge) at time t
+    nx, ny = lattice_shape(info)
+    X0 = np.stack(np.meshgrid((np.arange(nx) + 0.5) * info["dx"], (np.arange(ny) + 0.5) * info["dy"],
+                              indexing="ij"), axis=-1).reshape(-1, 2)   # initial positions (the lattice)
+    Ly = CUTTING_GEOMETRY["workpiece_m"][1]
+    feed = info["feed_m"]
+    bands = shear_bands(x, eps_p, nx, ny, info["dx"], info["dy"], feed, x_tip)
+    tc = chip_thickness(x[:n], X0, info["y0"], Ly, feed, x_tip, info["dy"])
     return dict(
         cutting_force_history=np.stack([tb, cb], axis=1),
         thrust_force_history=np.stack([tb, tb_], axis=1),
-        cutting_force_mean_N_per_m=_time_mean(t, dt, Fc, 0.5 * setup.t_end),
-        thrust_force_mean_N_per_m=_time_mean(t, dt, Ft, 0.5 * setup.t_end),
-        max_plastic_strain=float(np.max(state.eps_p[:n])),
-        max_temperature_K=float(np.max(state.T[:n])),
-        chip_thickness_mm=1e3 * chip_thickness(state.x[:n], X0, info["y0"], CUTTING_GEOMETRY["workpiece_m"][1],
-                                               info["feed_m"], tool_face, info["dy"]),
-        cut_length_mm=float(info["tool_speed_m_s"] * state.t * 1e3),
+        cutting_force_mean_N_per_m=_time_mean(t_r, dt, Fc, STEADY_FROM * t_end),
+        thrust_force_mean_N_per_m=_time_mean(t_r, dt, Ft, STEADY_FROM * t_end),
+        max_plastic_strain=float(np.max(eps_p[:n])),
+        max_temperature_K=float(np.max(T[:n])),
+        chip_thickness_mm=1e3 * tc,
+        shear_angle_from_chip_deg=float(np.degrees(np.arctan2(feed, tc))) if np.isfinite(tc) else float("nan"),
+        n_shear_bands=bands["n"],
+        band_spacing_mm=bands["spacing_mm"],
+        band_spacing_material_mm=bands["spacing_material_mm"],
+        band_angle_deg=bands["angle_deg"],
+        band_positions_mm=bands["peaks_X_mm"],
+        band_angles_deg=bands["angles_deg"],
+        band_angles_current_deg=bands["angles_current_deg"],
+        strain_along_chip=bands["profile"],
+        cut_length_mm=float(info["tool_speed_m_s"] * t * 1e3),
     )
+
+
+def _metrics(hist, state, setup):
+    return cutting_metrics(hist["reaction"], state.x, state.eps_p, state.T, state.t, setup.info, setup.t_end)
+
+
+def analyse_run(directory, snapshot: int = -1) -> dict:
+    """:func:`cutting_metrics` of a cutting run folder (``refsph run cutting --out DIR``) from its
+    ``summary.json``, ``reaction_forces.csv`` and snapshot number ``snapshot`` (default: the last); the forces
+    cover the whole run. Lets a changed measurement be applied to earlier runs without running them again."""
+    from .io import load_reactions, load_run, load_snapshot
+    directory = Path(directory)
+    summary, snaps = load_run(directory)
+    if summary.get("scene") != "cutting":
+        raise ValueError(f"{directory} is not a cutting run (scene {summary.get('scene')!r})")
+    if not snaps:
+        raise FileNotFoundError(f"{directory} has no snapshots")
+    z = load_snapshot(snaps[snapshot])
+    return cutting_metrics(load_reactions(directory / "reaction_forces.csv"), z["x"], z["eps_p"], z["T"], z["t"],
+                           summary["scene_info"], summary["t_end"])
+
+
+def cutting_table(summaries: list) -> str:
+    """The runs side by side, with what the paper reports (in words; no forces are printed)."""
+    from .reference import CUTTING_OBSERVED
+    rows = ["Orthogonal cutting, 2D plane strain (Section 3.3). The paper prints no forces; it reports bands from the",
+            f"tool tip to the free surface at about {CUTTING_OBSERVED['band_angle_deg']:.0f} deg, and for the deeper "
+            f"feed: {CUTTING_OBSERVED['deeper_feed']}.",
+            "",
+            f"{'method':7s} {'feed':>5s} {'dp[um]':>6s} {'particles':>9s} {'steps':>6s} {'wall[s]':>7s} "
+            f"{'ref.upd':>7s} {'Fc[kN/mm]':>9s} {'Ft[kN/mm]':>9s} {'chip[mm]':>8s} {'bands':>5s} "
+            f"{'spacing[mm]':>11s} {'angle[deg]':>10s} {'paper':>5s} {'max eps_p':>9s} {'max T[K]':>8s}"]
+    for s in summaries:
+        m = s.get("metrics") or {}
+        feed = s.get("scene_info", {}).get("feed_m", float("nan")) * 1e3
+        if not m:
+            rows.append(f"{s['method']:7s} {feed:5.2f} (status {s.get('status')}: {s.get('error', '')})")
+            continue
+        upd = s.get("diagnostics", {}).get("reference_updates")
+        rows.append(f"{s['method']:7s} {feed:5.2f} {s['dp'] * 1e6:6.2f} {s['n_particles']:9d} {s['n_steps']:6d} "
+                    f"{s['wall_time_s']:7.0f} {'-' if upd is None else upd:>7} "
+                    f"{m['cutting_force_mean_N_per_m'] * 1e-6:9.3f} {m['thrust_force_mean_N_per_m'] * 1e-6:9.3f} "
+                    f"{m['chip_thickness_mm']:8.3f} {m['n_shear_bands']:5d} {m['band_spacing_mm']:11.3f} "
+                    f"{m['band_angle_deg']:10.1f} {CUTTING_OBSERVED['band_angle_deg']:5.0f} "
+                    f"{m['max_plastic_strain']:9.2f} {m['max_temperature_K']:8.0f}")
+    rows.append(f"(Fc, Ft: cutting and thrust force on the tool per unit thickness, means over the last "
+                f"{100 * (1 - STEADY_FROM):.0f} % of the cut; kN per mm = MN/m. Bands: see refsph.cutting.shear_bands)")
+    return "\n".join(rows)
 
 
 def make_scene():
@@ -148,4 +296,4 @@ def make_scene():
         "cutting",
         "orthogonal cutting (PRELIMINARY): AISI 4340 3 x 1 mm, rigid tool 0.5 x 1 mm at 50 m/s (Section 3.3)",
         _default_dp, _build, _record, _metrics, options=CUTTING_OPTIONS, default_dim=2,
-        methods=("esph", "tlsph"))
+        methods=("esph", "tlsph"), report=cutting_table)

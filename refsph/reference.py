@@ -8,7 +8,8 @@ files outside it at run time.
 from __future__ import annotations
 
 __all__ = ["TAYLOR_TABLE1", "TAYLOR_TABLE2", "TAYLOR_GEOMETRY", "TAYLOR_RESULTS", "AISI4340_TABLE3",
-           "PRESSING_TABLE4", "PRESSING_GEOMETRY", "PRESSING_RESOLUTIONS_M", "AISI1045_RLA"]
+           "PRESSING_TABLE4", "PRESSING_GEOMETRY", "PRESSING_RESOLUTIONS_M", "CUTTING_TABLE5", "CUTTING_OBSERVED",
+           "AISI1045_RLA"]
 
 # Table 1: Johnson-Cook parameters of low-strength 4340 steel, as printed (T_m = 1293 K; 1793 K is usual)
 TAYLOR_TABLE1 = dict(rho=7830.0, shear_modulus_Pa=82.9e9, bulk_modulus_Pa=169.1e9, A_Pa=792e6, B_Pa=510e6,
@@ -39,6 +40,13 @@ PRESSING_GEOMETRY = dict(block_m=(1.0e-3, 0.5e-3), tool_m=(0.1e-3, 0.7e-3), tool
                          thickness_3d_m=0.1e-3)
 # Section 3.2, Fig. 10: the resolution study (h / dp = 1.5 kept); 0.0167 = 1/60 mm, 0.0133 = 1/75 mm, ...
 PRESSING_RESOLUTIONS_M = (0.0167e-3, 0.0133e-3, 0.01e-3, 0.00667e-3)
+# Section 3.3 and Table 5: orthogonal cutting (2D plane strain; h / dp = 1.8)
+CUTTING_TABLE5 = dict(particle_spacing_m=0.01e-3, smoothing_length_m=0.018e-3, time_step_s=1e-10,
+                      beta1=0.5, beta2=0.5, artificial_pressure_gamma_esph=0.3)
+# Section 3.3.1-3.3.2: what the paper reports for the cutting, in words only (no numbers are printed besides
+# the band angle): bands from the tool tip to the free surface at about 45 deg; a deeper feed gives a larger
+# cutting force and fewer, wider-spaced shear bands (larger chip segments).
+CUTTING_OBSERVED = dict(band_angle_deg=45.0, deeper_feed="larger cutting force, fewer and wider-spaced bands")
 
 # Rodriguez Prieto, Larsson & Afrasiabi, "Thermomechanical Simulation of Orthogonal Metal Cutting with PFEM and
 # SPH Using a Temperature-Dependent Friction Coefficient", Tables 1-2: AISI 1045 with the *modified*

@@ -1,8 +1,9 @@
-"""Orthogonal cutting scene (Section 3.3), preliminary: geometry and a coarse smoke run of both methods."""
+"""Orthogonal cutting scene (Section 3.3): geometry, the measurements (chip thickness, shear bands) on fields
+with a known answer, coarse runs of both methods, the CLI."""
 import numpy as np
 import pytest
 
-from refsph.cutting import CUTTING_GEOMETRY, TOOL_BODY, chip_thickness
+from refsph.cutting import CUTTING_GEOMETRY, TOOL_BODY, analyse_run, chip_thickness, shear_bands
 from refsph.scenes import get_scene
 from refsph.simulate import run
 
@@ -43,6 +44,45 @@ def test_chip_thickness_of_a_slab():
     X0 = x.copy()
     X0[:, 1] = 0.9e-3                                                     # all of it came from above the cut line
     assert chip_thickness(x, X0, 0.7e-3, 1e-3, 0.3e-3, 3.0e-3, dy) == pytest.approx(0.2e-3 - dy / 2, rel=1e-9)
+
+
+def _banded_field(dp, feed, spacing, angle_deg, x_tip, width=1.5):
+    """Workpiece lattice (undeformed, x = X0) with straight bands of eps_p = 2 (Gaussian, ``width`` spacings)
+    over a background 0.3, crossing the cut layer at ``angle_deg`` to the cutting direction (-x), their middle-row
+    crossings every ``spacing`` from x_tip - feed / 2 on."""
+    (Lx, Ly) = CUTTING_GEOMETRY["workpiece_m"]
+    nx, ny = round(Lx / dp), round(Ly / dp)
+    X = np.stack(np.meshgrid((np.arange(nx) + 0.5) * dp, (np.arange(ny) + 0.5) * dp, indexing="ij"),
+                 axis=-1).reshape(-1, 2)
+    ym = Ly - feed / 2
+    # a band through (xc, ym) leaning ahead of the tool: x = xc - (y - ym) / tan(angle)
+    shift = X[:, 0] + (X[:, 1] - ym) / np.tan(np.radians(angle_deg))
+    centres = np.arange(x_tip - feed / 2 + spacing, Lx - feed, spacing)         # all of each band inside
+    d = np.min(np.abs(shift[:, None] - centres[None, :]), axis=1) * np.sin(np.radians(angle_deg))
+    eps = 0.3 + 1.7 * np.exp(-0.5 * (d / (width * dp)) ** 2)
+    eps[X[:, 1] < Ly - feed] = 0.0
+    return X, eps, nx, ny, centres
+
+
+@pytest.mark.parametrize("angle", [45.0, 60.0, 120.0])
+def test_shear_bands_of_a_known_field(angle):
+    """Straight bands at a known angle and spacing are counted, spaced and angled as drawn (x = X0, so the
+    spacing along the chip equals the material spacing)."""
+    dp, feed, spacing, x_tip = 0.01e-3, 0.3e-3, 0.12e-3, 2.0e-3
+    X, eps, nx, ny, centres = _banded_field(dp, feed, spacing, angle, x_tip)
+    b = shear_bands(X, eps, nx, ny, dp, dp, feed, x_tip)
+    assert b["n"] == len(centres)
+    assert b["spacing_material_mm"] == pytest.approx(spacing * 1e3, abs=0.5 * dp * 1e3)
+    assert b["spacing_mm"] == pytest.approx(spacing * 1e3, abs=0.5 * dp * 1e3)
+    assert b["angle_deg"] == pytest.approx(angle, abs=2.0)
+    assert np.allclose(b["angles_current_deg"], 180.0 - angle, atol=2.0)   # same line, angle to +x
+
+
+def test_no_bands_in_a_uniform_field():
+    dp, feed = 0.01e-3, 0.3e-3
+    X, eps, nx, ny, _ = _banded_field(dp, feed, 0.12e-3, 45.0, 2.0e-3)
+    eps[eps > 0] = 1.0
+    assert shear_bands(X, eps, nx, ny, dp, dp, feed, 2.0e-3)["n"] == 0
 
 
 @pytest.mark.parametrize("method", ["esph", "tlsph"])

@@ -1,28 +1,37 @@
 """Orthogonal cutting (Section 3.3, Tables 3 and 5): an AISI 4340 workpiece 3 x 1 mm, a rigid frictionless tool
 0.5 x 1 mm moving at 50 m/s, feed (depth of cut) 0.3 or 0.5 mm, 2D plane strain.
 
-PRELIMINARY (issue 5 is open): geometry, held boundaries, forces and chip thickness are in place; the shear-band
-measurements, chapter 08 and the paper-resolution study are not yet.
-
 Model, and the choices the paper leaves open (its Fig. 11 is not in the text we have):
 
 * **Workpiece** [0, 3] x [0, 1] mm on a lattice of spacings 3 mm / round(3 mm / dp) and 1 mm / round(1 mm / dp),
-  held by clamps (:class:`~refsph.boundaries.Clamp`) on its bottom row and its left column of particles.
+  held by clamps (:class:`~refsph.boundaries.Clamp`) on its bottom row and its left column of particles (the
+  paper: "the workpiece bottom fixed"; the left column stops the whole workpiece from being pushed along).
 * **Tool**: the rectangle [3, 3.5] x [1 - feed, 2 - feed] mm, i.e. rake and clearance angles 0 (the paper gives
   only the size), its cutting edge at the cut depth, touching the workpiece's right face at t = 0 and moving at
   -50 m/s along x. Only its surface layers are modelled: ceil(2h/dp) columns on the rake face and as many rows on
-  the clearance face (an L of particles). Frictionless (Section 3.3).
-* **Cut length** (not printed): option ``travel``, 1 mm by default (t_end = 20 us).
+  the clearance face (an L of particles), so that every workpiece particle near the tool sees a full kernel
+  support of tool. Frictionless (Section 3.3).
+* **Cut length** (not printed): option ``travel``, 1 mm by default (t_end = 20 us), a third of the workpiece.
 
-Numerics: Table 5 (dp = 0.01 mm, h = 0.018 mm: h/dp = 1.8, beta1 = beta2 = 0.5), ESPH gamma = 0.3, Courant 0.3,
-ESPH Verlet skin 0.3 h; TLSPH reference updates at max |E| > 0.5 (``Numerics.ref_update_strain``).
+Numerics: Table 5 (dp = 0.01 mm, h = 0.018 mm: h/dp = 1.8, beta1 = beta2 = 0.5), ESPH gamma = 0.3, CFL step with
+Courant 0.3 (the paper's fixed 1e-10 s is 9x smaller), ESPH Verlet skin 0.3 h; TLSPH reference updates at
+max |E| > 0.5 (``Numerics.ref_update_strain``).
 
-Measurements (``summary.json`` metrics): ``cutting_force_history`` and ``thrust_force_history`` ([t, F], per
-metre of thickness, 400 time bins): the force of the workpiece on the tool along -x (against the cut) and along
-+y (pushing the tool away from the workpiece); their time averages over the second half of the run;
-``max_plastic_strain``, ``max_temperature_K``; ``chip_thickness_mm``: the horizontal width of the material that
-was above the cut line and now lies within one feed above the original surface, next to the rake face (the chip
-rises along the vertical rake face, so its thickness is horizontal there), the median over rows of one spacing.
+Measurements (``summary.json`` metrics, :func:`cutting_metrics`; :func:`analyse_run` recomputes them from a run
+folder):
+
+* ``cutting_force_history``, ``thrust_force_history`` ([t, F], per metre of thickness, 400 time bins): the force of
+  the workpiece on the tool along +x (against the cut; the tool moves along -x) and along +y (pushing the tool
+  away from the workpiece); ``cutting_force_mean_N_per_m``, ``thrust_force_mean_N_per_m``: their time averages
+  over the steady part, taken as the second half of the cut (``STEADY_FROM``);
+* ``chip_thickness_mm``: the horizontal width of the material that was above the cut line and now lies between
+  half a feed and one feed above the original surface, next to the rake face (the chip rises along the vertical
+  rake face, so its thickness is horizontal there), the median over rows of one spacing;
+  ``shear_angle_from_chip_deg``: atan(feed / chip thickness), the shear angle that continuity of a chip of that
+  thickness implies for rake angle 0 (Merchant);
+* ``n_shear_bands``, ``band_spacing_mm`` (along the chip), ``band_spacing_material_mm`` (in the uncut workpiece),
+  ``band_angle_deg`` (to the cutting direction): see :func:`shear_bands`;
+* ``max_plastic_strain``, ``max_temperature_K`` (workpiece), ``cut_length_mm``.
 """
 from __future__ import annotations
 
@@ -294,6 +303,6 @@ def make_scene():
     from .scenes import Scene                               # late import: scenes imports this module
     return Scene(
         "cutting",
-        "orthogonal cutting (PRELIMINARY): AISI 4340 3 x 1 mm, rigid tool 0.5 x 1 mm at 50 m/s (Section 3.3)",
+        "orthogonal cutting: AISI 4340 3 x 1 mm, rigid tool 0.5 x 1 mm at 50 m/s (Section 3.3)",
         _default_dp, _build, _record, _metrics, options=CUTTING_OPTIONS, default_dim=2,
         methods=("esph", "tlsph"), report=cutting_table)

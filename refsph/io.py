@@ -44,7 +44,7 @@ import numpy as np
 from .material import eos_pressure, von_mises
 from .state import FIELD_UNITS, State
 
-__all__ = ["save_snapshot", "load_snapshot", "load_run", "write_json", "save_reactions", "load_reactions",
+__all__ = ["save_snapshot", "load_snapshot", "load_run", "write_json", "json_ready", "save_reactions", "load_reactions",
            "SNAPSHOT_UNITS"]
 
 SNAPSHOT_UNITS = dict(FIELD_UNITS, p="Pa", sigma_vm="Pa", F="1")
@@ -89,21 +89,29 @@ def load_run(directory) -> tuple[dict, list[Path]]:
     return summary, snaps
 
 
-def _default(o):
+def json_ready(o):
+    """``o`` with arrays as lists and non-finite floats (nan, inf) as None, so that the file is strict JSON
+    (``null``), which every JSON reader loads; a measurement that could not be made is null."""
+    if isinstance(o, dict):
+        return {k: json_ready(v) for k, v in o.items()}
+    if isinstance(o, (list, tuple)):
+        return [json_ready(v) for v in o]
     if isinstance(o, np.ndarray):
-        return o.tolist()
-    if isinstance(o, (np.floating, np.integer, np.bool_)):
+        return json_ready(o.tolist())
+    if isinstance(o, (np.floating, float)):
+        return float(o) if np.isfinite(o) else None
+    if isinstance(o, (np.integer, np.bool_)):
         return o.item()
-    raise TypeError(f"not JSON serialisable: {type(o)}")
+    return o
 
 
 def write_json(path, data: dict) -> None:
-    """Write JSON atomically (temporary file, then rename)."""
+    """Write strict JSON (:func:`json_ready`: nan -> null) atomically (temporary file, then rename)."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     tmp = path.with_name(path.name + ".tmp")
     with open(tmp, "w") as f:
-        json.dump(data, f, indent=2, default=_default)
+        json.dump(json_ready(data), f, indent=2, allow_nan=False)
         f.write("\n")
     os.replace(tmp, path)
 

@@ -115,6 +115,20 @@ def simulate(setup: Setup, method: str, *, scene=None, out=None, dt: float | Non
     snap_next = 0
     snapshots = []
 
+    def update_outputs(s):
+        """The summary's run record and the reaction history (and its CSV) as they stand at state s."""
+        wall = time.perf_counter() - t0
+        summary.update(n_steps=n_steps, wall_time_s=wall, cpu_time_s=time.process_time() - c0, t_final=s.t,
+                       dt_min=float(min(dts)) if dts else None, dt_max=float(max(dts)) if dts else None,
+                       particle_steps_per_s=s.n * n_steps / wall if wall > 0 else None,
+                       snapshots=list(snapshots), diagnostics=solver.diagnostics())
+        reactions = solver.reaction_history()
+        if reactions:
+            history["reaction"] = reactions
+            if out is not None:
+                save_reactions(out / "reaction_forces.csv", reactions, s.dim)
+                summary["reaction_forces_file"] = "reaction_forces.csv"
+
     def maybe_snapshot(s, force=False):
         nonlocal snap_next
         while snap_next < len(snap_times) and (s.t >= snap_times[snap_next] * (1 - 1e-12) or force):
@@ -122,6 +136,9 @@ def simulate(setup: Setup, method: str, *, scene=None, out=None, dt: float | Non
                 name = f"snap_{snap_next:05d}.npz"
                 save_snapshot(out / "snapshots" / name, s, setup.material, F_of(s))
                 snapshots.append(name)
+                if 0 < snap_next < len(snap_times) - 1:     # a killed run keeps its record up to here
+                    update_outputs(s)
+                    write_json(out / "summary.json", summary)
             snap_next += 1
             force = False
             if s.t < setup.t_end * (1 - 1e-12):
@@ -143,7 +160,7 @@ def simulate(setup: Setup, method: str, *, scene=None, out=None, dt: float | Non
                    refsph_version=__version__,
                    status="running", metrics={})
 
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), time.process_time()
     last_print = t0
     n_steps = 0
     dts = []
@@ -208,17 +225,7 @@ def simulate(setup: Setup, method: str, *, scene=None, out=None, dt: float | Non
             summary.update(status="error", error=f"{type(e).__name__}: {e}")
         raise
     finally:
-        wall = time.perf_counter() - t0
-        summary.update(n_steps=n_steps, wall_time_s=wall, t_final=state.t,
-                       dt_min=float(min(dts)) if dts else None, dt_max=float(max(dts)) if dts else None,
-                       particle_steps_per_s=state.n * n_steps / wall if wall > 0 else None,
-                       snapshots=snapshots, diagnostics=solver.diagnostics())
-        reactions = solver.reaction_history()
-        if reactions:
-            history["reaction"] = reactions
-            if out is not None:
-                save_reactions(out / "reaction_forces.csv", reactions, state.dim)
-                summary["reaction_forces_file"] = "reaction_forces.csv"
+        update_outputs(state)
         if scene is not None and history and summary["status"] == "ok":
             summary["metrics"] = scene.metrics(history, state, setup)
         if out is not None:

@@ -1,5 +1,8 @@
 """Orthogonal cutting scene (Section 3.3): geometry, the measurements (chip thickness, shear bands) on fields
 with a known answer, coarse runs of both methods, the CLI."""
+import json
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -85,11 +88,24 @@ def test_no_bands_in_a_uniform_field():
     assert shear_bands(X, eps, nx, ny, dp, dp, feed, 2.0e-3)["n"] == 0
 
 
+REGRESSION = Path(__file__).parent / "regression" / "cutting_coarse.json"
+
+
+@pytest.fixture(scope="module")
+def coarse(tmp_path_factory):
+    """dp = 0.05 mm, 0.2 mm of cut, both methods, with output folders."""
+    out = {}
+    for m in ("esph", "tlsph"):
+        d = tmp_path_factory.mktemp(f"cut_{m}")
+        out[m] = (run("cutting", m, dp=0.05e-3, progress=False, out=d, options=dict(travel=0.2e-3)), d)
+    return out
+
+
 @pytest.mark.parametrize("method", ["esph", "tlsph"])
-def test_coarse_smoke_run(method):
-    """dp = 0.05 mm, 0.2 mm of cut: the tool meets a cutting force larger than the flow stress times the feed,
-    the workpiece's momentum balances the impulses of tool and clamps, nothing passes the rake face."""
-    res = run("cutting", method, dp=0.05e-3, progress=False, options=dict(travel=0.2e-3))
+def test_coarse_run(coarse, method):
+    """The tool meets a cutting force larger than the flow stress times the feed, the workpiece's momentum
+    balances the impulses of tool and clamps, nothing passes the rake face."""
+    res = coarse[method][0]
     assert res.summary["status"] == "ok"
     met, s, info = res.summary["metrics"], res.state, res.setup.info
     n = info["n_work"]
@@ -101,6 +117,29 @@ def test_coarse_smoke_run(method):
     face = s.x[n:, 0].min()
     above = s.x[:n, 1] > info["y0"] + info["dy"]
     assert np.all(s.x[:n][above, 0] < face)
+
+
+@pytest.mark.parametrize("method", ["esph", "tlsph"])
+def test_analyse_run_matches_the_run(coarse, method):
+    """Re-measuring a run folder (what benchmarks/cutting.py does) gives the run's own metrics."""
+    res, out = coarse[method]
+    again = analyse_run(out)
+    for k, v in res.summary["metrics"].items():
+        assert np.allclose(np.asarray(again[k], dtype=float), np.asarray(v, dtype=float), rtol=1e-6,
+                           equal_nan=True), k
+    with pytest.raises(FileNotFoundError):
+        analyse_run(out / "nowhere")
+
+
+def test_coarse_regression(coarse):
+    """Same numbers as the stored run (tests/regression/make_regression.py cutting writes the file). ESPH at
+    1e-4; TLSPH's pinball switch amplifies round-off (chapter 07), so its force means at 2 %, the rest at 5 %."""
+    ref = json.loads(REGRESSION.read_text())
+    for m, (res, _) in coarse.items():
+        met = res.summary["metrics"]
+        for k, v in ref[m].items():
+            tol = 1e-4 if m == "esph" else (0.02 if "force" in k else 0.05)
+            assert met[k] == pytest.approx(v, rel=tol), (m, k)
 
 
 def test_cli_option_flags_and_numerics(tmp_path, capsys):

@@ -32,6 +32,26 @@ def test_run_writes_summary_and_snapshots(tmp_path, method):
         assert key in last
 
 
+def test_summary_is_written_at_every_snapshot(tmp_path, monkeypatch):
+    """A run that is killed keeps a summary.json (status 'running') up to its last snapshot."""
+    import refsph.simulate as sim
+    seen = []
+    real = sim.write_json
+
+    def spy(path, data):
+        seen.append((data["status"], data["n_steps"], len(data["snapshots"])))
+        real(path, data)
+
+    monkeypatch.setattr(sim, "write_json", spy)
+    res = run("bar", "tlsph", quick=True, t_end=2e-6, out=tmp_path, progress=False)
+    n_snap = res.setup.n_snapshots
+    running = [x for x in seen if x[0] == "running"]
+    assert len(running) == n_snap - 1                       # at every snapshot but the first and the last
+    assert [x[2] for x in running] == list(range(2, n_snap + 1))
+    assert all(a[1] < b[1] for a, b in zip(running, running[1:]))
+    assert seen[-1][0] == "ok" and json.loads((tmp_path / "summary.json").read_text())["status"] == "ok"
+
+
 def test_nan_stops_and_keeps_last_good(tmp_path):
     out = tmp_path / "bad"
     setup = get_scene("bar").build(2, get_scene("bar").default_dp(2, True), True)

@@ -1,7 +1,8 @@
-"""Writes the regression files of tests/test_taylor.py and tests/test_pressing.py:
+"""Writes the regression files of tests/test_taylor.py, tests/test_pressing.py and tests/test_cutting.py:
 
 * ``taylor_3d_1mm.json``: the quick 3D Taylor run (dp = 1 mm) of both methods;
-* ``pressing_quick.json``: the quick pressing run (dp = 1/60 mm, CFL step) of both methods.
+* ``pressing_quick.json``: the quick pressing run (dp = 1/60 mm, CFL step) of both methods;
+* ``cutting_coarse.json``: the cutting run at dp = 0.05 mm, 0.2 mm of cut, of both methods (tests/test_cutting.py).
 
 Run it only when a change of the numbers is intended (and say why in the commit):
     python tests/regression/make_regression.py            # both
@@ -14,7 +15,7 @@ from pathlib import Path
 from refsph.simulate import run
 
 HERE = Path(__file__).parent
-which = sys.argv[1:] or ["taylor", "pressing"]
+which = sys.argv[1:] or ["taylor", "pressing", "cutting"]
 
 if "taylor" in which:
     out = {}
@@ -36,3 +37,13 @@ if "pressing" in which:
     path = HERE / "pressing_quick.json"
     path.write_text(json.dumps(out, indent=1) + "\n")
     print(path, {m: {k: v for k, v in d.items() if k != "plastic_strain_line_eps_p"} for m, d in out.items()})
+
+if "cutting" in which:
+    out = {}
+    for m in ("esph", "tlsph"):
+        met = run("cutting", m, dp=0.05e-3, progress=False, options=dict(travel=0.2e-3)).summary["metrics"]
+        out[m] = {k: met[k] for k in ("cutting_force_mean_N_per_m", "thrust_force_mean_N_per_m", "max_temperature_K",
+                                      "max_plastic_strain")}
+    path = HERE / "cutting_coarse.json"
+    path.write_text(json.dumps(out, indent=1) + "\n")
+    print(path, out)

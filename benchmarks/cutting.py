@@ -37,6 +37,7 @@ FIG = ROOT / "figures"
 METHODS = ("tlsph", "esph")
 FEEDS = (0.3e-3, 0.5e-3)
 DP_PAPER = 0.01e-3
+BAND_THRESHOLDS = (0.25, 0.5, 1.0)   # the band count's sensitivity to its threshold (the default is 0.5)
 
 
 def dp_tag(dp: float) -> str:
@@ -110,6 +111,12 @@ def record(job):
         rec.update(max_plastic_strain_last_snapshot=float(eps.max()), plastic_strain_p99=float(np.percentile(eps, 99)),
                    temperature_p99_K=float(np.percentile(T, 99)))
     if ok:
+        from refsph.cutting import lattice_shape, shear_bands
+        info = s["scene_info"]
+        x_tip = float(last["x"][n:, 0].min()) - 0.5 * info["dx"]
+        rec["n_shear_bands_by_prominence"] = {
+            f"{rp:g}": shear_bands(last["x"], last["eps_p"], *lattice_shape(info), info["dx"], info["dy"],
+                                   info["feed_m"], x_tip, rel_prominence=rp)["n"] for rp in BAND_THRESHOLDS}
         fc, ft = np.asarray(m["cutting_force_history"]), np.asarray(m["thrust_force_history"])
         q3 = fc[(fc[:, 0] > 0.5 * s["t_end"]) & (fc[:, 0] <= 0.75 * s["t_end"]), 1].mean()
         q4 = fc[fc[:, 0] > 0.75 * s["t_end"], 1].mean()
@@ -336,8 +343,8 @@ def plots(records):
             ax.set_title(f"TLSPH {upd} reference updates ({r['reference_updates']}), cut {50.0 * z['t'] * 1e3:.2f} mm\n"
                          f"max eps_p {z['eps_p'][:r['n_workpiece']].max():.1f}", fontsize=9)
         fig.colorbar(sc, cax=fig.add_axes([0.9, 0.2, 0.015, 0.6]), extend="max", label="effective plastic strain")
-        fig.suptitle("Reduced size (dp = 0.025 mm, feed 0.3 mm): the chip with and without updates of the "
-                     "reference configuration", fontsize=10)
+        fig.suptitle(f"Reduced size (dp = {pair[0]['dp_nominal_mm']:.3g} mm, feed {pair[0]['feed_mm']:g} mm): the chip "
+                     "with and without updates of the reference configuration", fontsize=10)
         fig.savefig(FIG / "08_cutting_reference_updates.png", dpi=120)
         plt.close(fig)
 

@@ -144,7 +144,8 @@ def shear_bands(x: np.ndarray, eps_p: np.ndarray, nx: int, ny: int, dx: float, d
     eps_p that crosses the cut layer (the rows above the cut line y0 = Ly - feed) from the cut line to the free
     surface. Method:
 
-    1. **Profile along the chip**: eps_p(i) on the middle row of the cut layer (the row nearest y0 + feed/2), for
+    1. **Profile along the chip**: eps_p(i) on the middle row of the cut layer (the row whose cell holds
+       y0 + feed/2; where that is a boundary between two rows, an even number of rows, the upper one), for
        the material the tool has reached, i.e. X0_x > x_tip - feed (``x_tip``: the cutting edge's x at this
        instant; the margin of one feed keeps the band now forming at the tool tip, which crosses the middle row
        ahead of the edge). A 3-point running mean removes particle-scale noise.
@@ -168,7 +169,7 @@ def shear_bands(x: np.ndarray, eps_p: np.ndarray, nx: int, ny: int, dx: float, d
     xc = x[: nx * ny].reshape(nx, ny, 2)
     Ly = ny * dy
     j0 = int(math.ceil((Ly - feed) / dy - 0.5 - 1e-9))     # first row above the cut line
-    jm = int(round((Ly - 0.5 * feed) / dy - 0.5))           # middle row of the cut layer
+    jm = int(math.floor((Ly - 0.5 * feed) / dy + 1e-6))     # middle row (with an even count: the one above)
     X = (np.arange(nx) + 0.5) * dx
     cols = np.flatnonzero(X > x_tip - feed)
     empty = dict(n=0, spacing_mm=float("nan"), spacing_material_mm=float("nan"), angle_deg=float("nan"),
@@ -271,6 +272,13 @@ def analyse_run(directory, snapshot: int = -1) -> dict:
                            summary["scene_info"], summary["t_end"])
 
 
+def _cell(value, width: int, fmt: str, scale: float = 1.0) -> str:
+    """A table cell; '-' for a measure that could not be made (nan in memory, null in summary.json)."""
+    if value is None or (isinstance(value, float) and not math.isfinite(value)):
+        return f"{'-':>{width}s}"
+    return f"{value * scale if scale != 1.0 else value:{width}{fmt}}"
+
+
 def cutting_table(summaries: list) -> str:
     """The runs side by side, with what the paper reports (in words; no forces are printed)."""
     from .reference import CUTTING_OBSERVED
@@ -288,12 +296,13 @@ def cutting_table(summaries: list) -> str:
             rows.append(f"{s['method']:7s} {feed:5.2f} (status {s.get('status')}: {s.get('error', '')})")
             continue
         upd = s.get("diagnostics", {}).get("reference_updates")
+        mm = lambda key, width, fmt, scale=1.0: _cell(m.get(key), width, fmt, scale)  # noqa: E731
         rows.append(f"{s['method']:7s} {feed:5.2f} {s['dp'] * 1e6:6.2f} {s['n_particles']:9d} {s['n_steps']:6d} "
                     f"{s['wall_time_s']:7.0f} {'-' if upd is None else upd:>7} "
-                    f"{m['cutting_force_mean_N_per_m'] * 1e-6:9.3f} {m['thrust_force_mean_N_per_m'] * 1e-6:9.3f} "
-                    f"{m['chip_thickness_mm']:8.3f} {m['n_shear_bands']:5d} {m['band_spacing_mm']:11.3f} "
-                    f"{m['band_angle_deg']:10.1f} {CUTTING_OBSERVED['band_angle_deg']:5.0f} "
-                    f"{m['max_plastic_strain']:9.2f} {m['max_temperature_K']:8.0f}")
+                    f"{mm('cutting_force_mean_N_per_m', 9, '.3f', 1e-6)} {mm('thrust_force_mean_N_per_m', 9, '.3f', 1e-6)} "
+                    f"{mm('chip_thickness_mm', 8, '.3f')} {mm('n_shear_bands', 5, 'd')} {mm('band_spacing_mm', 11, '.3f')} "
+                    f"{mm('band_angle_deg', 10, '.1f')} {CUTTING_OBSERVED['band_angle_deg']:5.0f} "
+                    f"{mm('max_plastic_strain', 9, '.2f')} {mm('max_temperature_K', 8, '.0f')}")
     rows.append(f"(Fc, Ft: cutting and thrust force on the tool per unit thickness, means over the last "
                 f"{100 * (1 - STEADY_FROM):.0f} % of the cut; kN per mm = MN/m. Bands: see refsph.cutting.shear_bands)")
     return "\n".join(rows)

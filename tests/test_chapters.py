@@ -30,5 +30,5 @@ def test_chapter_runs_quick(path, tmp_path, monkeypatch):
 
 def test_chapters_exist():
     names = {p.stem for p in CHAPTERS}
-    for stem in ("01_kernel", "02_esph", "03_tlsph", "04_johnson_cook", "05_contact", "06_taylor", "07_pressing"):
+    for stem in ("01_kernel", "02_esph", "03_tlsph", "04_johnson_cook", "05_contact", "06_taylor", "07_pressing", "08_cutting"):
         assert stem in names

@@ -156,3 +156,13 @@ def test_cli_option_flags_and_numerics(tmp_path, capsys):
     assert main(["run", "cutting", "--feed", "--quiet"]) == 2
     assert main(["run", "cutting", "--set", "courant=fast", "--quiet"]) == 2
     assert main(["run", "cutting", "--set", "nothing=1", "--quiet"]) == 2
+
+
+def test_report_reads_summary_files(coarse):
+    """The report table takes summaries as written to summary.json (unmeasurable values are null there)."""
+    from refsph.cutting import cutting_table
+    from refsph.io import load_run
+    summaries = [load_run(out)[0] for _, out in coarse.values()]
+    assert any(v is None for s in summaries for v in s["metrics"].values())   # e.g. no band spacing at 0.2 mm
+    text = cutting_table(summaries)
+    assert "esph" in text and "tlsph" in text and " - " in text

@@ -550,8 +550,6 @@ for key in FEED_RUNS:
           f"(T* = {(T.max() - jc.T_room) / (jc.T_melt - jc.T_room):.2f}) at eps_p {e[np.argmax(T)]:.2f}")
 
 # %% [markdown]
-# <!-- RESULTS: a sentence on what the reduced-size pictures show (chip shape, where the strain gathers, ESPH vs
-# TLSPH) belongs here once the final numbers are in. -->
 # The plastic strain gathers in a zone running from the cutting edge up towards the free surface ahead of the
 # tool, and the cut layer above it turns up along the rake face as a chip. The highest strains and temperatures
 # sit in the few particles pressed against the rake face next to the edge (printed; Section 5). The temperature
@@ -665,8 +663,6 @@ for key in FEED_RUNS:
           f"chip strain gamma/sqrt(3) = {gam / math.sqrt(3):.2f}, dT = {dT_M:.0f} K; {chip_txt}")
 
 # %% [markdown]
-# <!-- RESULTS: one or two sentences comparing Merchant's estimate with the measured force, chip strain and
-# temperature once the final numbers are in. -->
 # Merchant's model is the simplest account of a steady chip: one shear plane, a rigid-plastic material of constant
 # $k$, a flat frictionless rake face. The runs here are short and coarse (in quick mode the chip has barely left
 # the shear zone) and the measured force also contains the tool edge ploughing the new surface and the
@@ -712,7 +708,6 @@ fig.savefig(FIG / "08_band_profiles.png", dpi=110)
 plt.show()
 
 # %% [markdown]
-# <!-- RESULTS: what the reduced-size profiles show (humps or bands, how many) once the final numbers are in. -->
 # At a reduced size the profile along the chip is a few broad humps rather than sharp peaks; how many of them
 # count as bands depends on the threshold (printed above, and Section 5(g)). The bands of the paper-resolution runs
 # are in Section 4.
@@ -900,7 +895,8 @@ if bench is not None:
 # ### Cost: against the 30-minute target
 #
 # The issue asks for 1 mm of cut at the paper's resolution in 30 minutes. Wall times are single-core (the benchmark
-# pins the thread pools to one thread; with `--jobs 2` two runs share the machine):
+# pins the thread pools to one thread; with `--jobs 2` two runs share the machine, and anything else running on it
+# makes the wall time longer); the CPU time, where recorded, is the run's own single-core cost:
 
 # %%
 if bench is not None:
@@ -909,9 +905,12 @@ if bench is not None:
             continue
         w = r["wall_time_s"]
         rate = r["n_particles"] * r["n_steps"] / w
+        cpu = r.get("cpu_time_s")
+        cpu_txt = (f"CPU {cpu / 60:.1f} min = {cpu / TARGET_S:.2f} x the target" if cpu else
+                   "CPU time not recorded (a run made before summary.json had it)")
         print(f"{r['name']:18s}: {r['n_particles']} particles x {r['n_steps']} steps, {r['cut_length_mm']:.2f} mm of cut "
-              f"in {w / 60:.1f} min ({r['status']}) = {w / TARGET_S:.2f} x the target; {1e-3 * rate:.0f} thousand "
-              f"particle-steps/s; dp = {1e3 * r['dp_mm']:.4g} um")
+              f"in {w / 60:.1f} min wall ({r['status']}) = {w / TARGET_S:.2f} x the target, {cpu_txt}; "
+              f"{1e-3 * rate:.0f} thousand particle-steps/s; dp = {1e3 * r['dp_mm']:.4g} um")
     wp = [r for r in bench if "vs_paper" in r]
     if wp:
         print("\ncoarser runs against the paper-resolution run of the same method and feed (work-precision):")

@@ -198,6 +198,7 @@ def _picture(ax, z, dp, field, vmax, cmap="jet", vmin=0.0, xlim=(1.3, 3.6), ylim
 
 def plots(records):
     import matplotlib
+    import matplotlib.ticker
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     from refsph.io import load_snapshot
@@ -326,6 +327,10 @@ def plots(records):
             if p is not None:
                 ax.axvline(_time(p), color=colors[m], ls=":", lw=1, label=f"{m.upper()} at 0.01 mm (reference)")
         ax.set_xlabel("CPU time [s] (one core; wall time where no CPU time was recorded)")
+        for axis in (ax.xaxis, ax.yaxis):
+            axis.set_major_formatter(matplotlib.ticker.FuncFormatter(lambda v, _: f"{v:g}"))
+            axis.set_minor_formatter(matplotlib.ticker.FuncFormatter(
+                lambda v, _: f"{v:g}" if f"{v:.0e}"[0] in "25" else ""))
         ax.set_ylabel("|difference to dp = 0.01 mm| [%]")
         ax.set_title(f"{label}, feed 0.3 mm, 1 mm of cut", fontsize=10)
         ax.grid(alpha=0.3, which="both")
@@ -333,21 +338,32 @@ def plots(records):
     fig.savefig(FIG / "08_cutting_work_precision.png", dpi=120)
     plt.close(fig)
 
-    # TLSPH with and without reference-configuration updates (reduced size)
+    # TLSPH with and without reference-configuration updates (reduced size): both at the same cut length, and the
+    # run without updates at its end (its last good state if it failed)
     pair = [by.get("coarse-tlsph-f0.3-25um"), by.get("noupdate-tlsph-f0.3-25um")]
     if all(pair):
-        fig = plt.figure(figsize=(10, 4.8))
-        axs = fig.subplots(1, 2, gridspec_kw=dict(left=0.06, right=0.88, bottom=0.1, top=0.85, wspace=0.12))
-        for ax, r in zip(axs, pair):
-            _, snaps = load(r["name"])
-            k = 4 if r["name"].startswith("coarse") else -1          # both at 0.5 mm of cut
-            z = load_snapshot(snaps[k])
-            sc = _picture(ax, z, r["dp_mm"] * 1e-3, "eps_p", 3.0, xlim=(1.7, 3.4), ylim=(0.3, 1.9))
-            upd = "with" if r["ref_update_strain"] is not None else "without"
-            ax.set_title(f"TLSPH {upd} reference updates ({r['reference_updates']}), cut {50.0 * z['t'] * 1e3:.2f} mm\n"
-                         f"max eps_p {z['eps_p'][:r['n_workpiece']].max():.1f}", fontsize=9)
-        fig.colorbar(sc, cax=fig.add_axes([0.9, 0.2, 0.015, 0.6]), extend="max", label="effective plastic strain")
-        fig.suptitle(f"Reduced size (dp = {pair[0]['dp_nominal_mm']:.3g} mm, feed {pair[0]['feed_mm']:g} mm): the chip "
+        with_upd, without = pair
+        (_, snaps_w), (_, snaps_n) = load(with_upd["name"]), load(without["name"])
+        last = RUNS / without["name"] / "snapshots" / "last_good.npz"
+        z_end = load_snapshot(last if without["status"] != "ok" and last.exists() else snaps_n[-1])
+        z_n = [load_snapshot(p) for p in snaps_n]
+        z_w = [load_snapshot(p) for p in snaps_w]
+        near = 1e-8                 # snapshots land on the first step past their time: equal within 10 ns
+        t_common = max(z["t"] for z in z_n if any(abs(z["t"] - w["t"]) < near for w in z_w))
+        panels = [(with_upd, next(z for z in z_w if abs(z["t"] - t_common) < near), "with"),
+                  (without, next(z for z in z_n if abs(z["t"] - t_common) < near), "without"),
+                  (without, z_end, "without")]
+        fig = plt.figure(figsize=(14, 4.8))
+        axs = fig.subplots(1, 3, gridspec_kw=dict(left=0.05, right=0.9, bottom=0.1, top=0.8, wspace=0.12))
+        for ax, (r, z, upd) in zip(axs, panels):
+            sc = _picture(ax, z, r["dp_mm"] * 1e-3, "eps_p", 3.0, xlim=(1.9, 3.4), ylim=(0.3, 1.6))
+            end = ""
+            if z is z_end and r["status"] != "ok":
+                end = f" (last good state: the run stopped, {r['status']})"
+            ax.set_title(f"TLSPH {upd} reference updates ({r['reference_updates']}),\ncut {50.0 * z['t'] * 1e3:.3f} mm"
+                         f"{end}, max eps_p {z['eps_p'][:r['n_workpiece']].max():.1f}", fontsize=8)
+        fig.colorbar(sc, cax=fig.add_axes([0.92, 0.2, 0.012, 0.55]), extend="max", label="effective plastic strain")
+        fig.suptitle(f"Reduced size (dp = {with_upd['dp_nominal_mm']:.3g} mm, feed {with_upd['feed_mm']:g} mm): the chip "
                      "with and without updates of the reference configuration", fontsize=10)
         fig.savefig(FIG / "08_cutting_reference_updates.png", dpi=120)
         plt.close(fig)

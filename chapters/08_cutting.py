@@ -781,7 +781,10 @@ if KU in res and KN in res:
               f"{d['max_pinball_penetration_m'] / DP:.2f} dp; Fc over the 2nd half {1e-6 * res[key].summary['metrics']['cutting_force_mean_N_per_m']:.3f} MN/m")
 
 # %% [markdown]
-# <!-- RESULTS: the paper-resolution no-update run (benchmarks: noupdate-tlsph-f0.3-25um), one sentence. -->
+# The benchmark repeats this comparison at dp = 0.025 mm over 0.5 mm of cut (`noupdate-tlsph-f0.3-25um`, its
+# figure in Section 4). There the run without updates is lost: it stops with non-finite positions (its status and
+# error are in the Section 4 table), and its last good state shows the chip root torn apart, particles thrown out of
+# the workpiece and through the tool's surface layers. With updates the same run cuts the whole millimetre.
 # With updates the reference configuration is replaced every time max |E| passes 0.5 (the number of updates is
 # printed above, and in the `upd` column of Section 4), and pairs that have moved apart beyond the kernel's support drop out of each
 # other's sums: the chip separates from the workpiece along the cut line. Without updates the two runs are alike
@@ -855,8 +858,12 @@ else:
           "--plot-only redraws from runs/benchmarks/cutting/). Section 4 is skipped.")
 
 # %% [markdown]
-# <!-- RESULTS: two or three sentences on the paper-resolution table (forces, chip thickness and shear angle,
-# band counts and angles against the paper's 45 deg, ESPH against TLSPH, drift = how steady the force is). -->
+# Read the table this way. Both methods form a continuous chip with shear bands at the paper's spacing, and the
+# force has settled in the second half of the cut (`drift`). The chip is thicker than the feed, so the shear angle
+# it implies (`phi_c`) is below Merchant's 45°; the fitted band angles scatter around the paper's "approximately
+# 45°", mostly below it. ESPH's thrust force is of the order of its cutting force, TLSPH's a fraction of it
+# (Section 5(d)): the ESPH tool is not frictionless. The largest plastic strains and temperatures are the rake-face
+# particles at the edge (Section 5(c)); the 99th percentile is the number to compare.
 #
 # ### The paper's trend: a deeper feed
 #
@@ -890,7 +897,9 @@ if bench is not None:
     trend("coarse-", "-25um")
 
 # %% [markdown]
-# <!-- RESULTS: does the trend hold per method (force, band count, spacing)? One or two sentences. -->
+# At the paper's spacing TLSPH shows the paper's whole trend (larger force, fewer bands, wider spacing); ESPH shows
+# the larger force and the wider spacing but, with this band measure, not fewer bands. The 25-µm runs are too coarse
+# to resolve more than one or two bands (Section 5(g)), so their counts say little.
 #
 # ### Cost: against the 30-minute target
 #
@@ -921,7 +930,12 @@ if bench is not None:
                   f"chip thickness {f_(100 * val(d, 'chip_thickness_rel'), '+.1f', 1)} %")
 
 # %% [markdown]
-# <!-- RESULTS: the time against the 30-minute target, and what the coarse runs cost against what they miss. -->
+# The target is missed. TLSPH is near it: its wall time above was taken with three to four runs sharing the two
+# cores, and its CPU time (read from `/proc` while it ran; these runs predate the `cpu_time_s` field) was a little
+# over 30 minutes. ESPH costs more than twice the target: its Verlet list (skin 0.3 h, h = 1.8 dp) holds more pairs
+# than TLSPH's fixed operator, and it evaluates the kernel on all of them at every stage. The coarse runs cost a
+# few per cent of a paper-resolution run and get the forces within the percentages printed above; what they miss
+# is the bands (too few particles across a band) and the chip's finer shape.
 #
 # ### The benchmark's figures
 #
@@ -956,8 +970,10 @@ for path in BENCH_FIGS:
     print(f"{rel(path)}: {'present' if path.exists() else 'not there yet (made by python benchmarks/cutting.py)'}")
 
 # %% [markdown]
-# <!-- RESULTS: how to read the benchmark figures: chip shape and segmentation against the paper's description,
-# ESPH against TLSPH, the temperature, the force history, the band profiles. -->
+# In the figures: the chip rises along the rake face and curls away from it; the primary shear zone runs from the
+# cutting edge up to the free surface ahead of the tool; older bands are carried up into the chip and rotate with
+# it. TLSPH's bands are thin and distinct, ESPH's broader (as the paper says). The temperature follows the plastic
+# strain (adiabatic heating). The band profiles show how the count is made.
 
 # %% [markdown]
 # ## 5. Where it fails, and what deviates
@@ -1020,7 +1036,8 @@ if bench is not None:
         print(f"(the paper-resolution runs' snapshots are not in {rel(RUNS_BENCH)} here: only this chapter's runs)")
 
 # %% [markdown]
-# <!-- RESULTS: which method opens more gaps at the paper's spacing (numbers above). -->
+# The counts at the paper's spacing, where the snapshots are available, are printed above; quick mode has only
+# this chapter's reduced-size runs.
 # Stretched bonds are the lamellae of the chip pulled apart where it bends; broken bonds are material separation
 # inside the chip, which a continuous chip should not have. Compare the methods on the printed shares, not on the
 # pictures alone.
@@ -1096,8 +1113,8 @@ for name, (r, z) in bench_final.items():
           f"{z['v'][:n][outer, 1].mean() if outer.any() else float('nan'):.1f} m/s")
 
 # %% [markdown]
-# <!-- RESULTS: does the ESPH chip slide slower along the rake face than TLSPH's at the paper's spacing (numbers
-# above)? One sentence. -->
+# At the paper's spacing the clearest measure of the ESPH tool's drag is the thrust: Ft/Fc printed above, several
+# times TLSPH's (README, cutting results).
 # The thrust-to-cutting-force ratio is a measure of how far each method's tool is from the frictionless one the
 # paper assumes (Merchant: 0); a chip that slides up the rake face more slowly than the chip further out is being
 # held back at the face, one that slides faster is not.
@@ -1185,7 +1202,6 @@ if bench is not None:
         print(f"  {r['name']:26s}: {counts} (JSON: {f_(r.get('n_shear_bands'), 'd', 1)} at {BAND_REL_PROMINENCE}{extra})")
 
 # %% [markdown]
-# <!-- RESULTS: how sensitive the paper-resolution band counts are to the threshold (numbers above). -->
 # Where the count changes little between thresholds, the bands are distinct peaks; where it changes a lot, they are
 # humps and ripples, and the count is the threshold's as much as the simulation's. The band angle has the same
 # limitation at a coarse spacing: a band a few particles wide, tracked over a cut layer a few rows deep, fits a

@@ -1,6 +1,6 @@
 """Orthogonal cutting benchmark (Section 3.3 of Islam, Bansal & Peng): both feeds, both methods.
 
-    python benchmarks/cutting.py --jobs 2          # all runs, two at a time (about 3 hours of CPU, see below)
+    python benchmarks/cutting.py --jobs 2          # all runs, two at a time (about 4 hours of CPU, 2 on 2 cores)
     python benchmarks/cutting.py --only paper-     # only the jobs whose name contains 'paper-'
     python benchmarks/cutting.py --plot-only       # JSON, table and figures again from runs/benchmarks/cutting/
 

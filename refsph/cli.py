@@ -7,7 +7,7 @@ import sys
 
 import numpy as np
 
-from .scenes import SCENES, Numerics
+from .scenes import SCENES, Numerics, parse_bool
 from .simulate import METHODS, SimulationError, run
 
 
@@ -141,9 +141,7 @@ def _parse_numerics(items) -> dict:
         if value.lower() == "none" and name in optional:
             out[name] = None
         elif isinstance(d, bool):
-            if value.lower() not in ("true", "false", "1", "0", "yes", "no"):
-                raise ValueError(f"--set {name} must be true or false, got {value!r}")
-            out[name] = value.lower() in ("true", "1", "yes")
+            out[name] = parse_bool(value, f"--set {name}")
         elif isinstance(d, str):
             out[name] = value
         else:

@@ -41,7 +41,7 @@ from pathlib import Path
 import numpy as np
 
 from .boundaries import Clamp, RigidBody
-from .pressing import _binned, _time_mean, pressing_johnson_cook, pressing_material
+from .pressing import _binned, _time_mean, block_lattice, pressing_johnson_cook, pressing_material
 from .state import concatenate_states, make_state
 
 __all__ = ["make_scene", "cutting_particles", "CUTTING_GEOMETRY", "TOOL_BODY"]
@@ -72,9 +72,8 @@ def cutting_particles(dp: float, feed: float, n_tool_layers: int):
     dx, dy = Lx / nx, Ly / ny
     if not (2 * dy <= feed <= Ly - 2 * dy):
         raise ValueError(f"feed must lie between two spacings and the workpiece depth less two spacings, got {feed!r}")
-    i, j = np.meshgrid(np.arange(nx), np.arange(ny), indexing="ij")
-    xw = np.stack([(i.ravel() + 0.5) * dx, (j.ravel() + 0.5) * dy], axis=1)
-    clamp = np.flatnonzero((i.ravel() == 0) | (j.ravel() == 0))
+    xw, i, j = block_lattice(nx, ny, dx, dy)
+    clamp = np.flatnonzero((i == 0) | (j == 0))
     y0 = Ly - feed
     ti, tj = np.meshgrid(np.arange(round(Wt / dx)), np.arange(round(Ht / dy)), indexing="ij")
     surface = (ti.ravel() < n_tool_layers) | (tj.ravel() < n_tool_layers)
@@ -225,8 +224,7 @@ def cutting_metrics(reaction: dict, x: np.ndarray, eps_p: np.ndarray, T: np.ndar
     _, tb_ = _binned(t_r, dt, Ft, t_end, nb)
     x_tip = float(x[n:, 0].min()) - 0.5 * info["dx"]     # the rake face (and the cutting edge) at time t
     nx, ny = lattice_shape(info)
-    X0 = np.stack(np.meshgrid((np.arange(nx) + 0.5) * info["dx"], (np.arange(ny) + 0.5) * info["dy"],
-                              indexing="ij"), axis=-1).reshape(-1, 2)   # initial positions (the lattice)
+    X0 = block_lattice(nx, ny, info["dx"], info["dy"])[0]          # initial positions (the lattice)
     Ly = CUTTING_GEOMETRY["workpiece_m"][1]
     feed = info["feed_m"]
     bands = shear_bands(x, eps_p, nx, ny, info["dx"], info["dy"], feed, x_tip)

@@ -75,6 +75,14 @@ def pressing_johnson_cook(eps_dot_0: float) -> JohnsonCook:
                        hardening_saturation_strain=None)
 
 
+def block_lattice(nx: int, ny: int, dx: float, dy: float):
+    """Cell centres ((i + 1/2) dx, (j + 1/2) dy) of an nx x ny block, particle k = i ny + j (column i, row j),
+    with the (i, j) of every particle: the layout of the pressing block and of the cutting workpiece."""
+    i, j = np.meshgrid(np.arange(nx), np.arange(ny), indexing="ij")
+    i, j = i.ravel(), j.ravel()
+    return np.stack([(i + 0.5) * dx, (j + 0.5) * dy], axis=1), i, j
+
+
 def pressing_particles(dp: float, n_tool_layers: int):
     """Block and tool particle centres: (x_block, x_tool, dx, dy, clamp index, mid-height row index)."""
     (Lx, Ly), (_, Ht) = PRESSING_GEOMETRY["block_m"], PRESSING_GEOMETRY["tool_m"]
@@ -82,11 +90,10 @@ def pressing_particles(dp: float, n_tool_layers: int):
     if nx < 4 or ny < 4:
         raise ValueError(f"spacing dp = {dp!r} m is too coarse for a {Lx * 1e3} x {Ly * 1e3} mm block")
     dx, dy = Lx / nx, Ly / ny
-    i, j = np.meshgrid(np.arange(nx), np.arange(ny), indexing="ij")
-    xb = np.stack([(i.ravel() + 0.5) * dx, (j.ravel() + 0.5) * dy], axis=1)
-    clamp = np.flatnonzero(i.ravel() == 0)
+    xb, i, j = block_lattice(nx, ny, dx, dy)
+    clamp = np.flatnonzero(i == 0)
     j_mid = int(np.argmin(np.abs((np.arange(ny) + 0.5) * dy - 0.5 * Ly)))
-    line = np.flatnonzero(j.ravel() == j_mid)
+    line = np.flatnonzero(j == j_mid)
     nt = round(Ht / dy)
     ti, tj = np.meshgrid(np.arange(n_tool_layers), np.arange(nt), indexing="ij")
     xt = np.stack([Lx + (ti.ravel() + 0.5) * dx, 0.5 * Ly + (tj.ravel() - 0.5 * (nt - 1)) * dy], axis=1)

@@ -102,6 +102,15 @@ class Scene:
 _TRUE, _FALSE = ("true", "1", "yes"), ("false", "0", "no")
 
 
+def parse_bool(value, what: str) -> bool:
+    """A boolean, or its spelling true/false/1/0/yes/no (any case); ``what`` names it in the error."""
+    if isinstance(value, str) and value.lower() in _TRUE + _FALSE:
+        return value.lower() in _TRUE
+    if isinstance(value, (bool, np.bool_)):
+        return bool(value)
+    raise ValueError(f"{what} must be true or false, got {value!r}")
+
+
 def convert_options(scene: Scene, options: dict) -> dict:
     """Check a scene's options and convert each value like its default (strings from the command line
     included): booleans from true/false/1/0/yes/no, numbers with float(). Unknown names are refused."""
@@ -112,11 +121,7 @@ def convert_options(scene: Scene, options: dict) -> dict:
             raise ValueError(f"unknown option {name!r} for scene {scene.name!r} (known: {known})")
         default = scene.options[name][0]
         if isinstance(default, bool):
-            if isinstance(value, str) and value.lower() in _TRUE + _FALSE:
-                value = value.lower() in _TRUE
-            if not isinstance(value, (bool, np.bool_)):
-                raise ValueError(f"option {name} must be true or false, got {value!r}")
-            out[name] = bool(value)
+            out[name] = parse_bool(value, f"option {name}")
         elif isinstance(default, (int, float)):
             try:
                 out[name] = float(value)

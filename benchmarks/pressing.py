@@ -77,7 +77,7 @@ def run_job(job):
     t0 = time.perf_counter()
     out = RUNS / job["name"]
     res = run("pressing", job["method"], dp=job["dp"], dt=job["dt"], out=out, progress=False,
-              numerics=job["numerics"])
+              numerics=dict(job["numerics"] or {}, threads=job["threads"]))
     snaps = sorted((out / "snapshots").glob("snap_*.npz"))
     for p in snaps[:-1]:                                   # keep the final snapshot only
         p.unlink()
@@ -326,12 +326,13 @@ def main(argv=None):
     jobs = job_list()
     todo = [j for j in jobs if args.only is None or args.only in j["name"]]
     if not args.plot_only:
+        from refsph.neighbours import threads_per_job      # all cores for --jobs 1, one each for --jobs 2
         todo.sort(key=lambda j: (j["dp"], j["dt"] is None))      # longest first
         # a fresh process for every run: a worker that ran a large run before starts the next one with a grown
         # heap and runs it faster (glibc returns freed memory to the OS only at the top of the heap), so reused
         # workers would make the wall times depend on the order of the runs
         with ProcessPoolExecutor(max_workers=args.jobs, max_tasks_per_child=1) as ex:
-            list(ex.map(run_job, todo))
+            list(ex.map(run_job, [dict(j, threads=threads_per_job(args.jobs)) for j in todo]))
     have = [j for j in jobs if (RUNS / j["name"] / "summary.json").exists()]
     records = add_differences([record(j) for j in have])
     write_json(records)

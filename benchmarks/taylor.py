@@ -58,7 +58,7 @@ def run_job(job):
     from refsph.simulate import run
     t0 = time.perf_counter()
     res = run("taylor", job["method"], dim=3, dp=job["dp"], dt=job["dt"], out=RUNS / job["name"], progress=False,
-              options=dict(T_melt=job["T_melt"]), numerics=job.get("numerics"))
+              options=dict(T_melt=job["T_melt"]), numerics=dict(job.get("numerics") or {}, threads=job["threads"]))
     s = res.summary
     print(f"{job['name']}: {time.perf_counter() - t0:.0f} s, L = {s['metrics']['final_length_mm']:.2f} mm, "
           f"D = {s['metrics']['final_diameter_mm']:.2f} mm", flush=True)
@@ -188,9 +188,10 @@ def main(argv=None):
     if args.only:
         jobs = [j for j in jobs if args.only in j["name"]]
     if not args.plot_only:
+        from refsph.neighbours import threads_per_job      # all cores for --jobs 1, one each for --jobs 2
         jobs.sort(key=lambda j: (j["dp"], j["dt"] is None))       # longest first
         with ProcessPoolExecutor(max_workers=args.jobs) as ex:
-            list(ex.map(run_job, jobs))
+            list(ex.map(run_job, [dict(j, threads=threads_per_job(args.jobs)) for j in jobs]))
     # every run that exists (the 0.375 mm ones too, if an earlier call made them with --finest)
     names = [j["name"] for j in job_list(args.finest or 0.375e-3) if (RUNS / j["name"] / "summary.json").exists()]
     records = [record(n) for n in names]

@@ -53,7 +53,7 @@ def block_setup(n_side: int, dp: float = 1.0e-4, v_rms: float = 1.0, seed: int =
     x = lattice([n_side * dp, n_side * dp], dp)
     v = v_rms * np.random.default_rng(seed).standard_normal(x.shape)
     state = make_state(x, v, mat.rho0, dp * dp)
-    return Setup(state=state, material=mat, dp=dp, numerics=Numerics(), t_end=1.0, n_snapshots=0)
+    return Setup(state=state, material=mat, dp=dp, numerics=Numerics(threads=1), t_end=1.0, n_snapshots=0)
 
 
 def half_pairs_within_support(setup: Setup) -> int:
@@ -121,14 +121,23 @@ def main(argv=None) -> list[dict]:
             print(f"{method:6s} {n:9d} {r['pairs_per_particle']:10.2f} {steps:5d} "
                   f"{r['particle_steps_per_s']:16.3e} {r['ns_per_pair_step']:12.1f} {r['wall_s']:7.3f} "
                   f"{r['cpu_s']:7.3f} {r['setup_s']:7.3f}", flush=True)
-    meta = dict(refsph=refsph.__version__, numpy=np.__version__, scipy=scipy.__version__,
-                python=platform.python_version(), machine=platform.machine(), threads=1,
-                pair_definition="half pair (i < j) with |x_i - x_j| < 2h in the initial lattice",
-                timing="best of `repeats` repetitions of `steps` predictor-corrector steps, after one warm-up "
-                       "step; particle_steps_per_s and ns_per_pair_step from the wall time")
-    args.json.write_text(json.dumps(dict(meta=meta, results=results), indent=2) + "\n")
-    print(f"\nwritten {args.json}")
+    write_results(args.json, results, threads=1,
+                  pair_definition="half pair (i < j) with |x_i - x_j| < 2h in the initial lattice",
+                  timing="best of `repeats` repetitions of `steps` predictor-corrector steps, after one warm-up "
+                         "step; particle_steps_per_s and ns_per_pair_step from the wall time")
     return results
+
+
+def software() -> dict:
+    """Versions and machine, for the record of a timing."""
+    return dict(refsph=refsph.__version__, numpy=np.__version__, scipy=scipy.__version__,
+                python=platform.python_version(), machine=platform.machine(), cores=os.cpu_count())
+
+
+def write_results(path: Path, results: list, **meta) -> None:
+    """{meta: software() + meta, results} as JSON at path."""
+    path.write_text(json.dumps(dict(meta=dict(software(), **meta), results=results), indent=2) + "\n")
+    print(f"\nwritten {path}")
 
 
 if __name__ == "__main__":

@@ -245,6 +245,27 @@ print(f"|sum_i m_i dv_i/dt| / sum_i |m_i dv_i/dt| = {mom_err:.1e}")
 assert mom_err < 1e-12
 
 # %% [markdown]
+# **How the package lays the work out.** At the paper's cutting resolution a rate evaluation has 0.5–0.8 million
+# half pairs, and NumPy computes each of the pair quantities above ($\mathbf x_{ij}$, $r$, $W$, $\nabla W$,
+# $\pi_{ij}$, ...) as a whole array. An array that size does not fit in the CPU's cache, so every operation
+# streams it from memory. `refsph.neighbours.PairBlocks` cuts the pair list into blocks of `PAIR_BLOCK` pairs
+# (1 MB per array), computes every pair quantity and every sum one block at a time, and adds the blocks'
+# per-particle sums up in block order. The arithmetic is the same; only the order in which the sums are added
+# changes, by round-off. Blocks are independent, so two threads can take them. The blocks depend only on the pair
+# list, never on the thread count, so a run gives the same bits on one core or two
+# (`benchmarks/pair_blocks.py` measures what this buys):
+
+# %%
+from refsph.neighbours import PairBlocks  # noqa: E402
+
+one_thread = esph_rates(st_r, mat, prm_r, I_r, J_r, pairs=PairBlocks(I_r, J_r, st_r.n, size=200, threads=1))
+two_threads = esph_rates(st_r, mat, prm_r, I_r, J_r, pairs=PairBlocks(I_r, J_r, st_r.n, size=200, threads=2))
+assert all(np.array_equal(getattr(one_thread, f), getattr(two_threads, f)) for f in ("rho", "v", "S", "S_zz"))
+blk_err = np.abs(one_thread.v - rates.v).max() / np.abs(rates.v).max()
+print(f"{len(I_r)} pairs in blocks of 200: 1 thread == 2 threads bit for bit; against one block: {blk_err:.1e}")
+assert blk_err < 1e-12
+
+# %% [markdown]
 # ## 2. Patch test: the velocity gradient of a linear velocity field
 #
 # Take $\mathbf v = \mathbf A\mathbf x$. Then $\mathbf v_{ij} = \mathbf A\mathbf x_{ij}$, and Eq. (23) gives

@@ -144,6 +144,11 @@ def _parse_numerics(items) -> dict:
             out[name] = parse_bool(value, f"--set {name}")
         elif isinstance(d, str):
             out[name] = value
+        elif isinstance(d, int):
+            try:
+                out[name] = int(value)
+            except ValueError:
+                raise ValueError(f"--set {name} must be a whole number, got {value!r}") from None
         else:
             try:
                 out[name] = float(value)

@@ -14,7 +14,7 @@ Model, and the choices the paper leaves open (its Fig. 11 is not in the text we 
 * **Cut length** (not printed): option ``travel``, 1 mm by default (t_end = 20 us), a third of the workpiece.
 
 Numerics: Table 5 (dp = 0.01 mm, h = 0.018 mm: h/dp = 1.8, beta1 = beta2 = 0.5), ESPH gamma = 0.3, CFL step with
-Courant 0.3 (the paper's fixed 1e-10 s is 9x smaller), ESPH Verlet skin 0.3 h; TLSPH reference updates at
+Courant 0.3 (the paper's fixed 1e-10 s is 9x smaller), ESPH Verlet skin 0.15 h; TLSPH reference updates at
 max |E| > 0.5 (``Numerics.ref_update_strain``).
 
 Measurements (``summary.json`` metrics, :func:`cutting_metrics`; :func:`analyse_run` recomputes them from a run
@@ -93,7 +93,7 @@ def _build(dim, dp, quick, feed=CUTTING_OPTIONS["feed"][0], travel=CUTTING_OPTIO
         raise ValueError(f"travel must lie in (0, 2 mm], got {travel!r} m")
     g = CUTTING_GEOMETRY
     numerics = Numerics(h_over_dp=g["smoothing_length_m"] / g["particle_spacing_m"], beta1=g["beta1"],
-                        beta2=g["beta2"], gamma=0.3, skin_factor=0.3)
+                        beta2=g["beta2"], gamma=0.3, skin_factor=0.15)
     layers = math.ceil(2.0 * numerics.h_over_dp - 1e-9)
     xw, xt, dx, dy, clamp, y0 = cutting_particles(dp, float(feed), layers)
     mat = pressing_material()                           # Table 3 (the same AISI 4340 as the pressing)

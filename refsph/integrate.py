@@ -22,7 +22,7 @@ import numpy as np
 
 from .esph import ESPHParams, Rates, esph_rates
 from .material import ElasticMaterial
-from .neighbours import PairSum, VerletList
+from .neighbours import PairBlocks, VerletList
 from .state import State
 from .tensor import det
 from .boundaries import Ghosts, MirrorPlanes
@@ -221,11 +221,12 @@ class ESPHSolver(_Solver):
 
     def __init__(self, material: ElasticMaterial, params: ESPHParams, skin_factor: float, *,
                  plasticity: JohnsonCook | None = None, mirror: MirrorPlanes | None = None, walls=(),
-                 rigid=(), clamps=()):
+                 rigid=(), clamps=(), threads: int = 1):
         self._init_common(material, plasticity, mirror, walls, rigid, clamps)
         self.params = params
+        self.threads = _check_threads(threads)
         self.pairs = VerletList(params.kernel.support * params.h, skin_factor * params.h)
-        self._pair_sum: PairSum | None = None              # sparse pattern of the current pair list
+        self._pair_sum: PairBlocks | None = None           # blocks and sparse patterns of the current pair list
         self._pair_sum_build = -1
         self._ghosts: Ghosts | None = None
         self._ghost_constant: tuple | None = None          # extended (m, X, V0) of the current ghosts
@@ -253,7 +254,10 @@ class ESPHSolver(_Solver):
             self._bind_bodies(state)
         (I, J), ext = self._pairs_and_state(state)
         if self._pair_sum_build != self.pairs.n_builds:
-            self._pair_sum, self._pair_sum_build = PairSum(I, J, ext.n), self.pairs.n_builds
+            if self._pair_sum is not None:
+                self._pair_sum.close()
+            self._pair_sum = PairBlocks(I, J, ext.n, threads=self.threads)
+            self._pair_sum_build = self.pairs.n_builds
         r = esph_rates(ext, self.material, self.params, I, J, pairs=self._pair_sum)
         r = r if ext is state else self._real_rows(r, state.n)
         return self._constrain(state, r)
@@ -281,8 +285,9 @@ class TLSPHSolver(_Solver):
 
     def __init__(self, material: ElasticMaterial, params: TLSPHParams, *, plasticity: JohnsonCook | None = None,
                  mirror: MirrorPlanes | None = None, walls=(), rigid=(), clamps=(),
-                 contact: PinballContact | None = None, dp: float | None = None):
+                 contact: PinballContact | None = None, dp: float | None = None, threads: int = 1):
         self._init_common(material, plasticity, mirror, walls, rigid, clamps)
+        self.threads = _check_threads(threads)
         if self.rigid and contact is None:
             raise ValueError("TLSPH with rigid bodies needs a contact model (PinballContact)")
         if contact is not None and not (dp is not None and dp > 0):
@@ -305,12 +310,12 @@ class TLSPHSolver(_Solver):
         if self.op is None:
             p = self.params
             if self.mirror is None:
-                self.op = ReferenceOperator(state.X, state.V0, p.h, p.kernel, p.corrected)
+                self.op = ReferenceOperator(state.X, state.V0, p.h, p.kernel, p.corrected, threads=self.threads)
             else:
                 g = self.mirror.ghosts(state.X, p.kernel.support * p.h)
                 self._ghost_constant = g.extend_constant(state)   # m, X, V0: fixed with the operator
                 _, X, V0 = self._ghost_constant
-                self.op = ReferenceOperator(X, V0, p.h, p.kernel, p.corrected, ghosts=g)
+                self.op = ReferenceOperator(X, V0, p.h, p.kernel, p.corrected, ghosts=g, threads=self.threads)
         return self.op
 
     def _extended(self, state: State, op: ReferenceOperator) -> State:
@@ -407,6 +412,7 @@ class TLSPHSolver(_Solver):
         thr = self.params.ref_update_strain
         if thr is not None and float(np.max(green_lagrange_norm(F))) > thr:
             state = reset_reference(state, self._with_identity(F, state))
+            self.op.pairs.close()
             self.op = None
             self.operator(self._deformable(state))
             self.n_reference_updates += 1
@@ -433,6 +439,12 @@ class TLSPHSolver(_Solver):
             out["pinball_contacts_last_step"] = self.n_contacts
         out.update(self._common_diagnostics())
         return out
+
+
+def _check_threads(threads) -> int:
+    if isinstance(threads, bool) or not isinstance(threads, (int, np.integer)) or threads < 1:
+        raise ValueError(f"threads must be a whole number >= 1, got {threads!r}")
+    return int(threads)
 
 
 def _advance(state: State, rates: Rates, dt: float, evolved) -> State:

@@ -12,14 +12,31 @@ That halves the arithmetic and makes pairwise-antisymmetric forces conserve mome
 * :func:`scatter_add` -- sums over pairs onto particles as ``np.bincount``.
 * :class:`PairSum` -- the sums that SPH needs most, "add w_j t_ij to i and +-w_i t_ij to j", as two sparse
   matrix-vector products whose stored values are the pair values t themselves (no gathers, no bincount).
+* :class:`PairBlocks` -- a pair list cut into blocks of consecutive pairs, each with its own PairSum, so that a
+  rate evaluation works on arrays that fit in the CPU cache (and can run blocks on several threads).
+
+Why blocks. A pair array at the paper's cutting resolution has 0.5-0.8 million numbers (4-7 MB). Every NumPy
+operation on it streams it from main memory, and every temporary of that size is a fresh allocation whose
+pages the kernel must fault in and zero. Cut into blocks of ``PAIR_BLOCK`` pairs (1 MB per array; the dozen or
+so arrays of one block's evaluation stay in the CPU's caches) the same operations reuse cached, already
+mapped memory: ESPH's rate evaluation at the paper's cutting resolution is 1.5x faster on one core
+(``benchmarks/pair_blocks.py``). The block
+layout depends only on the pair list, never on the number of threads, and per-block results are added in
+block order, so a run gives the same bits on any number of threads (``tests/test_neighbours.py``,
+``tests/test_driver.py``).
 """
 from __future__ import annotations
+
+import os
 
 import numpy as np
 import scipy.sparse as sp
 from scipy.spatial import cKDTree
 
-__all__ = ["find_pairs", "VerletList", "scatter_add", "pair_count_per_particle", "PairSum"]
+__all__ = ["find_pairs", "VerletList", "scatter_add", "pair_count_per_particle", "PairSum", "PairBlocks",
+           "PAIR_BLOCK", "available_cores", "threads_per_job"]
+
+PAIR_BLOCK = 2**17        # pairs per block of a PairBlocks: 1 MB per float array (benchmarks/pair_blocks.py)
 
 
 def find_pairs(x: np.ndarray, radius: float) -> tuple[np.ndarray, np.ndarray]:
@@ -95,6 +112,95 @@ class PairSum:
         """sum over pairs: w_j t_p into i, -w_i t_p into j."""
         self._values(t)
         return self._U @ w - self._UT @ w
+
+
+class PairBlocks:
+    """Half pairs (I, J) cut into consecutive blocks of at most ``size`` pairs (None: ``PAIR_BLOCK``).
+
+    A block covers the particles ``window = slice(lo, hi)`` that its pairs touch (lo = its smallest index,
+    hi - 1 its largest); its :class:`PairSum` ``sums`` works on local indices I - lo, J - lo, i.e. on the
+    per-particle arrays cut to ``window`` (``blk.local(w)``), and returns sums over that window only. With
+    pairs sorted by I and particles numbered so that neighbours have nearby numbers (a lattice), a window is
+    a little longer than the block's rows; a block whose particles pair with rows far down the array (mirror
+    ghosts, tool particles: they come last) has a long window, which costs time but not accuracy.
+
+    ``map(fn)`` calls ``fn(block)`` for every block -- a block has ``I``, ``J`` (global indices), ``sl`` (its
+    slice of the whole pair list), ``window`` and ``sums`` -- and returns the results in block order.
+    ``reduce(fn)`` adds results of shape (..., hi - lo) into one array of shape (..., n), block by block in
+    block order, so the total does not depend on ``threads``. With ``threads`` > 1 the blocks run on a thread
+    pool: NumPy's array operations and SciPy's sparse products release the GIL, so the blocks of one
+    evaluation really do run at the same time. One PairBlocks serves one evaluation at a time (each block's
+    PairSum holds the pair values of the sum in progress).
+    """
+
+    _pool = None                                            # the thread pool, made on first use
+
+    class Block:
+        def __init__(self, I, J, sl):
+            self.I, self.J, self.sl = I, J, sl
+            lo = int(min(I.min(), J.min())) if len(I) else 0
+            hi = int(max(I.max(), J.max())) + 1 if len(I) else 0
+            self.window = slice(lo, hi)
+            self.sums = PairSum(I - lo, J - lo, hi - lo)
+
+        def local(self, w: np.ndarray) -> np.ndarray:
+            """The rows of per-particle array w inside this block's window (a view)."""
+            return w[self.window]
+
+    def __init__(self, I: np.ndarray, J: np.ndarray, n: int, size: int | None = None, threads: int = 1):
+        size = PAIR_BLOCK if size is None else size
+        if size < 1:
+            raise ValueError(f"block size must be a positive number of pairs, got {size!r}")
+        if threads < 1:
+            raise ValueError(f"threads must be at least 1, got {threads!r}")
+        I, J = np.asarray(I), np.asarray(J)
+        if len(I) and (min(I.min(), J.min()) < 0 or max(I.max(), J.max()) >= n):
+            raise ValueError(f"pair indices must lie in [0, {n})")
+        self.n, self.n_pairs, self.size = int(n), len(I), int(size)
+        self.blocks = [self.Block(I[a:a + self.size], J[a:a + self.size], slice(a, a + self.size))
+                       for a in range(0, max(len(I), 1), self.size)]
+        self.threads = int(threads)
+
+    def map(self, fn, items=None) -> list:
+        """[fn(item) for item in items] (default: the blocks), on the thread pool if ``threads`` > 1."""
+        items = self.blocks if items is None else list(items)
+        if self.threads == 1 or len(items) == 1:
+            return [fn(b) for b in items]
+        if self._pool is None:
+            from concurrent.futures import ThreadPoolExecutor
+            self._pool = ThreadPoolExecutor(self.threads)
+        return list(self._pool.map(fn, items))
+
+    def reduce(self, fn) -> np.ndarray:
+        """sum over blocks of fn(block), an array of shape (..., window length), into shape (..., n)."""
+        results = self.map(fn)
+        total = np.zeros(results[0].shape[:-1] + (self.n,))
+        for blk, r in zip(self.blocks, results):
+            total[..., blk.window] += r
+        return total
+
+    def close(self) -> None:
+        if self._pool is not None:
+            self._pool.shutdown()
+            self._pool = None
+
+    def __del__(self):
+        self.close()
+
+
+def available_cores() -> int:
+    """CPU cores this process may run on (the affinity mask where the OS has one). A container's CPU quota is not
+    seen here, nor other work on the machine: where several runs share the cores, give each its share
+    (``Numerics.threads``, ``refsph run --set threads=N``, :func:`threads_per_job`)."""
+    try:
+        return len(os.sched_getaffinity(0))
+    except AttributeError:                                  # not on Linux
+        return os.cpu_count() or 1
+
+
+def threads_per_job(n_jobs: int) -> int:
+    """Threads for each of ``n_jobs`` runs sharing this machine: its share of the available cores (at least 1)."""
+    return max(1, available_cores() // max(1, int(n_jobs)))
 
 
 def pair_count_per_particle(I: np.ndarray, J: np.ndarray, n: int) -> np.ndarray:

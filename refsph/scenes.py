@@ -33,7 +33,8 @@ class Numerics:
     courant: CFL number; corrected: TLSPH kernel-gradient correction; ref_update_strain: TLSPH reference
     update trigger on max |E| (None = never); skin_factor: ESPH Verlet skin in units of h; contact_k: TLSPH
     pinball radius R = contact_k h (Eq. 32; None = dp / (2h), pinballs of neighbouring bodies touch at one
-    spacing); contact_Kp: the pinball scaling factor K_p (Eq. 33).
+    spacing); contact_Kp: the pinball scaling factor K_p (Eq. 33); threads: threads that share the pair sums
+    (0 = one per available core). The numbers of a run do not depend on ``threads``, only its speed does.
     """
 
     h_over_dp: float = 1.5
@@ -49,6 +50,7 @@ class Numerics:
     skin_factor: float = 0.1
     contact_k: float | None = None
     contact_Kp: float = 50.0
+    threads: int = 0
 
 
 @dataclass

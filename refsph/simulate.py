@@ -20,6 +20,7 @@ from .esph import ESPHParams
 from .integrate import ESPHSolver, TLSPHSolver, cfl_time_step, predictor_corrector_step
 from .io import save_reactions, save_snapshot, write_json
 from .kernels import get_kernel
+from .neighbours import available_cores
 from .scenes import Setup, convert_options, get_scene
 from .state import State
 from .tlsph import TLSPHParams
@@ -44,6 +45,10 @@ class RunResult:
 def make_solver(method: str, setup: Setup):
     """ESPH or TLSPH solver for a setup."""
     nm = setup.numerics
+    if isinstance(nm.threads, bool) or not isinstance(nm.threads, (int, np.integer)) or nm.threads < 0:
+        raise ValueError(f"Numerics.threads must be a whole number >= 0 (0 = one thread per available core), "
+                         f"got {nm.threads!r}")
+    threads = available_cores() if nm.threads == 0 else int(nm.threads)    # (numbers do not depend on it)
     kernel = get_kernel(nm.kernel)
     h = setup.h
     if method == "esph":
@@ -53,7 +58,8 @@ def make_solver(method: str, setup: Setup):
         prm = ESPHParams(h=h, dp=setup.dp, beta1=nm.beta1, beta2=nm.beta2, gamma=nm.gamma, n_ap=nm.n_ap,
                          eps=nm.eps, kernel=kernel)
         return ESPHSolver(setup.material, prm, skin_factor=nm.skin_factor, plasticity=setup.plasticity,
-                          mirror=setup.mirror, walls=setup.walls, rigid=setup.rigid, clamps=setup.clamps)
+                          mirror=setup.mirror, walls=setup.walls, rigid=setup.rigid, clamps=setup.clamps,
+                          threads=threads)
     if method == "tlsph":
         prm = TLSPHParams(h=h, beta1=nm.beta1, beta2=nm.beta2, eps=nm.eps, kernel=kernel,
                           corrected=nm.corrected, ref_update_strain=nm.ref_update_strain)
@@ -65,7 +71,7 @@ def make_solver(method: str, setup: Setup):
             contact = PinballContact(k=k, K_p=nm.contact_Kp, friction=setup.friction)
         return TLSPHSolver(setup.material, prm, plasticity=setup.plasticity, mirror=setup.mirror,
                            walls=setup.walls, rigid=setup.rigid, clamps=setup.clamps, contact=contact,
-                           dp=setup.dp)
+                           dp=setup.dp, threads=threads)
     raise ValueError(f"unknown method {method!r}; choose one of {', '.join(METHODS)}")
 
 
@@ -147,7 +153,7 @@ def simulate(setup: Setup, method: str, *, scene=None, out=None, dt: float | Non
     summary = dict(scene=scene.name if scene is not None else label, method=method, dim=state.dim,
                    dp=setup.dp, h=setup.h, n_particles=state.n, t_end=setup.t_end, n_steps=0,
                    dt_mode="fixed" if dt is not None else "cfl", courant=setup.numerics.courant,
-                   numerics=dataclasses.asdict(setup.numerics),
+                   numerics=dataclasses.asdict(setup.numerics), threads=solver.threads,
                    material=dataclasses.asdict(setup.material),
                    plasticity=dataclasses.asdict(setup.plasticity) if setup.plasticity is not None else None,
                    boundaries=dict(symmetry_axes=list(setup.mirror.axes) if setup.mirror is not None else [],

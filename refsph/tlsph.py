@@ -3,8 +3,8 @@
 Pairs, kernel gradients grad_i W(X_ij) and reference volumes V_j = m_j / rho_0j do not change until the
 reference configuration is updated, so every sum below is a product with a fixed sparse matrix
 (:class:`ReferenceOperator`), built once per reference configuration. The artificial viscosity, whose pair
-terms depend on the current x_ij and v_ij, is computed on the approaching pairs only and summed with the
-operator's :class:`~refsph.neighbours.PairSum` (fixed sparse pattern, new values at each evaluation).
+terms depend on the current x_ij and v_ij, is summed block by block with the operator's
+:class:`~refsph.neighbours.PairBlocks` (fixed sparse patterns, new values at each evaluation).
 
     Eq. (18)  F_i     = - sum_j V_j (x_i - x_j) (x) grad_i W(X_ij)            (deformation gradient)
     Eq. (19)  Fdot_i  = - sum_j V_j (v_i - v_j) (x) grad_i W(X_ij)
@@ -40,7 +40,7 @@ import scipy.sparse as sp
 from .esph import Rates, artificial_viscosity
 from .kernels import Kernel
 from .material import ElasticMaterial, cauchy_stress, eos_pressure, jaumann_deviatoric_rate
-from .neighbours import PairSum, find_pairs, scatter_add
+from .neighbours import PairBlocks, find_pairs, scatter_add
 from .state import State
 from .tensor import component_major, det, identity, inv, matmul, rowdot, transpose
 
@@ -76,10 +76,14 @@ class ReferenceOperator:
     The kernel-gradient correction L is baked into the entries, so F needs no per-step matrix product.
     Products are taken one column at a time: SciPy's single-vector CSR product is its fastest sparse
     kernel (about 0.5 ns per stored entry), faster than its multi-vector one.
+
+    ``pairs`` is a :class:`~refsph.neighbours.PairBlocks` of the half pairs (``block_size`` pairs per block,
+    None = ``PAIR_BLOCK``), used by the artificial viscosity; its ``threads`` also run the independent sparse
+    products of :meth:`gradient` and :meth:`momentum_sum` at the same time. The numbers do not depend on them.
     """
 
     def __init__(self, X: np.ndarray, V: np.ndarray, h: float, kernel: Kernel, corrected: bool,
-                 ghosts=None):
+                 ghosts=None, threads: int = 1, block_size: int | None = None):
         X = np.asarray(X, dtype=float)
         n, d = X.shape
         self.n, self.dim, self.h, self.kernel, self.corrected = n, d, float(h), kernel, bool(corrected)
@@ -115,7 +119,9 @@ class ReferenceOperator:
         self.G = [sp.csr_matrix((Vgc[:, k], (rows, cols)), shape=(n, n)) for k in range(d)]
         self.GT = [Gk.T.tocsr() for Gk in self.G]
         self.s = np.stack([Gk @ np.ones(n) for Gk in self.G], axis=1)   # sum_j V_j grad~_i W_ij
-        self.pairs = PairSum(I, J, n)
+        self.pairs = PairBlocks(I, J, n, size=block_size, threads=threads)     # for the artificial viscosity
+        for blk in self.pairs.blocks:                          # its reference gradients, per component
+            blk.gW = [np.ascontiguousarray(self.gW[blk.sl, k]) for k in range(d)]
         self._sm, self._sm_m = None, None
 
     def gradient(self, f: np.ndarray) -> np.ndarray:
@@ -128,9 +134,10 @@ class ReferenceOperator:
         n, c = f.shape
         fT = np.ascontiguousarray(f.T)                      # fT[a]: column a of f, contiguous
         out = np.empty((self.dim, c, n))                    # out[k, a, i]: each component contiguous
-        for k, Gk in enumerate(self.G):
-            for a in range(c):
-                np.subtract(Gk @ fT[a], fT[a] * self.s[:, k], out=out[k, a])
+        tasks = [(k, a) for k in range(self.dim) for a in range(c)]
+        products = self.pairs.map(lambda ka: self.G[ka[0]] @ fT[ka[1]], tasks)   # independent: on threads
+        for (k, a), Gf in zip(tasks, products):
+            np.subtract(Gf, fT[a] * self.s[:, k], out=out[k, a])
         return out.transpose(2, 1, 0)
 
     def deformation_gradient(self, x: np.ndarray) -> np.ndarray:
@@ -152,12 +159,15 @@ class ReferenceOperator:
         Q = component_major(Q)
         d = self.dim
         out = np.empty((d, self.n))                         # out[a, i]
+        tasks = [(a, k) for a in range(d) for k in range(d)]
+        # sum_j m_j Q_j,ak V_i grad~_j W_ji, one sparse product per (a, k), independent: on threads
+        jside = self.pairs.map(lambda ak: self.GT[ak[1]] @ (m * Q[:, ak[0], ak[1]]), tasks)
         for a in range(d):
             iside = rowdot(Q[:, a, :], sm)                                  # Q_i,ak sm_ik
-            jside = self.GT[0] @ (m * Q[:, a, 0])                           # sum_j m_j Q_j,ak V_i grad~_j W_ji
+            js = jside[a * d]
             for k in range(1, d):
-                jside += self.GT[k] @ (m * Q[:, a, k])
-            out[a] = iside - jside / self.V
+                js += jside[a * d + k]
+            out[a] = iside - js / self.V
         return out.T
 
 
@@ -197,32 +207,48 @@ def reference_viscosity(x: np.ndarray, v: np.ndarray, m: np.ndarray, rho: np.nda
                         op: ReferenceOperator, c0: float, prm: TLSPHParams) -> np.ndarray:
     """Artificial viscosity of Eq. (17) in the reference frame: -sum_j m_j pi_ij (B_i + B_j)/2 grad_i W(X_ij).
 
-    pi_ij is Eqs. (12)-(13) with the current x_ij, v_ij. It is zero for receding pairs (v_ij . x_ij >= 0), so
-    v_ij . x_ij is computed on every pair and everything else only on the approaching ones (about half);
-    their pair terms are put into a per-pair array that is zero elsewhere and summed with ``op.pairs``.
-    The pair term is antisymmetric (momentum conserved to round-off). B is (N, d, d); C order is fastest
-    (its rows are gathered per pair).
+    pi_ij is Eqs. (12)-(13) with the current x_ij, v_ij (zero for receding pairs, v_ij . x_ij >= 0). As in the
+    stress term, the pair sum is split into an i-side and a j-side sum, so that no B is gathered per pair:
+
+        sum_j m_j pi_ij (B_i + B_j) g_ij / 2 = B_i (sum_j m_j pi_ij g_ij) / 2 + (sum_j m_j B_j pi_ij g_ij) / 2,
+
+    g_ij = grad_i W(X_ij). Both are antisymmetric pair sums (momentum conserved to round-off), computed block
+    by block over ``op.pairs`` (a :class:`~refsph.neighbours.PairBlocks`, see :func:`_viscosity_block`).
+    B is (N, d, d).
     """
     n, d = x.shape
-    dx = np.take(x, op.I, axis=0) - np.take(x, op.J, axis=0)
-    dv = np.take(v, op.I, axis=0) - np.take(v, op.J, axis=0)
-    vr = rowdot(dx, dv)
-    k = np.flatnonzero(vr < 0.0)                            # the approaching pairs
-    I, J = np.take(op.I, k), np.take(op.J, k)
-    dx = np.take(dx, k, axis=0)
-    r2 = rowdot(dx, dx)
-    pi = artificial_viscosity(np.take(vr, k), r2, 0.5 * (np.take(rho, I) + np.take(rho, J)), c0, prm.h,
-                              prm.beta1, prm.beta2, prm.eps)
-    g = np.take(op.gW, k, axis=0)
-    Bs = np.take(B.reshape(n, d * d), I, axis=0)
-    Bs += np.take(B.reshape(n, d * d), J, axis=0)           # (B_i + B_j) on each pair, row-major (a, b)
-    pi *= -0.5
+    particle = dict(x=[np.ascontiguousarray(x[:, k]) for k in range(d)],
+                    v=[np.ascontiguousarray(v[:, k]) for k in range(d)],
+                    rho=rho, m=m, m_B=[[m * B[:, c, b] for b in range(d)] for c in range(d)])
+    sums = op.pairs.reduce(lambda blk: _viscosity_block(blk, particle, c0, prm, d))
     a = np.empty((n, d))
-    q = np.zeros(op.n_pairs)
-    for c in range(d):
-        np.put(q, k, pi * rowdot(Bs[:, c * d:(c + 1) * d], g))      # -pi_ij/2 ((B_i + B_j) grad_i W_ij)_c
-        a[:, c] = op.pairs.antisymmetric(q, m)
+    for c in range(d):                          # rows of block b: sum_j m_j pi g_b, sum_j m_j B_j,cb pi g_b (c...)
+        a[:, c] = sum(B[:, c, b] * sums[b * (d + 1)] + sums[b * (d + 1) + 1 + c] for b in range(d))
+    a *= -0.5
     return a
+
+
+def _viscosity_block(blk, particle: dict, c0: float, prm: TLSPHParams, d: int) -> np.ndarray:
+    """Over one block's pairs (rows over its window): for each direction b, the row sum_j m_j pi_ij (g_ij)_b,
+    then the d rows sum_j m_j (B_j)_cb pi_ij (g_ij)_b, c = 0..d-1."""
+    I, J = blk.I, blk.J
+    dx = [np.take(xk, I) - np.take(xk, J) for xk in particle["x"]]     # current x_ij
+    dv = [np.take(vk, I) - np.take(vk, J) for vk in particle["v"]]     # v_ij
+    r2 = dx[0] * dx[0]
+    vr = dv[0] * dx[0]
+    for k in range(1, d):
+        r2 += dx[k] * dx[k]
+        vr += dv[k] * dx[k]
+    rho = particle["rho"]
+    pi = artificial_viscosity(vr, r2, 0.5 * (np.take(rho, I) + np.take(rho, J)), c0, prm.h, prm.beta1,
+                              prm.beta2, prm.eps)
+    out = np.empty((d * (d + 1), blk.sums.n))
+    for b in range(d):
+        t = pi * blk.gW[b]
+        out[b * (d + 1)] = blk.sums.antisymmetric(t, blk.local(particle["m"]))
+        for c in range(d):
+            out[b * (d + 1) + 1 + c] = blk.sums.antisymmetric(t, blk.local(particle["m_B"][c][b]))
+    return out
 
 
 def tlsph_rates(state: State, mat: ElasticMaterial, prm: TLSPHParams, op: ReferenceOperator,
@@ -251,7 +277,7 @@ def tlsph_rates(state: State, mat: ElasticMaterial, prm: TLSPHParams, op: Refere
 
     # Eq. (17), artificial viscosity: a_i -= sum_j m_j pi_ij (B_i + B_j)/2 grad_i W_ij,  B = J F^-T
     if prm.beta1 > 0 or prm.beta2 > 0:
-        B = np.ascontiguousarray(J[:, None, None] * transpose(Finv))   # row-major: gathered per pair
+        B = J[:, None, None] * transpose(Finv)
         a += reference_viscosity(x, v, m, rho, B, op, mat.c0, prm)
 
     dS, dS_zz = jaumann_deviatoric_rate(state.S, state.S_zz, l, mat.G)
@@ -278,5 +304,6 @@ def reference_update(state: State, op: ReferenceOperator,
     if F is None:
         F = op.deformation_gradient(state.x)
     new = reset_reference(state, F)
-    new_op = ReferenceOperator(new.X, new.V0, op.h, op.kernel, op.corrected)
+    new_op = ReferenceOperator(new.X, new.V0, op.h, op.kernel, op.corrected, threads=op.pairs.threads,
+                               block_size=op.pairs.size)
     return new, new_op

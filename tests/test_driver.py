@@ -107,3 +107,28 @@ def test_cli_list_and_run(tmp_path, capsys):
     assert main(["run", "nope"]) == 2
     assert main(["run", "bar", "--dp", "-1", "--out", str(tmp_path / "x")]) == 2
     assert "dp" in capsys.readouterr().err
+    # a whole-number numerical parameter from --set: threads
+    assert main(["run", "bar", "--method", "esph", "--quick", "--t-end", "1e-6", "--out", str(out), "--quiet",
+                 "--set", "threads=1"]) == 0
+    assert json.loads((out / "summary.json").read_text())["threads"] == 1
+    assert main(["run", "bar", "--quick", "--set", "threads=1.5", "--out", str(tmp_path / "y")]) == 2
+    assert "whole number" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("method", ["esph", "tlsph"])
+def test_threads_change_speed_not_numbers(tmp_path, monkeypatch, method):
+    """A short cut with small pair blocks (many per evaluation) on 1 and on 2 threads: the same bits."""
+    import refsph.neighbours
+    monkeypatch.setattr(refsph.neighbours, "PAIR_BLOCK", 2000)
+    runs = [run("cutting", method, dp=0.1e-3, t_end=0.5e-6, out=tmp_path / f"t{k}", progress=False,
+                numerics={"threads": k}) for k in (1, 2)]
+    assert runs[0].summary["n_steps"] == runs[1].summary["n_steps"] > 10
+    a, b = (load_snapshot(load_run(tmp_path / f"t{k}")[1][-1]) for k in (1, 2))
+    for key in ("x", "v", "S", "eps_p", "T"):
+        assert np.array_equal(a[key], b[key]), key
+    assert np.any(a["eps_p"] > 0)                            # the tool has cut into the workpiece
+
+
+def test_bad_thread_count():
+    with pytest.raises(ValueError, match="threads"):
+        run("bar", "esph", quick=True, progress=False, numerics={"threads": -1})

@@ -201,3 +201,17 @@ def test_artificial_viscosity_only_for_approaching_pairs():
     assert np.all(pi[:2] > 0.0)
     mu = H * vr[0] / (DP**2 + 0.01 * H**2)
     assert math.isclose(pi[0], (-1.5 * MAT.c0 * mu + 1.5 * mu * mu) / MAT.rho0, rel_tol=1e-14)
+
+
+def test_blocks_of_pairs_give_the_same_rates():
+    """esph_rates over many small pair blocks (refsph.neighbours.PairBlocks) = over one block, to round-off."""
+    from refsph.neighbours import PairBlocks
+    st, prm = random_state(), params()
+    I, J = find_pairs(st.x, 2.3 * H)
+    one = esph_rates(st, MAT, prm, I, J)
+    many = esph_rates(st, MAT, prm, I, J, pairs=PairBlocks(I, J, st.n, size=97, threads=2))
+    for f in ("rho", "v", "S", "S_zz", "l"):
+        ref = getattr(one, f)
+        assert np.allclose(ref, getattr(many, f), rtol=1e-12, atol=1e-13 * np.abs(ref).max()), f
+    with pytest.raises(ValueError, match="do not match"):
+        esph_rates(st, MAT, prm, I[:-1], J[:-1], pairs=PairBlocks(I, J, st.n))

@@ -187,3 +187,18 @@ def test_lattice_partition_of_unity_interior(name, dim, hdp):
     assert abs(s_w - 1.0) < 0.02
     assert s_w != 1.0                      # it is a sum, not an integral: not exactly one
     assert np.all(np.abs(s_g) * hdp < 1e-12)
+
+
+@pytest.mark.parametrize("name", NAMES)
+@pytest.mark.parametrize("dim", DIMS)
+def test_fused_value_and_gradient_match_the_separate_ones(name, dim):
+    """w_and_dw_dr_over_r (one pass, what ESPH uses) equals w and dw_dr_over_r to round-off, q = 0 included."""
+    k, h = get_kernel(name), 0.7
+    r = np.concatenate([[0.0, 1e-14, 1e-6], np.linspace(0.0, 2.6 * h, 1001)])
+    w, g = k.w_and_dw_dr_over_r(r, h, dim)
+    assert np.allclose(w, k.w(r, h, dim), rtol=1e-13, atol=1e-14 * k.w(0.0, h, dim))
+    ref = k.dw_dr_over_r(r, h, dim)
+    nonzero = r > 1e-9
+    assert np.allclose(g[nonzero], ref[nonzero], rtol=1e-9, atol=1e-12 * np.abs(ref).max())
+    assert np.all(np.isfinite(g))
+    assert np.all(w[r >= 2 * h] == 0.0) and np.all(g[r >= 2 * h] == 0.0)

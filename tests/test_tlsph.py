@@ -257,3 +257,12 @@ def test_singular_correction_matrix_stays_finite():
     F = op.deformation_gradient(2.0 * X)
     np.testing.assert_allclose(F[:10, 0, 0], 2.0, rtol=1e-12)
     np.testing.assert_allclose(F[11:], np.broadcast_to(2.0 * np.eye(2), F[11:].shape), atol=1e-12)
+
+
+def test_blocks_and_threads_give_the_same_rates(block):
+    """The artificial viscosity summed over many small pair blocks on two threads = over one block."""
+    one = ReferenceOperator(block.X, block.V0, H, KERNEL, True)
+    many = ReferenceOperator(block.X, block.V0, H, KERNEL, True, threads=2, block_size=53)
+    a, b = (tlsph_rates(block, MAT, params(True), op).v for op in (one, many))
+    assert len(many.pairs.blocks) > 5
+    assert np.allclose(a, b, rtol=1e-12, atol=1e-13 * np.abs(a).max())

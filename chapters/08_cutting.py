@@ -906,7 +906,7 @@ if bench is not None:
 # ### Reproducibility: the same runs with arithmetic that differs by round-off
 #
 # The paper-resolution runs were made twice, by two versions of refsph whose rate evaluations are the same
-# equations summed in a different order (the second cuts the pair sums into blocks, Section 4's cost paragraph):
+# equations summed in a different order (the second cuts the pair sums into blocks, the cost paragraph below):
 # the two differ by about 1e-16 relative in every rate. A cutting simulation amplifies such differences (contact
 # that switches on and off, particles that leave the chip or stay, bands that start a step earlier), so how far
 # the two runs end apart is the tolerance that any comparison of two implementations of these equations, a

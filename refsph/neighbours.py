@@ -162,9 +162,10 @@ class PairBlocks:
         self.threads = int(threads)
 
     def map(self, fn, items=None) -> list:
-        """[fn(item) for item in items] (default: the blocks), on the thread pool if ``threads`` > 1."""
+        """[fn(item) for item in items] (default: the blocks), on the thread pool if ``threads`` > 1 and the pair
+        list has more than one block (a list that fits in one block is too small to pay for the threads)."""
         items = self.blocks if items is None else list(items)
-        if self.threads == 1 or len(items) == 1:
+        if self.threads == 1 or len(self.blocks) == 1 or len(items) == 1:
             return [fn(b) for b in items]
         if self._pool is None:
             from concurrent.futures import ThreadPoolExecutor

@@ -6,7 +6,7 @@
     python benchmarks/cutting.py --plot-only --rerun-of DIR --rerun-label "commit abc1234"
                                                    # ... and vs_rerun: the paper runs against the same runs in DIR
 
-Runs (2D plane strain, the scene `refsph.cutting`, 1 mm of cut = 20 us unless stated):
+Runs (2D plane strain, the scene `refsph.scenes.cutting`, 1 mm of cut = 20 us unless stated):
   paper-METHOD-fFEED   dp = 0.01 mm, h = 0.018 mm (Table 5), feed 0.3 and 0.5 mm, both methods, CFL step
   coarse-...           the same at dp = 0.025 mm and 0.0167 mm (feed 0.3 mm), for the work-precision plot
   noupdate-tlsph       TLSPH without reference-configuration updates, dp = 0.025 mm, feed 0.3 mm, 0.5 mm of
@@ -93,8 +93,8 @@ def load(name):
 
 def record(job, runs=None):
     """The record of a finished or failed run in folder runs (default RUNS); the measurements are recomputed from
-    the run's files with the current code (refsph.cutting.analyse_run), so a changed measure needs no new run."""
-    from refsph.cutting import analyse_run
+    the run's files with the current code (refsph.scenes.cutting.analyse_run), so a changed measure needs no new run."""
+    from refsph.scenes.cutting import analyse_run
     from refsph.io import load_run, load_snapshot
     name = job["name"]
     folder = (RUNS if runs is None else Path(runs)) / name
@@ -120,7 +120,7 @@ def record(job, runs=None):
                    temperature_p99_K=float(np.percentile(T, 99)))
         rec.update(flank_contact(last["x"][:n], last["x"][n:], s["dp"]))
     if ok:
-        from refsph.cutting import lattice_shape, shear_bands
+        from refsph.scenes.cutting import lattice_shape, shear_bands
         info = s["scene_info"]
         x_tip = float(last["x"][n:, 0].min()) - 0.5 * info["dx"]
         rec["n_shear_bands_by_prominence"] = {
@@ -192,7 +192,8 @@ def add_reruns(records, runs, label):
             continue
         rel = lambda k: r[k] / o[k] - 1 if r.get(k) is not None and o.get(k) not in (None, 0) else None  # noqa: E731
         r["vs_rerun"] = dict(runs=label, cutting_force_rel=rel("cutting_force_mean_MN_per_m"),
-                             thrust_force_rel=rel("thrust_force_mean_MN_per_m"), chip_thickness_rel=rel("chip_thickness_mm"),
+                             thrust_force_rel=rel("thrust_force_mean_MN_per_m"),
+                             chip_thickness_rel=rel("chip_thickness_mm"),
                              n_shear_bands=[o["n_shear_bands"], r["n_shear_bands"]],
                              band_spacing_material_mm=[o["band_spacing_material_mm"], r["band_spacing_material_mm"]],
                              band_angle_deg=[o["band_angle_deg"], r["band_angle_deg"]],
@@ -213,14 +214,16 @@ def write_json(records):
 
 def table(records) -> str:
     f = lambda v, fmt: "-" if v is None or (isinstance(v, float) and not np.isfinite(v)) else format(v, fmt)  # noqa: E731
-    lines = [f"{'run':26s} {'N':>6s} {'steps':>6s} {'wall s':>7s} {'cpu s':>7s} {'upd':>4s} {'status':>6s} {'Fc':>6s} {'Ft':>6s} "
+    lines = [f"{'run':26s} {'N':>6s} {'steps':>6s} {'wall s':>7s} {'cpu s':>7s} {'upd':>4s} {'status':>6s} "
+             f"{'Fc':>6s} {'Ft':>6s} "
              f"{'drift':>6s} {'chip':>6s} {'phi_c':>5s} {'bands':>5s} {'spac':>6s} {'spac0':>6s} {'angle':>5s} "
              f"{'eps max':>7s} {'eps p99':>7s} {'T max':>6s}"]
     for r in records:
         lines.append(f"{r['name']:26s} {r['n_particles']:6d} {r['n_steps']:6d} {r['wall_time_s']:7.0f} "
                      f"{f(r.get('cpu_time_s'), '7.0f'):>7s} "
                      f"{f(r['reference_updates'], 'd'):>4s} {r['status']:>6s} "
-                     f"{f(r.get('cutting_force_mean_MN_per_m'), '.3f'):>6s} {f(r.get('thrust_force_mean_MN_per_m'), '.3f'):>6s} "
+                     f"{f(r.get('cutting_force_mean_MN_per_m'), '.3f'):>6s} "
+                     f"{f(r.get('thrust_force_mean_MN_per_m'), '.3f'):>6s} "
                      f"{f(r.get('cutting_force_drift'), '+.2f'):>6s} {f(r.get('chip_thickness_mm'), '.3f'):>6s} "
                      f"{f(r.get('shear_angle_from_chip_deg'), '.0f'):>5s} {f(r.get('n_shear_bands'), 'd'):>5s} "
                      f"{f(r.get('band_spacing_mm'), '.3f'):>6s} {f(r.get('band_spacing_material_mm'), '.3f'):>6s} "
@@ -409,7 +412,8 @@ def plots(records):
             ax.set_title(f"TLSPH {upd} reference updates ({r['reference_updates']}),\ncut {50.0 * z['t'] * 1e3:.3f} mm"
                          f"{end}, max eps_p {z['eps_p'][:r['n_workpiece']].max():.1f}", fontsize=8)
         fig.colorbar(sc, cax=fig.add_axes([0.92, 0.2, 0.012, 0.55]), extend="max", label="effective plastic strain")
-        fig.suptitle(f"Reduced size (dp = {with_upd['dp_nominal_mm']:.3g} mm, feed {with_upd['feed_mm']:g} mm): the chip "
+        fig.suptitle(f"Reduced size (dp = {with_upd['dp_nominal_mm']:.3g} mm, feed {with_upd['feed_mm']:g} mm): "
+                     "the chip "
                      "with and without updates of the reference configuration", fontsize=10)
         fig.savefig(FIG / "08_cutting_reference_updates.png", dpi=120)
         plt.close(fig)

@@ -1,6 +1,6 @@
 """Cost of one time step of the cutting scene at the paper's resolution, by pair-block size and thread count.
 
-The orthogonal cutting scene (``refsph.cutting``, feed 0.3 mm, dp = 0.01 mm, h = 0.018 mm: 30,584 particles) is
+The orthogonal cutting scene (``refsph.scenes.cutting``, feed 0.3 mm, dp = 0.01 mm, h = 0.018 mm: 30,584 particles) is
 built as a run builds it and advanced from t = 0 with ``predictor_corrector_step`` at its CFL step: a few
 warm-up steps, then ``--steps`` timed steps, ``--repeats`` times; the best repetition is reported (other work
 on the machine can only slow a repetition down). For each method, every combination of
@@ -14,7 +14,7 @@ what the data layout buys: arrays that fit in the L2 cache (blocks) and two core
 column is the time that 1 mm of cut (about 22,400 CFL steps) would take at that speed, the target of issue 5
 being under 30 minutes. Output: a table and ``benchmarks/pair_blocks.json``.
 
-    python benchmarks/pair_blocks.py                          # both methods, sizes all/2^15/2^16/2^17/2^18, 1 and 2 threads
+    python benchmarks/pair_blocks.py           # both methods, sizes all/2^15/2^16/2^17/2^18, 1 and 2 threads
     python benchmarks/pair_blocks.py --methods esph --sizes all 131072 --threads 2 --steps 20
 """
 from __future__ import annotations
@@ -44,7 +44,7 @@ STEPS_PER_MM = 22_400          # CFL steps for 1 mm of cut at the paper's resolu
 def time_step(method: str, size: int | None, threads: int | None, steps: int, repeats: int,
               warmup: int = 3) -> dict:
     """Best s/step of ``method``; ``threads=None``: the code as it is (for a checkout before PairBlocks)."""
-    setup = get_scene("cutting").build(2, 0.01e-3, False, feed=0.3e-3)
+    setup = get_scene("cutting").setup(2, 0.01e-3, False, feed=0.3e-3)
     as_is = threads is None
     if not as_is:
         setup.numerics = dataclasses.replace(setup.numerics, threads=threads)
@@ -103,7 +103,8 @@ def main(argv=None) -> list[dict]:
     if args.as_is:
         sizes, args.threads = ["as-is"], [None]
     print(", ".join(f"{k} {v}" for k, v in software().items()) + "; cutting scene, paper resolution, feed 0.3 mm")
-    header = f"{'method':6s} {'block':>7s} {'threads':>7s} {'pairs':>8s} {'s/step':>7s} {'cpu s/step':>10s} {'min/mm':>7s}"
+    header = (f"{'method':6s} {'block':>7s} {'threads':>7s} {'pairs':>8s} {'s/step':>7s} {'cpu s/step':>10s} "
+              f"{'min/mm':>7s}")
     print(header + "\n" + "-" * len(header))
     results = []
     for method in args.methods:
@@ -115,7 +116,8 @@ def main(argv=None) -> list[dict]:
                 print(f"{method:6s} {'all' if size is None else size:>7} {threads or 0:7d} {r['n_pairs']:8d} "
                       f"{r['s_per_step']:7.4f} {r['cpu_s_per_step']:10.4f} {r['minutes_per_mm']:7.1f}", flush=True)
     write_results(args.json, results, refsph_path=str(Path(refsph.neighbours.__file__).parent),
-                  refsph_commit=_commit(Path(refsph.neighbours.__file__).parent), scene="cutting, dp = 0.01 mm, h = 0.018 mm, feed 0.3 mm, from t = 0",
+                  refsph_commit=_commit(Path(refsph.neighbours.__file__).parent),
+                  scene="cutting, dp = 0.01 mm, h = 0.018 mm, feed 0.3 mm, from t = 0",
                   timing="best of `repeats` repetitions of `steps` predictor-corrector steps after 3 warm-up "
                          "steps; minutes_per_mm = s_per_step x 22,400 steps / 60")
     return results

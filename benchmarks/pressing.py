@@ -5,7 +5,7 @@
     python benchmarks/pressing.py --only conv-    # only the jobs whose name contains 'conv-'
     python benchmarks/pressing.py --plot-only     # JSON, table and figures again from runs/benchmarks/pressing/
 
-Runs (2D plane strain, the scene `refsph.pressing`, tool travel 0.2 mm = 1 us, both methods unless stated):
+Runs (2D plane strain, the scene `refsph.scenes.pressing`, tool travel 0.2 mm = 1 us, both methods unless stated):
   conv       dp = 0.0167, 0.0133, 0.01, 0.00667 mm (the paper's Fig. 10; h/dp = 1.5), CFL step (Courant 0.3)
   dt1e-10    dp = 0.01 mm with the paper's fixed dt = 1e-10 s (Table 4)
   kp10/kp200 TLSPH at dp = 0.01 mm with the pinball scaling factor K_p = 10 and 200 (default 50)
@@ -50,7 +50,7 @@ N_LINE_GRID = 400                    # points of the common x grid on which two 
 
 
 def resolutions():
-    from refsph.reference import PRESSING_RESOLUTIONS_M
+    from refsph.paper_data import PRESSING_RESOLUTIONS_M
     return tuple(PRESSING_RESOLUTIONS_M)
 
 
@@ -192,9 +192,11 @@ def table(records) -> str:
         fin = (f"{100 * d['force_mean_rel']:+6.1f}% {100 * d['line_peak_rel']:+6.1f}% {100 * d['line_L2_rel']:5.1f}%"
                if d and d["ref"] != r["name"] else f"{'(ref)':>7s} {'':7s} {'':6s}")
         lines.append(f"{r['name']:22s} {1e3 * r['dp_mm']:6.2f} {r['n_particles']:6d} {r['n_steps']:6d} "
-                     f"{r['wall_time_s']:7.1f} {r['tool_force_peak_MN_per_m']:7.3f} {r['tool_force_mean_MN_per_m']:7.3f} "
-                     f"{r['clamp_force_mean_MN_per_m']:7.3f} {r['max_plastic_strain']:7.2f} {r['plastic_strain_p99']:7.3f} "
-                     f"{r['line_peak']:7.3f} {r['line_peak_x_mm']:5.2f} {r['line_peak_width_mm']:5.3f} {r['max_temperature_K']:6.0f} "
+                     f"{r['wall_time_s']:7.1f} {r['tool_force_peak_MN_per_m']:7.3f} "
+                     f"{r['tool_force_mean_MN_per_m']:7.3f} {r['clamp_force_mean_MN_per_m']:7.3f} "
+                     f"{r['max_plastic_strain']:7.2f} {r['plastic_strain_p99']:7.3f} "
+                     f"{r['line_peak']:7.3f} {r['line_peak_x_mm']:5.2f} {r['line_peak_width_mm']:5.3f} "
+                     f"{r['max_temperature_K']:6.0f} "
                      f"{r['min_tool_gap_over_dp']:6.2f} {fin}")
     lines.append("F: force of the block on the tool [MN/m = kN per mm of thickness], peak of the 400-bin history "
                  "and mean over the 2nd half; clamp: force on the clamped column (mean, 2nd half); eps p99: 99th "

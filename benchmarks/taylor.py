@@ -86,7 +86,7 @@ def plots(records):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     from refsph.io import load_run, load_snapshot
-    from refsph.reference import TAYLOR_RESULTS
+    from refsph.paper_data import TAYLOR_RESULTS
 
     FIG.mkdir(exist_ok=True)
     Lexp = TAYLOR_RESULTS["final_length_mm"]["experiment"]

@@ -38,9 +38,8 @@ import scipy  # noqa: E402
 
 import refsph  # noqa: E402
 from refsph.integrate import cfl_time_step, predictor_corrector_step  # noqa: E402
-from refsph.material import ElasticMaterial  # noqa: E402
 from refsph.neighbours import find_pairs  # noqa: E402
-from refsph.scenes import AISI4340_ELASTIC, Numerics, Setup, lattice  # noqa: E402
+from refsph.scenes import Numerics, Setup, aisi4340_material, lattice  # noqa: E402
 from refsph.simulate import make_solver  # noqa: E402
 from refsph.state import make_state  # noqa: E402
 
@@ -49,7 +48,7 @@ METHODS = ("esph", "tlsph")
 
 def block_setup(n_side: int, dp: float = 1.0e-4, v_rms: float = 1.0, seed: int = 2024) -> Setup:
     """n_side x n_side lattice block of AISI 4340 with random velocities of rms ``v_rms`` per component."""
-    mat = ElasticMaterial(**AISI4340_ELASTIC)
+    mat = aisi4340_material()
     x = lattice([n_side * dp, n_side * dp], dp)
     v = v_rms * np.random.default_rng(seed).standard_normal(x.shape)
     state = make_state(x, v, mat.rho0, dp * dp)

@@ -52,7 +52,7 @@ from pathlib import Path
 import numpy as np
 from scipy import integrate, special
 
-from refsph.kernels import CubicSpline, WendlandC2, get_kernel
+from refsph.kernels import get_kernel
 from refsph.neighbours import find_pairs, pair_count_per_particle, scatter_add
 
 QUICK = os.environ.get("REFSPH_QUICK", "0") == "1"

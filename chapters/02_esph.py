@@ -49,9 +49,9 @@ import matplotlib.pyplot as plt
 
 from refsph.esph import ESPHParams, esph_rates, velocity_gradient
 from refsph.kernels import get_kernel
-from refsph.material import ElasticMaterial, eos_pressure, jaumann_deviatoric_rate, von_mises
-from refsph.neighbours import find_pairs
-from refsph.scenes import AISI4340_ELASTIC, get_scene, lattice
+from refsph.material import eos_pressure, jaumann_deviatoric_rate, von_mises
+from refsph.neighbours import PairSum, find_pairs
+from refsph.scenes import aisi4340_material, get_scene, lattice
 from refsph.simulate import run, simulate
 from refsph.state import State
 
@@ -63,7 +63,7 @@ FIG = Path(os.environ["REFSPH_FIGURES"]) if os.environ.get("REFSPH_FIGURES") els
 FIG.mkdir(parents=True, exist_ok=True)
 T_START = time.perf_counter()
 
-mat = ElasticMaterial(**AISI4340_ELASTIC)       # AISI 4340, Table 3: rho0 = 7830 kg/m^3, E = 207 GPa, nu = 0.3
+mat = aisi4340_material()       # AISI 4340, Table 3: rho0 = 7830 kg/m^3, E = 207 GPa, nu = 0.3
 cubic = get_kernel("cubic")                     # Eq. (9)
 print(f"quick mode: {QUICK};  K = {mat.K / 1e9:.1f} GPa, G = {mat.G / 1e9:.1f} GPa, "
       f"C = sqrt(E/rho0) = {mat.c0:.0f} m/s")
@@ -288,8 +288,9 @@ v_l = x_l @ A_l.T
 I_l, J_l = find_pairs(x_l, 2.0 * h_l)
 dx_l = x_l[I_l] - x_l[J_l]
 gW_l = cubic.dw_dr_over_r(np.linalg.norm(dx_l, axis=1), h_l, 2)[:, None] * dx_l
-l_l = velocity_gradient(I_l, J_l, V_l, v_l[I_l] - v_l[J_l], gW_l, len(x_l))
-M_l = velocity_gradient(I_l, J_l, V_l, dx_l, gW_l, len(x_l))    # the same sum with v replaced by x
+pairs_l = PairSum(I_l, J_l, len(x_l))
+l_l = velocity_gradient(pairs_l, V_l, v_l[I_l] - v_l[J_l], gW_l)
+M_l = velocity_gradient(pairs_l, V_l, dx_l, gW_l)    # the same sum with v replaced by x
 err_l = np.linalg.norm(l_l - A_l, axis=(1, 2)) / np.linalg.norm(A_l)
 
 depth = np.minimum(x_l, n_side * dp_l - x_l).min(axis=1)     # distance to the nearest free surface
@@ -604,7 +605,7 @@ def print_tension(label, r, t_run):
 
 ten_scene = get_scene("tension")
 dp_ten = ten_scene.default_dp(2, QUICK)
-_s = ten_scene.build(2, dp_ten, QUICK)                  # only to print what the scene is
+_s = ten_scene.setup(2, dp_ten, QUICK)                  # only to print what the scene is
 c_L, SIDE = mat.c_longitudinal, _s.info["side"]
 print(f"scene 'tension': dp = {dp_ten * 1e3} mm, {_s.state.n} particles, edge velocity {_s.info['v_edge']:.0f} m/s, "
       f"beta1 = {_s.numerics.beta1}, beta2 = {_s.numerics.beta2}, "
@@ -628,7 +629,7 @@ assert rmin["ESPH, gamma = 0.3"] > rmin["ESPH, gamma = 0"] + 0.08  # ... the art
 # %%
 def old_tension_setup():
     """Scene 'tension' with the old settings: v_edge 50 m/s, beta1 = beta2 = 1.5, t_end = 6 side / c_L."""
-    setup = ten_scene.build(2, dp_ten, QUICK)
+    setup = ten_scene.setup(2, dp_ten, QUICK)
     side = setup.info["side"]
     setup.state.v[:] = 50.0 / (0.5 * side) * (setup.state.x - 0.5 * side)
     setup.info["v_edge"] = 50.0

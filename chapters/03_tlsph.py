@@ -48,9 +48,9 @@ import matplotlib.pyplot as plt
 from matplotlib.lines import Line2D
 
 from refsph.kernels import get_kernel
-from refsph.material import ElasticMaterial, von_mises
+from refsph.material import von_mises
 from refsph.neighbours import find_pairs
-from refsph.scenes import AISI4340_ELASTIC, lattice
+from refsph.scenes import aisi4340_material, lattice
 from refsph.simulate import SimulationError, run
 from refsph.state import make_state
 from refsph.tensor import det
@@ -65,7 +65,7 @@ FIG = Path(os.environ["REFSPH_FIGURES"]) if os.environ.get("REFSPH_FIGURES") els
 FIG.mkdir(parents=True, exist_ok=True)
 T_START = time.perf_counter()
 
-mat = ElasticMaterial(**AISI4340_ELASTIC)       # AISI 4340, Table 3: rho0 = 7830 kg/m^3, E = 207 GPa, nu = 0.3
+mat = aisi4340_material()       # AISI 4340, Table 3: rho0 = 7830 kg/m^3, E = 207 GPa, nu = 0.3
 kernel = get_kernel("cubic")                    # Eq. (9)
 print(f"quick mode: {QUICK};  K = {mat.K / 1e9:.1f} GPa, G = {mat.G / 1e9:.1f} GPa, "
       f"C = sqrt(E/rho) = {mat.c0:.0f} m/s")
@@ -812,7 +812,8 @@ for gamma in (0.0, 0.1, 0.3, 0.6, 1.0):
     st = sheared_state(gamma)
     out_b = {}
     a_b = tlsph_rates(st, mat, prm_u, op_u, out=out_b).v          # before the update
-    st_new, op_new = reference_update(st, op_u)
+    st_new = reference_update(st, op_u.deformation_gradient(st.x))
+    op_new = ReferenceOperator(st_new.X, st_new.V0, prm_u.h, kernel, True)
     out_a = {}
     a_a = tlsph_rates(st_new, mat, prm_u, op_new, out=out_a).v    # right after it (same x, v, stress)
     a_ex = exact_acceleration(X_u, gamma)

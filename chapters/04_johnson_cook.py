@@ -30,7 +30,7 @@
 #
 # 1. writes Eqs. (25)–(31) out, says what the paper leaves open and what `refsph` does there;
 # 2. implements the return map as a plain scalar loop, particle by particle, and checks
-#    `refsph.plasticity.plastic_update` against it on random trial stresses (3D and 2D plane strain);
+#    `refsph.strength.plastic_update` against it on random trial stresses (3D and 2D plane strain);
 # 3. shows why the strain rate of Eq. (26) is taken from the *total* deformation of the step, not from the
 #    previous step's plastic flow: the latter makes the stress chatter, worse the smaller the time step;
 # 4. drives one particle of the 4340 steel of the Taylor test in uniaxial stress and in simple shear and
@@ -44,7 +44,7 @@
 import math
 import os
 import time
-from dataclasses import replace
+from dataclasses import fields, replace
 from pathlib import Path
 
 import numpy as np
@@ -53,10 +53,11 @@ from scipy.integrate import solve_ivp
 
 from refsph.material import ElasticMaterial
 from refsph.material_point import material_point
-from refsph.plasticity import (JohnsonCook, equivalent_strain_rate, plastic_strain_increment, plastic_update,
+from refsph.plasticity import (JohnsonCook, ModifiedJohnsonCook, equivalent_strain_rate, plastic_strain_increment,
                                radial_return, yield_stress)
-from refsph.reference import AISI1045_RLA
-from refsph.taylor import taylor_johnson_cook, taylor_material
+from refsph.strength import plastic_update
+from refsph.paper_data import AISI1045_RLA
+from refsph.scenes.taylor import taylor_johnson_cook, taylor_material
 
 QUICK = os.environ.get("REFSPH_QUICK", "0") == "1"     # REFSPH_QUICK=1: fewer material-point steps (the tests)
 ROOT = Path.cwd().parent if Path.cwd().name == "chapters" else Path.cwd()
@@ -207,7 +208,7 @@ plt.show()
 def plain_yield_stress(jc, eps_p, eps_dot, T):
     """Eq. (25) for one particle, with the clamps of Section 1."""
     eps_p = max(eps_p, 0.0)
-    if jc.hardening_saturation_strain is not None:                 # modified law (Section 7)
+    if isinstance(jc, ModifiedJohnsonCook):                         # modified law (Section 7)
         eps_p = min(eps_p, jc.hardening_saturation_strain)
     rate_star = eps_dot / jc.eps_dot_0                              # Eq. (26)
     T_star = (T - jc.T_room) / (jc.T_melt - jc.T_room)              # Eq. (27)
@@ -255,7 +256,7 @@ def plain_return_map(s, s_zz, eps_p, T, rho, eps_dot, jc, G, heating=True):
 # AISI 1045 of Section 7 (hardening capped at $\bar\epsilon_p = 2$).
 
 # %%
-jc_1045 = JohnsonCook(A=AISI1045_RLA["A_Pa"], B=AISI1045_RLA["B_Pa"], n=AISI1045_RLA["n"], C=AISI1045_RLA["C"],
+jc_1045 = ModifiedJohnsonCook(A=AISI1045_RLA["A_Pa"], B=AISI1045_RLA["B_Pa"], n=AISI1045_RLA["n"], C=AISI1045_RLA["C"],
                       m=AISI1045_RLA["m"], eps_dot_0=AISI1045_RLA["eps_dot_0"], T_room=AISI1045_RLA["T_room_K"],
                       T_melt=AISI1045_RLA["T_melt_K"], cp=AISI1045_RLA["cp_J_kgK"],
                       chi=AISI1045_RLA["taylor_quinney"],
@@ -769,11 +770,12 @@ plt.show()
 # For AISI 1045 the second paper stops the hardening at $\bar\epsilon_p = 2$, where dislocation generation and
 # annihilation balance (their Eqs. 8–9):
 # $$\sigma_y = \big[A + B\min(\bar\epsilon_p, 2)^n\big]\big[1 + C\ln\dot\epsilon^*\big]\big[1 - T^{*m}\big].$$
-# In `refsph` this is `JohnsonCook(..., hardening_saturation_strain=2.0)`; `None` gives Eq. (25) as printed.
-# The constants are those of their Tables 1–2 (`refsph.reference.AISI1045_RLA`; $\dot\epsilon_0$ = 0.004 /s).
+# In `refsph` this is `ModifiedJohnsonCook(..., hardening_saturation_strain=2.0)`; `JohnsonCook(...)` gives Eq. (25)
+# as printed.
+# The constants are those of their Tables 1–2 (`refsph.paper_data.AISI1045_RLA`; $\dot\epsilon_0$ = 0.004 /s).
 
 # %%
-jc_1045_plain = replace(jc_1045, hardening_saturation_strain=None)
+jc_1045_plain = JohnsonCook(**{f.name: getattr(jc_1045, f.name) for f in fields(JohnsonCook)})
 ep4 = np.linspace(0.0, 4.0, 801)
 RATE_1045 = 1e4
 s_mod = yield_stress(jc_1045, ep4, RATE_1045, jc_1045.T_room)

@@ -44,13 +44,13 @@ import numpy as np
 import matplotlib.pyplot as plt
 from scipy.spatial import cKDTree
 
-import refsph.integrate as integrate
+import refsph.contact as contact_module
 from refsph.boundaries import RigidBody, RigidWall
 from refsph.contact import CoulombFriction, PinballContact, pinball_contact
 from refsph.integrate import cfl_time_step
-from refsph.material import ElasticMaterial, eos_pressure
-from refsph.reference import AISI1045_RLA
-from refsph.scenes import AISI4340_ELASTIC, Numerics, Scene, Setup, lattice
+from refsph.material import eos_pressure
+from refsph.paper_data import AISI1045_RLA
+from refsph.scenes import Numerics, Setup, aisi4340_material, lattice
 from refsph.simulate import simulate
 from refsph.state import concatenate_states, make_state
 
@@ -62,7 +62,7 @@ FIG = Path(os.environ["REFSPH_FIGURES"]) if os.environ.get("REFSPH_FIGURES") els
 FIG.mkdir(parents=True, exist_ok=True)
 T_START = time.perf_counter()
 
-mat = ElasticMaterial(**AISI4340_ELASTIC)     # AISI 4340, elastic constants of Table 3
+mat = aisi4340_material()     # AISI 4340, elastic constants of Table 3
 DP = 0.25e-3                                  # particle spacing [m] (the same in quick and full mode)
 NUM = Numerics(beta1=0.5, beta2=0.5)          # artificial viscosity of Tables 4-5; contact: the defaults
 H = NUM.h_over_dp * DP
@@ -335,7 +335,7 @@ assert min(branches.values()) > 0 and n_capped > 0               # every branch 
 
 # %% [markdown]
 # The same loop can watch a running solver. `ContactSpy` wraps the pinball call of the TLSPH solver
-# (`refsph.integrate.pinball_contact`, the name the solver looks up at every rate evaluation), runs the plain loop
+# (`refsph.contact.pinball_contact`, the name the solver looks up at every rate evaluation), runs the plain loop
 # on the same arguments, checks that both give the same forces, and keeps the pairs. It changes nothing in the
 # run; it is how Sections 3, 5 and 6 see which branch of Eq. (33) acted and how much friction there was.
 
@@ -349,7 +349,7 @@ class ContactSpy:
         self.worst = 0.0
 
     def __enter__(self):
-        self._original = integrate.pinball_contact
+        self._original = contact_module.pinball_contact
 
         def spy(x_a, v_a, m_a, x_b, v_b, m_b, R, mu_a, mu_b, dt, contact, thickness=1.0, T_a=None):
             out = self._original(x_a, v_a, m_a, x_b, v_b, m_b, R, mu_a, mu_b, dt, contact, thickness, T_a)
@@ -365,11 +365,11 @@ class ContactSpy:
             self.calls.append((dt, pairs, out.force_on_b.sum(axis=0)))
             return out
 
-        integrate.pinball_contact = spy
+        contact_module.pinball_contact = spy
         return self
 
     def __exit__(self, *exc):
-        integrate.pinball_contact = self._original
+        contact_module.pinball_contact = self._original
         return False
 
     def corrector(self):
@@ -452,9 +452,8 @@ def run_case(body, method, *, wall=None, numerics=NUM, t_end, dt=None, friction=
         return dict(t=s.t, Px=float(P[0]), Py=float(P[1]), dmin=dmin, face=float(xb[:, face_axis].min()),
                     KE=KE, E=KE + E_el)
 
-    scene = Scene("contact", "chapter 5", lambda dim, quick: DP, None, record, lambda h, s, st: {})
     t0 = time.perf_counter()
-    res = simulate(setup, method, progress=False, scene=scene, record_every=1, dt=dt)
+    res = simulate(setup, method, progress=False, record=record, record_every=1, dt=dt)
     out = {k: np.asarray(v) for k, v in res.history.items() if k != "reaction"}
     out.update(res=res, frames=frames, wall_s=time.perf_counter() - t0, n=n, body0=body,
                P0=np.sum(body.m[:, None] * body.v, axis=0), P1=np.sum(res.state.m[:n, None] * res.state.v[:n], axis=0))

@@ -51,11 +51,11 @@ from scipy.spatial import cKDTree
 from refsph.boundaries import MirrorPlanes, RigidWall
 from refsph.io import load_run, load_snapshot
 from refsph.plasticity import yield_stress
-from refsph.reference import TAYLOR_GEOMETRY, TAYLOR_RESULTS, TAYLOR_TABLE1, TAYLOR_TABLE2
+from refsph.paper_data import TAYLOR_GEOMETRY, TAYLOR_RESULTS, TAYLOR_TABLE1, TAYLOR_TABLE2
 from refsph.scenes import get_scene
 from refsph.simulate import make_solver, run
 from refsph.state import make_state
-from refsph.taylor import (bar_diameter, bar_length, comparison_table, taylor_johnson_cook, taylor_material,
+from refsph.scenes.taylor import (bar_diameter, bar_length, comparison_table, taylor_johnson_cook, taylor_material,
                            taylor_particles)
 
 QUICK = os.environ.get("REFSPH_QUICK", "0") == "1"     # REFSPH_QUICK=1: coarse runs (the tests use it)
@@ -97,10 +97,10 @@ print(f"quick mode: {QUICK};  2D spacing {1e3 * DP_2D} mm, 3D spacing {1e3 * DP_
 # %%
 mat = taylor_material()
 jc = taylor_johnson_cook(TAYLOR_TABLE1["T_melt_K"], 1.0)
-print("Table 1 (refsph.reference.TAYLOR_TABLE1):")
+print("Table 1 (refsph.paper_data.TAYLOR_TABLE1):")
 for k, v in TAYLOR_TABLE1.items():
     print(f"  {k:18s} {v:g}")
-print("Table 2 (refsph.reference.TAYLOR_TABLE2):")
+print("Table 2 (refsph.paper_data.TAYLOR_TABLE2):")
 for k, v in TAYLOR_TABLE2.items():
     print(f"  {k:32s} {v:g}")
 print(f"derived: E = {mat.E / 1e9:.1f} GPa, nu = {mat.nu:.3f}, c_L = sqrt((K + 4G/3)/rho) = {mat.c_longitudinal:.0f} m/s, "
@@ -241,7 +241,7 @@ scene = get_scene("taylor")
 rng = np.random.default_rng(6)
 for dim, dp, sym in ((2, 0.5e-3, True), (2, 0.5e-3, False), (2, 0.25e-3, True), (3, 1e-3, True),
                      (3, 0.5e-3, True), (3, 1e-3, False)):
-    st = scene.build(dim, dp, True, symmetry=sym)
+    st = scene.setup(dim, dp, True, symmetry=sym)
     info, x = st.info, st.state.x
     L_meas, D_meas = bar_length(x, info["dz"]), bar_diameter(x, info["dr"])
     assert abs(L_meas - L0) < 1e-12 and abs(D_meas - D0) < 1e-12          # exact at t = 0
@@ -295,7 +295,7 @@ def plain_ghosts(x, axes, cutoff):
 
 
 for dim, dp in ((3, 1e-3), (2, 0.5e-3)):
-    st = scene.build(dim, dp, True).state
+    st = scene.setup(dim, dp, True).state
     n, d = st.x.shape
     st.v = rng.normal(scale=50.0, size=(n, d))
     A = rng.normal(scale=1e8, size=(n, d, d))
@@ -334,7 +334,7 @@ for dim, dp in ((3, 1e-3), (2, 0.5e-3)):
 # missing neighbours correctly.
 
 # %%
-setup_q = scene.build(3, 1e-3, True)
+setup_q = scene.setup(3, 1e-3, True)
 solver_q = make_solver("tlsph", setup_q)
 st_q = setup_q.state.copy()
 A_st = np.diag([1.05, 1.02, 0.93])

@@ -55,9 +55,9 @@ from scipy.spatial import cKDTree
 from refsph.contact import PinballContact, pinball_contact
 from refsph.io import load_snapshot
 from refsph.plasticity import yield_stress
-from refsph.pressing import (TOOL_BODY, pressing_johnson_cook, pressing_material, pressing_particles,
-                             pressing_table)
-from refsph.reference import AISI4340_TABLE3, PRESSING_GEOMETRY, PRESSING_RESOLUTIONS_M, PRESSING_TABLE4
+from refsph.scenes.measure import TOOL_BODY, aisi4340_johnson_cook, aisi4340_material
+from refsph.scenes.pressing import pressing_particles, pressing_table
+from refsph.paper_data import AISI4340_TABLE3, PRESSING_GEOMETRY, PRESSING_RESOLUTIONS_M, PRESSING_TABLE4
 from refsph.scenes import elastic_energy, get_scene
 from refsph.simulate import run
 
@@ -93,12 +93,12 @@ print(f"quick mode: {QUICK};  spacing dp = {1e3 * DP:.5f} mm;  run folders in {T
 # $\dot\varepsilon_0$ is not printed; `refsph` uses 1/s, as for the Taylor bar.
 
 # %%
-mat = pressing_material()
-jc = pressing_johnson_cook(1.0)
-print("Table 3 (refsph.reference.AISI4340_TABLE3):")
+mat = aisi4340_material()
+jc = aisi4340_johnson_cook(1.0)
+print("Table 3 (refsph.paper_data.AISI4340_TABLE3):")
 for k, v in AISI4340_TABLE3.items():
     print(f"  {k:16s} {v:g}")
-print("Table 4 (refsph.reference.PRESSING_TABLE4):")
+print("Table 4 (refsph.paper_data.PRESSING_TABLE4):")
 for k, v in PRESSING_TABLE4.items():
     print(f"  {k:32s} {v:g}")
 c_L, c_B = mat.c_longitudinal, math.sqrt(mat.K / mat.rho0)
@@ -120,7 +120,7 @@ print(f"the tool speed is {V_TOOL / c_L:.3f} c_L; an elastic wave crosses the bl
 #
 # The paper gives the sizes (block 1.0 × 0.5 × 0.1 mm, tool 0.1 × 0.7 × 0.1 mm), the tool speed, the spacing
 # and the particle counts of its 3D run, and says "the left side of the metal block is fixed". Everything else
-# is a choice; `refsph.pressing` makes these, each with its reason:
+# is a choice; `refsph.scenes.pressing` makes these, each with its reason:
 #
 # * **Plane strain** instead of the 3D slab: the model is the slab's mid-plane, per metre of thickness. The
 #   paper does not say whether the slab's front and back faces are free or held; a free 0.1 mm slab, five
@@ -165,7 +165,7 @@ def plain_layout(dp, layers):
 
 scene = get_scene("pressing")
 for dp in PRESSING_RESOLUTIONS_M:
-    st = scene.build(2, dp, True)
+    st = scene.setup(2, dp, True)
     layers = st.info["tool_layers"]
     pb, pt, pdx, pdy, pcl, prow = plain_layout(dp, layers)
     xb, xt, dx, dy, clamp, line = pressing_particles(dp, layers)
@@ -190,7 +190,7 @@ print(f"the paper's 3D block: 184,624 particles; a lattice of 1/150 mm would hav
 # its spacing.
 
 # %%
-st0 = scene.build(2, DP, True)
+st0 = scene.setup(2, DP, True)
 n_b = st0.info["n_block"]
 x0 = st0.state.x
 fig, ax = plt.subplots(figsize=(8, 4.6), constrained_layout=True)
@@ -198,7 +198,7 @@ ms = 6 if QUICK else 1.2
 ax.plot(1e3 * x0[:n_b, 0], 1e3 * x0[:n_b, 1], ".", ms=ms, color="0.55", label="block (AISI 4340)")
 cl = st0.clamps[0].index
 ax.plot(1e3 * x0[cl, 0], 1e3 * x0[cl, 1], "s", ms=ms, color="k", label="clamped column (v = 0)")
-ln = st0.info["line_index"]
+ln = st0.arrays["line_index"]
 ax.plot(1e3 * x0[ln, 0], 1e3 * x0[ln, 1], ".", ms=ms, color="C2", label="mid-height row (Fig. 8 line)")
 ax.plot(1e3 * x0[n_b:, 0], 1e3 * x0[n_b:, 1], ".", ms=ms, color="C1", label="rigid tool, 3 columns")
 ax.annotate("", xy=(1.2, 0.25), xytext=(1.35, 0.25), arrowprops=dict(arrowstyle="->", lw=2))

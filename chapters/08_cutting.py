@@ -33,7 +33,7 @@
 #    boundary, and every choice the paper leaves open, with a plain-Python version of the layout checked against
 #    the package;
 # 2. defines the measurements in plain form (forces, chip thickness and the shear angle from it, the shear bands)
-#    and checks a plain-Python version of the band measure against `refsph.cutting.shear_bands` on a field with
+#    and checks a plain-Python version of the band measure against `refsph.scenes.cutting.shear_bands` on a field with
 #    known bands;
 # 3. runs both methods at a reduced size (quick mode: dp = 0.05 mm and 0.3 mm of cut; full mode: dp = 0.025 mm
 #    and 1 mm of cut), shows the chip, its plastic strain and temperature, the forces, the bands, a hand estimate
@@ -59,13 +59,14 @@ from matplotlib.patches import Patch
 from scipy.signal import find_peaks
 from scipy.spatial import cKDTree
 
-from refsph.cutting import (BAND_REL_PROMINENCE, CUTTING_GEOMETRY, STEADY_FROM, TOOL_BODY, chip_thickness,
-                            cutting_particles, cutting_table, lattice_shape, shear_bands)
+from refsph.scenes.cutting import (BAND_REL_PROMINENCE, STEADY_FROM, chip_thickness, cutting_particles, cutting_table,
+                                   lattice_shape, shear_bands)
+from refsph.scenes.measure import TOOL_BODY
 from refsph.integrate import cfl_time_step
 from refsph.io import load_snapshot
 from refsph.plasticity import yield_stress
 from refsph.plots import particle_field
-from refsph.reference import AISI1045_RLA, AISI4340_TABLE3, CUTTING_OBSERVED, CUTTING_TABLE5
+from refsph.paper_data import AISI1045_RLA, AISI4340_TABLE3, CUTTING_GEOMETRY, CUTTING_OBSERVED, CUTTING_TABLE5
 from refsph.scenes import get_scene
 from refsph.simulate import SimulationError, run
 
@@ -107,20 +108,14 @@ print(f"quick mode: {QUICK};  spacing dp = {1e3 * DP:.3f} mm, {1e3 * TRAVEL:.1f}
 
 # %%
 scene = get_scene("cutting")
-st_paper = scene.build(2, DP_PAPER, False, feed=FEEDS[0])
-mat, jc, num = st_paper.material, st_paper.plasticity, st_paper.numerics
-assert (jc.A, jc.B, jc.n, jc.C, jc.m) == tuple(AISI4340_TABLE3[k] for k in ("A_Pa", "B_Pa", "n", "C", "m"))
-assert (jc.T_room, jc.T_melt, jc.cp, jc.chi) == tuple(AISI4340_TABLE3[k] for k in ("T_room_K", "T_melt_K",
-                                                                                     "cp_J_kgK", "taylor_quinney"))
-assert (mat.E, mat.nu, mat.rho0) == (AISI4340_TABLE3["E_Pa"], AISI4340_TABLE3["nu"], AISI4340_TABLE3["rho"])
-print("Table 3 (refsph.reference.AISI4340_TABLE3):")
+st_paper = scene.setup(2, DP_PAPER, False, feed=FEEDS[0])
+mat, jc, num = st_paper.material, st_paper.strength, st_paper.numerics
+print("Table 3 (refsph.paper_data.AISI4340_TABLE3):")
 for k, v in AISI4340_TABLE3.items():
     print(f"  {k:16s} {v:g}")
-print("Table 5 (refsph.reference.CUTTING_TABLE5):")
+print("Table 5 (refsph.paper_data.CUTTING_TABLE5):")
 for k, v in CUTTING_TABLE5.items():
     print(f"  {k:32s} {v:g}")
-h_paper = CUTTING_TABLE5["smoothing_length_m"]
-assert abs(st_paper.h / h_paper - 1) < 1e-12 and (num.beta1, num.beta2) == (CUTTING_TABLE5["beta1"], CUTTING_TABLE5["beta2"])
 print(f"scene numerics: h/dp = {num.h_over_dp:.2f}, beta1 = beta2 = {num.beta1}, ESPH gamma = {num.gamma}, Courant "
       f"{num.courant}, TLSPH reference update at max|E| > {num.ref_update_strain}, ESPH Verlet skin {num.skin_factor} h, "
       f"pinball K_p = {num.contact_Kp}")
@@ -137,7 +132,7 @@ print(f"CFL step at dp = 0.01 mm (Courant {num.courant}, c_L + v_tool): {dt_cfl:
 #
 # The paper gives the sizes, the tool speed, the material, "no friction between the workpiece and the cutting
 # tool", the pinball contact for TLSPH, and Table 5. Its set-up figure (Fig. 11) is not in the text we have.
-# Everything else is a choice; `refsph.cutting` makes these, each with its reason:
+# Everything else is a choice; `refsph.scenes.cutting` makes these, each with its reason:
 #
 # * **2D plane strain**, per metre of thickness: orthogonal cutting is the textbook plane-strain process (the cut
 #   is wide compared with the feed), and the paper's own figures are 2D sections.
@@ -192,7 +187,7 @@ def plain_layout(dp, feed, layers):
 
 for dp in (DP, DP_PAPER):
     for feed in FEEDS:
-        st = scene.build(2, dp, False, feed=feed) if dp != DP_PAPER or feed != FEEDS[0] else st_paper
+        st = scene.setup(2, dp, False, feed=feed) if dp != DP_PAPER or feed != FEEDS[0] else st_paper
         info = st.info
         layers = math.ceil(2 * st.h / dp - 1e-9)
         assert layers == info["tool_layers"]
@@ -215,7 +210,7 @@ for dp in (DP, DP_PAPER):
               f"y = {1e3 * (s.x[n:, 1].min() - 0.5 * dy):.3f} mm; h = {1e3 * st.h:.4f} mm; run to {1e6 * st.t_end:.0f} us")
 
 # %%
-st0 = scene.build(2, DP, False, feed=FEEDS[0])
+st0 = scene.setup(2, DP, False, feed=FEEDS[0])
 n0, info0 = st0.info["n_work"], st0.info
 nx0, ny0 = lattice_shape(info0)
 X0 = st0.state.x[:n0]
@@ -302,7 +297,7 @@ def plain_time_mean(t, dt, f, t_from, t_to=np.inf):
 #
 # The workpiece particles start on a lattice, so their plastic strain $\varepsilon_p[i, j]$ (column $i$, row $j$)
 # is a field over the **undeformed** workpiece: material coordinates, in which a chip segment is simply a stretch of
-# the cut layer between two lines of high strain. `refsph.cutting.shear_bands` measures the bands there:
+# the cut layer between two lines of high strain. `refsph.scenes.cutting.shear_bands` measures the bands there:
 #
 # 1. **Profile along the chip**: $\varepsilon_p(i)$ along the middle row $j_m$ of the cut layer (the row whose
 #    cell holds $y_0 + f/2$; the cut layer has an even number of rows at every spacing used here, so that point is
@@ -805,7 +800,7 @@ if KU in res and KN in res:
 # process per run, which shares its pair sums out to threads on the cores it has (all of them with the default
 # `--jobs 1`, one each with `--jobs 2`; `Numerics.threads`, which changes the speed, not the numbers). It writes
 # `benchmarks/cutting.json` (one record per run, the measurements
-# recomputed from each run's files with `refsph.cutting.analyse_run`) and the figures shown below. This section
+# recomputed from each run's files with `refsph.scenes.cutting.analyse_run`) and the figures shown below. This section
 # prints its table.
 
 # %%

@@ -1,5 +1,6 @@
 """Boundaries that a scene may need: symmetry planes (mirror ghosts), a rigid frictionless wall, rigid bodies
-(tools) of prescribed velocity and clamps.
+(tools) of prescribed motion and clamps, and :class:`Constraints`, which applies the last three in a run and
+keeps the reaction log (the force on every tool and clamp at every step).
 
 The paper does not say how its Taylor bar meets the wall or whether it uses symmetry; these are the standard
 choices, stated here and in chapter 06.
@@ -26,14 +27,15 @@ wall gives is the sum of m (v_a,after - v_a,before).
 It is the simplest thing that a Taylor impact needs; tools are :class:`RigidBody` particles (below).
 
 **Rigid body** (the paper's tools, Section 2.4): particles of their own body id (``State.body``) that move
-with a prescribed velocity V,
+with a prescribed velocity V (and, if given, turn with a prescribed angular velocity, :class:`RigidBody`),
 
     x_i(t) = x_i(0) + V t,   v_i = V,
 
 made only of the layers that can touch the workpiece. They carry no constitutive stress. How they act on the
 workpiece is the method's: in ESPH they are ordinary SPH neighbours (their density is integrated by the
-continuity equation, Eq. 10, and floored at rho0, so their own pressure K (rho/rho0 - 1) is never negative;
-a workpiece particle in tension still pulls on them through its own stress term of Eq. 11); in TLSPH they are partners of the pinball contact (:mod:`refsph.contact`). The solvers record
+continuity equation, Eq. (10), and floored at rho0, so their own pressure K (rho/rho0 - 1) is never negative;
+a workpiece particle in tension still pulls on them through its own stress term of Eq. (11)); in TLSPH they
+are partners of the pinball contact (:mod:`refsph.contact`). The solvers record
 the force the rest of the system exerts on each body at every step.
 
 **Clamp** (the fixed left side of the pressing block): particles *of the deformable body* whose velocity is
@@ -47,9 +49,9 @@ from itertools import combinations
 
 import numpy as np
 
-from .state import State
+from .state import Rates, State
 
-__all__ = ["MirrorPlanes", "Ghosts", "RigidWall", "RigidBody", "Clamp"]
+__all__ = ["MirrorPlanes", "Ghosts", "RigidWall", "RigidBody", "Clamp", "Constraints"]
 
 
 @dataclass(frozen=True)
@@ -182,14 +184,21 @@ class RigidWall:
 
 @dataclass(frozen=True)
 class RigidBody:
-    """A rigid body of prescribed translation: the particles with ``State.body == body`` move with
-    ``velocity`` (m/s, a d-vector): x(t) = x(0) + V t. ``body`` must be a positive id (0 is the workpiece);
-    its particles must come after every deformable particle in the state (the solvers work on the leading
-    deformable rows as one block)."""
+    """A rigid body of prescribed motion: the particles with ``State.body == body`` translate with ``velocity``
+    V (m/s, a d-vector) and turn with ``angular_velocity`` omega (rad/s; 2D: a number, about +z; 3D: a vector)
+    about ``centre`` (the point c0 it turns about at the start; None: the centroid of its particles then):
+
+        c(t) = c0 + V t,   x_i(t) = c(t) + R(omega t) (x_i(0) - c0),   v_i = V + omega x (x_i - c(t)).
+
+    ``body`` must be a positive id (0 is the workpiece); its particles must come after every deformable
+    particle in the state (the solvers work on the leading deformable rows as one block) and start with the
+    velocity of this motion (:meth:`velocity_at`)."""
 
     name: str
     body: int
     velocity: tuple
+    angular_velocity: float | tuple = 0.0
+    centre: tuple | None = None
 
     def __post_init__(self):
         if isinstance(self.body, bool) or not isinstance(self.body, (int, np.integer)) or self.body < 1:
@@ -198,11 +207,64 @@ class RigidBody:
         if v.ndim != 1 or not np.all(np.isfinite(v)):
             raise ValueError(f"rigid body velocity must be a finite vector, got {self.velocity!r}")
         object.__setattr__(self, "velocity", tuple(float(c) for c in v))
+        w = np.asarray(self.angular_velocity, dtype=float)
+        if w.ndim > 1 or not np.all(np.isfinite(w)):
+            raise ValueError(f"rigid body angular velocity must be a finite number (2D) or vector (3D), "
+                             f"got {self.angular_velocity!r}")
+        object.__setattr__(self, "angular_velocity", float(w) if w.ndim == 0 else tuple(float(c) for c in w))
+        if self.centre is not None:
+            c = np.asarray(self.centre, dtype=float)
+            if c.ndim != 1 or not np.all(np.isfinite(c)):
+                raise ValueError(f"rigid body centre must be a finite point, got {self.centre!r}")
+            object.__setattr__(self, "centre", tuple(float(a) for a in c))
+
+    @property
+    def rotates(self) -> bool:
+        return bool(np.any(np.asarray(self.angular_velocity) != 0.0))
 
     def check(self, d: int) -> None:
         if len(self.velocity) != d:
             raise ValueError(f"rigid body {self.name!r}: velocity has {len(self.velocity)} components, "
                              f"the state is {d}D")
+        w = np.asarray(self.angular_velocity)
+        if (d == 2 and w.ndim != 0) or (d == 3 and w.shape not in ((), (3,))) or (d == 3 and w.ndim == 0 and w != 0):
+            raise ValueError(f"rigid body {self.name!r}: angular velocity must be a number in 2D (about z) and a "
+                             f"3-vector in 3D, got {self.angular_velocity!r}")
+        if self.centre is not None and len(self.centre) != d:
+            raise ValueError(f"rigid body {self.name!r}: centre has {len(self.centre)} components, the state is {d}D")
+
+    def _omega3(self) -> np.ndarray:
+        w = np.asarray(self.angular_velocity, dtype=float)
+        return np.array([0.0, 0.0, float(w)]) if w.ndim == 0 else w
+
+    def spin(self, r: np.ndarray) -> np.ndarray:
+        """omega x r for offsets r (n, d) from the centre."""
+        w = self._omega3()
+        if r.shape[1] == 2:
+            return w[2] * np.stack([-r[:, 1], r[:, 0]], axis=1)
+        return np.cross(w, r)
+
+    def velocity_at(self, x: np.ndarray, centre=None) -> np.ndarray:
+        """v = V + omega x (x - c) of particles at x (n, d); c: the centre (default ``centre``, else the
+        centroid of x). Use it to give the body's particles their starting velocity."""
+        x = np.asarray(x, dtype=float)
+        c = np.asarray(centre if centre is not None else (self.centre if self.centre is not None
+                                                          else x.mean(axis=0)), dtype=float)
+        return np.asarray(self.velocity) + self.spin(x - c)
+
+    def rotation(self, t: float, d: int) -> np.ndarray:
+        """R(omega t), (d, d): 2D rotation by omega t; 3D Rodrigues' formula about omega / |omega|."""
+        w = self._omega3()
+        if d == 2:
+            a = w[2] * t
+            return np.array([[np.cos(a), -np.sin(a)], [np.sin(a), np.cos(a)]])
+        speed = float(np.linalg.norm(w))
+        if speed == 0.0:
+            return np.eye(3)
+        k = w / speed
+        K = np.array([[0.0, -k[2], k[1]], [k[2], 0.0, -k[0]], [-k[1], k[0], 0.0]])
+        a = speed * t
+        return np.eye(3) + np.sin(a) * K + (1.0 - np.cos(a)) * K @ K
 
 
 @dataclass(frozen=True, eq=False)
@@ -220,3 +282,170 @@ class Clamp:
 
     def to_dict(self) -> dict:
         return dict(name=self.name, n_particles=int(len(self.index)))
+
+
+class Constraints:
+    """The prescribed motions of a run and what they cost: rigid walls, rigid bodies and clamps, and the reaction
+    log (the force the rest of the system exerts on each rigid body and clamp, every step).
+
+    A solver owns one and calls it at three points of every stage of a step:
+
+    * :meth:`bind` once, on the initial state (which rows are rigid; rigid rows come last);
+    * :meth:`constrain` on the rates: the force on each body / clamp is kept (sum m dv/dt over its rows of the
+      unconstrained rates; pairs inside one body cancel), then rigid rows get dv/dt = 0 and no stress rate and
+      clamped rows dx/dt = dv/dt = 0;
+    * :meth:`apply` on the state the stage produced: walls (a unilateral constraint), the exact rigid motion (no
+      drift from round-off: a translating body's velocity is reset to V, a turning body is placed by its closed
+      form), clamps back in place; on the final stage, the step's forces go into the log.
+    """
+
+    def __init__(self, walls=(), rigid=(), clamps=(), mirror: MirrorPlanes | None = None):
+        self.walls = tuple(walls or ())
+        self.rigid = tuple(rigid or ())
+        self.clamps = tuple(clamps or ())
+        names = self.reaction_names
+        if len(set(names)) != len(names):
+            raise ValueError(f"rigid bodies and clamps need distinct names, got {names}")
+        for name in names:
+            if name in ("t", "dt") or not name or not all(ch.isalnum() or ch in "_-" for ch in name):
+                raise ValueError(f"rigid body / clamp name {name!r}: use letters, digits, '_' or '-' "
+                                 "(not 't' or 'dt', the time columns of the reaction log)")
+        ids = [b.body for b in self.rigid]
+        if len(set(ids)) != len(ids):
+            raise ValueError(f"rigid bodies need distinct body ids, got {ids}")
+        if self.rigid and mirror is not None:
+            raise ValueError("rigid bodies together with symmetry planes are not implemented")
+        if self.rigid and self.walls:
+            raise ValueError("rigid bodies together with RigidWall are not implemented (make the wall a rigid "
+                             "body of particles)")
+        self.wall_impulse = np.zeros(len(self.walls))
+        self.n_deformable: int | None = None   # rows [0, n_deformable) are deformable, the rest rigid
+        self.dim: int | None = None
+        self.rows: list[slice] = []            # the rows of each rigid body
+        self._start: list[tuple | None] = []   # per turning body: (t0, c0, x0 - c0)
+        self._reaction: list[np.ndarray] | None = None      # force on each rigid body / clamp, last evaluation
+        self.reaction_log: list[list[float]] = []           # per step: t_mid, dt, then d components per body/clamp
+        self.reaction_impulse = [0.0 for _ in names]
+
+    @property
+    def reaction_names(self) -> list[str]:
+        """Names of the rigid bodies and clamps, in the order of the reaction log."""
+        return [b.name for b in self.rigid] + [c.name for c in self.clamps]
+
+    def bind(self, state: State) -> None:
+        """Check the state against the constraints and find the rigid rows (ValueError naming what is wrong)."""
+        n = state.n
+        self.dim = state.dim
+        for w in self.walls:
+            w.check(state.dim)
+        self.rows, self._start = [], []
+        if self.rigid and state.body is None:
+            raise ValueError("rigid bodies need State.body (the body id of every particle)")
+        for b in self.rigid:
+            self.rows.append(self._body_rows(b, state))
+        n_def = min((r.start for r in self.rows), default=n)
+        if sum(r.stop - r.start for r in self.rows) != n - n_def:
+            raise ValueError("rigid body particles must come after every deformable particle in the state")
+        self.n_deformable = n_def
+        if state.body is not None and np.any(state.body[:n_def] != 0):
+            other = sorted(set(np.unique(state.body[:n_def]).tolist()) - {0})
+            raise ValueError(f"body ids {other} are not declared as rigid bodies; the deformable workpiece is "
+                             "body 0 (a second deformable body is not implemented)")
+        for c in self.clamps:
+            if c.index[-1] >= n_def:
+                raise ValueError(f"clamp {c.name!r} holds particle {c.index[-1]}, which is not a deformable one")
+
+    def _body_rows(self, b: RigidBody, state: State) -> slice:
+        b.check(state.dim)
+        idx = np.flatnonzero(state.body == b.body)
+        if len(idx) == 0:
+            raise ValueError(f"rigid body {b.name!r}: no particle has body id {b.body}")
+        if idx[-1] - idx[0] + 1 != len(idx):
+            raise ValueError(f"rigid body {b.name!r}: its particles must be consecutive rows")
+        rows = slice(int(idx[0]), int(idx[-1]) + 1)
+        x = state.x[rows]
+        if not b.rotates:
+            self._start.append(None)
+            ok = np.all(state.v[rows] == np.asarray(b.velocity))
+        else:
+            c0 = np.asarray(b.centre) if b.centre is not None else x.mean(axis=0)
+            self._start.append((state.t, c0, x - c0))
+            v = b.velocity_at(x, c0)
+            ok = np.allclose(state.v[rows], v, rtol=1e-12, atol=1e-12 * np.max(np.abs(v)))
+        if not ok:
+            raise ValueError(f"rigid body {b.name!r}: its particles must start with its velocity "
+                             f"{b.velocity}" + (" turning at " + str(b.angular_velocity) + " rad/s (give them "
+                                                "RigidBody.velocity_at(x))" if b.rotates else ""))
+        return rows
+
+    def constrain(self, state: State, r: Rates) -> Rates:
+        """Prescribed motion on the rates (in place), after keeping the force on each body and clamp."""
+        if not self.rigid and not self.clamps:
+            return r
+        forces = []
+        for rows in self.rows:
+            forces.append(np.sum(state.m[rows, None] * r.v[rows], axis=0))
+            r.v[rows] = 0.0
+            r.x[rows] = state.v[rows]
+            r.S[rows] = 0.0
+            r.S_zz[rows] = 0.0
+        for c in self.clamps:
+            forces.append(np.sum(state.m[c.index, None] * r.v[c.index], axis=0))
+            r.v[c.index] = 0.0
+            r.x[c.index] = 0.0
+        self._reaction = forces
+        return r
+
+    def apply(self, old: State, new: State, dt: float, final: bool, rho_floor: float | None = None) -> State:
+        """Walls, rigid motion and clamps on the state a stage produced (in place); ``rho_floor``: ESPH keeps a
+        tool's density (Eq. (10)) at or above it, so that its own pressure is never negative."""
+        for k, wall in enumerate(self.walls):
+            imp = wall.apply(new, dt)
+            if final:
+                self.wall_impulse[k] += imp
+        for b, rows, start in zip(self.rigid, self.rows, self._start):
+            if start is None:
+                new.v[rows] = np.asarray(b.velocity)
+            else:
+                t0, c0, r0 = start
+                t = old.t + dt - t0
+                c = c0 + np.asarray(b.velocity) * t
+                r = r0 @ b.rotation(t, new.dim).T
+                new.x[rows] = c + r
+                new.v[rows] = np.asarray(b.velocity) + b.spin(r)
+            if rho_floor is not None:
+                new.rho[rows] = np.maximum(new.rho[rows], rho_floor)
+        for c in self.clamps:
+            new.v[c.index] = 0.0
+            new.x[c.index] = old.x[c.index]
+        if final and self._reaction is not None:
+            self.reaction_log.append([old.t + 0.5 * dt, dt] + [float(c) for f in self._reaction for c in f])
+            for k, f in enumerate(self._reaction):
+                self.reaction_impulse[k] = self.reaction_impulse[k] + f * dt
+        return new
+
+    def reaction_history(self) -> dict:
+        """{'t': (n_steps,), 'dt': (n_steps,), name: (n_steps, d) force on that rigid body / clamp} (N; 2D: N per
+        metre of thickness), one row per step at the step's midpoint t (the time of the rates that moved it);
+        dt is the step's size, so sum(F dt) is the impulse."""
+        names = self.reaction_names
+        if not names or self.dim is None:
+            return {}
+        d = self.dim
+        log = np.asarray(self.reaction_log, dtype=float).reshape(-1, 2 + d * len(names))
+        out = {"t": log[:, 0], "dt": log[:, 1]}
+        for k, name in enumerate(names):
+            out[name] = log[:, 2 + k * d: 2 + (k + 1) * d]
+        return out
+
+    def diagnostics(self) -> dict:
+        out = {}
+        if self.walls:
+            # impulse of each wall on the *model* (a quarter/half of the body with symmetry planes), N s (2D: N s/m)
+            out["wall_impulse"] = [float(i) for i in self.wall_impulse]
+        if self.reaction_names:
+            # impulse the rest of the system gave each rigid body / clamp, N s (2D: N s/m); note the sign
+            # convention differs from wall_impulse, which is the impulse the wall gave the model
+            out["reaction_impulse"] = {name: [float(c) for c in np.atleast_1d(imp)]
+                                       for name, imp in zip(self.reaction_names, self.reaction_impulse)}
+        return out

@@ -8,6 +8,7 @@ import sys
 import numpy as np
 
 from .scenes import SCENES, Numerics, parse_bool
+from .scenes.base import numerics_field_optional
 from .simulate import METHODS, SimulationError, run
 
 
@@ -57,7 +58,7 @@ def main(argv=None) -> int:
         return 2
     scene = SCENES[args.scene]
     try:
-        options = _parse_options(args.option)          # checked and converted by run() (scenes.convert_options)
+        options = _parse_options(args.option)          # checked and converted by run() (Scene.setup)
         options.update(_option_flags(extra, scene))
         numerics = _parse_numerics(args.set)
     except ValueError as e:
@@ -94,7 +95,7 @@ def main(argv=None) -> int:
 
 
 def _parse_options(items) -> dict:
-    """NAME=VALUE strings -> {name: 'VALUE'}; :func:`refsph.scenes.convert_options` checks and converts them."""
+    """NAME=VALUE strings -> {name: 'VALUE'}; :meth:`refsph.scenes.Scene.setup` checks and converts them."""
     out = {}
     for item in items:
         if "=" not in item:
@@ -129,7 +130,6 @@ def _option_flags(tokens, scene) -> dict:
 def _parse_numerics(items) -> dict:
     """NAME=VALUE strings -> Numerics overrides, each converted like the field's default ('none' for None)."""
     defaults = {f.name: f.default for f in dataclasses.fields(Numerics)}
-    optional = {f.name for f in dataclasses.fields(Numerics) if "None" in str(f.type)}
     out = {}
     for item in items:
         name, eq, value = item.partition("=")
@@ -138,7 +138,7 @@ def _parse_numerics(items) -> dict:
         if name not in defaults:
             raise ValueError(f"unknown numerical parameter {name!r} (known: {', '.join(defaults)})")
         d = defaults[name]
-        if value.lower() == "none" and name in optional:
+        if value.lower() == "none" and numerics_field_optional(name):
             out[name] = None
         elif isinstance(d, bool):
             out[name] = parse_bool(value, f"--set {name}")

@@ -1,4 +1,4 @@
-"""Pinball contact of TLSPH (Section 2.4, Eqs. 32-36), with a place for a friction law.
+"""Pinball contact of TLSPH (Section 2.4, Eqs. (32)-(36)), with a place for a friction law.
 
 TLSPH cannot let two bodies meet through the SPH sums (its kernels live in each body's reference
 configuration), so the paper adds the pinball contact of Campbell, Vignjevic & Libersky (2000, Comput. Methods
@@ -15,17 +15,17 @@ e_ij = x_ij / r:
 What is implemented, exactly, where the printed equations leave a choice:
 
 - **Penetration rate.** The paper prints pdot_d = |vdot_i - vdot_j| (accelerations, and never negative, so the
-  case pdot_d < 0 of Eq. 34 could not occur). We use the rate of Eq. (32): pdot_d = -(v_i - v_j) . e_ij,
+  case pdot_d < 0 of Eq. (34) could not occur). We use the rate of Eq. (32): pdot_d = -(v_i - v_j) . e_ij,
   positive while the particles approach. With it Eq. (34) is the force that removes the approach velocity of
   the pair within one step (the pinball idea), and zero while they separate.
 - **Effective mass.** Eq. (34) prints rho_i rho_j R_i^3 R_j^3 / (rho_i R_i^3 + rho_j R_j^3), the reduced mass
   of two spheres up to the factor 4 pi / 3. We use the particles' own masses, m_ij = m_i m_j / (m_i + m_j), so
   that F1 stops the approach of the particles as they are (and has the right units in 2D, where masses are
   per unit thickness). For a rigid partner (m_j = infinity) m_ij = m_i.
-- **Hertz modulus.** mu is the shear modulus (the units of Eq. 35 need a modulus; the paper's Table 3 gives E
+- **Hertz modulus.** mu is the shear modulus (the units of Eq. (35) need a modulus; the paper's Table 3 gives E
   and nu, from which G = E / (2 (1 + nu))); mu_ij = mu_i mu_j / (mu_i + mu_j), = mu_i for a rigid partner.
 - **2D.** Eq. (35) is a force between spheres. In plane strain a particle stands for a row of particles at
-  spacing dp through the thickness, so the force per unit thickness is F2 / dp (Eq. 34 is per unit thickness
+  spacing dp through the thickness, so the force per unit thickness is F2 / dp (Eq. (34) is per unit thickness
   already, through the masses).
 - **Influence radius.** R = k h with k = dp / (2 h) (1/3 for h = 1.5 dp): two bodies whose surface particles
   sit one spacing apart are just touching, as their faces (centres +- dp/2) are. K_p = 50 (``Numerics.contact_Kp``).
@@ -41,12 +41,12 @@ particles is the force on the body. Without friction nothing acts along the surf
 
 **Friction (off by default).** A :class:`CoulombFriction` adds, per contact pair, a tangential force against
 the relative sliding velocity v_t = v_ij - (v_ij . e) e (second paper, Rodriguez Prieto, Larsson & Afrasiabi,
-Eqs. 10-11):
+Eqs. (10)-(11)):
 
     f_t = - min(mu(T) F_ij, m_ij |v_t| / dt) v_t / |v_t|,   mu(T) = mu0 (1 - ((T - T_r)/(T_m - T_r))^q)
 
 with T the temperature of the deformable particle. The cap m_ij |v_t| / dt (sticking) keeps friction from
-reversing the sliding within a step. The frictional heat (their Eq. 7) is not added: refsph has no heat
+reversing the sliding within a step. The frictional heat (their Eq. (7)) is not added: refsph has no heat
 conduction, which is where that heat would go.
 """
 from __future__ import annotations
@@ -62,7 +62,7 @@ __all__ = ["PinballContact", "CoulombFriction", "ContactResult", "penetration", 
 
 @dataclass(frozen=True)
 class CoulombFriction:
-    """Coulomb friction with a temperature-dependent coefficient (second paper, Eqs. 10-11):
+    """Coulomb friction with a temperature-dependent coefficient (second paper, Eqs. (10)-(11)):
     mu(T) = mu0 (1 - ((T - T_room)/(T_melt - T_room))^q), clipped to [0, mu0]. No defaults (material data)."""
 
     mu0: float
@@ -139,7 +139,7 @@ def pinball_force(p_d, pdot, m_ij, mu_ij, R_i, R_j, dt, K_p, thickness=1.0):
 @dataclass
 class ContactResult:
     """Forces of one contact evaluation. ``a``: (n_a, d) acceleration added to each particle of the
-    deformable set (Eq. 36); ``force_on_b``: (n_b, d) force on each partner particle (the reaction, equal and
+    deformable set (Eq. (36)); ``force_on_b``: (n_b, d) force on each partner particle (the reaction, equal and
     opposite pair by pair); ``n_contacts``: pairs with p_d > 0; ``max_penetration``: max p_d [m] (0 if none)."""
 
     a: np.ndarray

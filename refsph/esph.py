@@ -10,11 +10,11 @@ Per half pair (i, j), with x_ij = x_i - x_j, v_ij = v_i - v_j and grad_i W_ij = 
     Eq. (14)  p^a_ij = gamma (|p_i| / rho_i^2 + |p_j| / rho_j^2) (W(r_ij) / W(dp))^n,
               zero when p_i > 0 and p_j > 0 (both in compression)
 
-Every pair term is symmetric (Eq. 10, 23) or antisymmetric (Eq. 11) under i <-> j, so it is computed
+Every pair term is symmetric (Eqs. (10), (23)) or antisymmetric (Eq. (11)) under i <-> j, so it is computed
 once per half pair and added to both particles: linear momentum is conserved to round-off. The adding is
 done by :class:`~refsph.neighbours.PairSum` (two sparse products per sum, the pair values as matrix entries),
 block by block (:class:`~refsph.neighbours.PairBlocks`: arrays that fit in the cache, optionally on threads).
-The velocity gradient (Eq. 23) is exact for a linear velocity field only where the kernel support is
+The velocity gradient (Eq. (23)) is exact for a linear velocity field only where the kernel support is
 full; at a free surface it is not (no correction is applied in ESPH, as in the paper).
 """
 from __future__ import annotations
@@ -26,17 +26,17 @@ import numpy as np
 from .kernels import Kernel
 from .material import ElasticMaterial, cauchy_stress, eos_pressure, jaumann_deviatoric_rate
 from .neighbours import PairBlocks, PairSum
-from .state import State
+from .state import Rates, State
 from .tensor import empty
 
-__all__ = ["ESPHParams", "Rates", "esph_rates", "artificial_viscosity", "artificial_pressure",
+__all__ = ["ESPHParams", "esph_rates", "artificial_viscosity", "artificial_pressure",
            "velocity_gradient", "continuity_rate"]
 
 
 @dataclass(frozen=True)
 class ESPHParams:
-    """Numerical parameters of ESPH. h: smoothing length [m]; dp: initial spacing [m] (Eq. 14);
-    beta1, beta2: artificial viscosity (Eq. 12); gamma: artificial pressure coefficient (Eq. 14, 0 = off);
+    """Numerical parameters of ESPH. h: smoothing length [m]; dp: initial spacing [m] (Eq. (14));
+    beta1, beta2: artificial viscosity (Eq. (12)); gamma: artificial pressure coefficient (Eq. (14), 0 = off);
     n_ap: artificial pressure exponent (paper: 4); eps: Eq. (13) regulariser (paper: 0.01)."""
 
     h: float
@@ -47,19 +47,6 @@ class ESPHParams:
     n_ap: float
     eps: float
     kernel: Kernel
-
-
-@dataclass
-class Rates:
-    """Time derivatives of the evolved fields. ``rho`` is None where density is not integrated (TLSPH).
-    ``l`` is the velocity gradient the stress rate came from (used by the plastic update for the strain rate)."""
-
-    x: np.ndarray
-    v: np.ndarray
-    rho: np.ndarray | None
-    S: np.ndarray
-    S_zz: np.ndarray
-    l: np.ndarray | None = None
 
 
 def artificial_viscosity(vr, r2, rho_bar, c_bar, h, beta1, beta2, eps):
@@ -94,23 +81,28 @@ def _artificial_pressure(a_i, a_j, both_compressed, w_ratio, gamma, n):
     return pa
 
 
-def continuity_rate(I, J, m, dv_dot_gW, n, pairs: PairSum | None = None):
-    """Eq. (10): d rho_i/dt = sum_j m_j v_ij . grad_i W_ij (symmetric pair term)."""
-    pairs = pairs if pairs is not None else PairSum(I, J, n)
-    return pairs.symmetric(dv_dot_gW, m)
+def continuity_rate(pairs: PairSum, m: np.ndarray, vr_gW: np.ndarray) -> np.ndarray:
+    """Eq. (10): d rho_i/dt = sum_j m_j v_ij . grad_i W_ij, from one value v_ij . grad_i W_ij per half pair
+    (a symmetric pair term) and the masses m of the particles of ``pairs`` (a :class:`~refsph.neighbours.PairSum`)."""
+    return pairs.symmetric(vr_gW, m)
 
 
-def velocity_gradient(I, J, V, dv, gW, n, pairs: PairSum | None = None):
-    """Eq. (23): l_i = -sum_j V_j v_ij (x) grad_i W_ij  (l_ab = dv_a/dx_b; symmetric pair term).
+def velocity_gradient(pairs: PairSum, V: np.ndarray, dv, gW, out: np.ndarray | None = None) -> np.ndarray:
+    """Eq. (23): l_i = -sum_j V_j v_ij (x) grad_i W_ij  (l_ab = dv_a/dx_b; a symmetric pair term).
 
-    Returned component-major (see :mod:`refsph.tensor`)."""
-    pairs = pairs if pairs is not None else PairSum(I, J, n)
-    d = dv.shape[1]
-    l = empty(n, d)
+    ``pairs``: a :class:`~refsph.neighbours.PairSum` of the half pairs; V: volumes m / rho of its particles;
+    dv = v_i - v_j and gW = grad_i W_ij per pair, as (P, d) arrays or as d arrays of P values (one per
+    component). ``out``: a (d, d, n) array to fill. Returns the (n, d, d) gradient, component-major (see
+    :mod:`refsph.tensor`)."""
+    if isinstance(dv, np.ndarray) and dv.ndim == 2:
+        dv, gW = dv.T, np.asarray(gW).T
+    d = len(dv)
+    out = np.empty((d, d, pairs.n)) if out is None else out
     for a in range(d):
         for b in range(d):
-            l[:, a, b] = -pairs.symmetric(dv[:, a] * gW[:, b], V)
-    return l
+            out[a, b] = pairs.symmetric(dv[a] * gW[b], V)
+            np.negative(out[a, b], out=out[a, b])
+    return out.transpose(2, 0, 1)
 
 
 def esph_rates(state: State, mat: ElasticMaterial, prm: ESPHParams, I: np.ndarray, J: np.ndarray,
@@ -163,11 +155,11 @@ def esph_rates(state: State, mat: ElasticMaterial, prm: ESPHParams, I: np.ndarra
 def _block_sums(blk, particle: dict, mat: ElasticMaterial, prm: ESPHParams, d: int) -> np.ndarray:
     """The pair sums of one block of pairs, one row per sum (each row: the block's window of particles):
 
-        [0]                    sum_j m_j v_ij . grad_i W_ij                          (Eq. 10)
-        [1 + a d + b]          -sum_j V_j (v_ij)_a (grad_i W_ij)_b                  (Eq. 23)
-        [1 + d^2 + b]          sum_j m_j (grad_i W_ij)_b                             (Eq. 11, i-side)
-        [1 + d^2 + d + c d + b] sum_j m_j (s_j)_cb (grad_i W_ij)_b                   (Eq. 11, j-side)
-        [1 + 2 d^2 + d + c]    sum_j m_j (pi_ij + p^a_ij) (grad_i W_ij)_c            (Eqs. 11-14)
+        [0]                    sum_j m_j v_ij . grad_i W_ij                          (Eq. (10))
+        [1 + a d + b]          -sum_j V_j (v_ij)_a (grad_i W_ij)_b                  (Eq. (23))
+        [1 + d^2 + b]          sum_j m_j (grad_i W_ij)_b                             (Eq. (11), i-side)
+        [1 + d^2 + d + c d + b] sum_j m_j (s_j)_cb (grad_i W_ij)_b                   (Eq. (11), j-side)
+        [1 + 2 d^2 + d + c]    sum_j m_j (pi_ij + p^a_ij) (grad_i W_ij)_c            (Eqs. (11)-(14))
 
     Per-particle inputs come as one contiguous array per component (gathering from a 1-D array is about 2.5x
     faster than gathering rows of an (N, d) array)."""
@@ -184,13 +176,10 @@ def _block_sums(blk, particle: dict, mat: ElasticMaterial, prm: ESPHParams, d: i
 
     m, V = local(particle["m"]), local(particle["V"])
     out = np.empty((1 + 2 * d * d + 2 * d, sums.n))
-    out[0] = sums.symmetric(fr * vr, m)
-    for a in range(d):
-        for b in range(d):
-            out[1 + a * d + b] = sums.symmetric(dv[a] * gW[b], V)
-            np.negative(out[1 + a * d + b], out=out[1 + a * d + b])
+    out[0] = continuity_rate(sums, m, fr * vr)                          # Eq. (10)
+    velocity_gradient(sums, V, dv, gW, out=out[1:1 + d * d].reshape(d, d, sums.n))     # Eq. (23)
 
-    # pair scalar: artificial viscosity (Eqs. 12-13) + artificial pressure (Eq. 14)
+    # pair scalar: artificial viscosity (Eqs. (12)-(13)) + artificial pressure (Eq. (14))
     rho = particle["rho"]
     pi = artificial_viscosity(vr, r2, 0.5 * (np.take(rho, I) + np.take(rho, J)), mat.c0, prm.h, prm.beta1,
                               prm.beta2, prm.eps)

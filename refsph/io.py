@@ -21,10 +21,10 @@ Snapshot arrays (N particles, d dimensions):
 | sigma_vm  | (N,)      | Pa            | von Mises stress sqrt(3 J2), S_zz included           |
 | X, V0     | (N, d), (N,) | m, m^d     | reference position and volume (TLSPH)                |
 | F         | (N, d, d) | -             | deformation gradient (TLSPH only)                    |
-| eps_p     | (N,)      | -             | effective plastic strain (Johnson-Cook runs only)    |
-| eps_dot_p | (N,)      | 1/s           | effective plastic strain rate of the last step (J-C) |
-| W_p       | (N,)      | J/m^3         | plastic work density (J-C)                           |
-| T         | (N,)      | K             | temperature (J-C)                                    |
+| eps_p     | (N,)      | -             | effective plastic strain (plasticity runs only)      |
+| eps_dot_p | (N,)      | 1/s           | plastic strain rate of the last step (plasticity)    |
+| W_p       | (N,)      | J/m^3         | plastic work density (plasticity)                    |
+| T         | (N,)      | K             | temperature (plasticity)                             |
 | body      | (N,)      | -             | body id (scenes with tools: 0 workpiece, see summary["boundaries"]) |
 | units     | ()        | -             | JSON string: unit of every key                       |
 

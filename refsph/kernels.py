@@ -177,7 +177,7 @@ KERNELS = {"cubic": CubicSpline(), "wendland": WendlandC2()}
 
 
 def get_kernel(name: str) -> Kernel:
-    """Kernel by name: 'cubic' (Eq. 9) or 'wendland'."""
+    """Kernel by name: 'cubic' (Eq. (9)) or 'wendland'."""
     try:
         return KERNELS[name]
     except KeyError:

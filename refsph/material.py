@@ -1,4 +1,4 @@
-"""Elastic material and the hypoelastic constitutive update (Section 2.3, Eqs. 20-24).
+"""Elastic material and the hypoelastic constitutive update (Section 2.3, Eqs. (20)-(24)).
 
     Eq. (21)  eps_dot = (l + l^T) / 2                      strain rate
     Eq. (22)  omega   = (l - l^T) / 2                      spin
@@ -92,7 +92,7 @@ class ElasticMaterial:
 
     @property
     def c0(self) -> float:
-        """Sound speed used by the paper in the artificial viscosity, C = sqrt(E / rho) (after Eq. 13)."""
+        """Sound speed used by the paper in the artificial viscosity, C = sqrt(E / rho) (after Eq. (13))."""
         return math.sqrt(self.E / self.rho0)
 
     @property

@@ -1,9 +1,9 @@
 """A material-point driver: one particle, a prescribed velocity gradient, the package's own constitutive path.
 
-The same functions as in a particle run are used, in the same order: the Jaumann stress rate (Eq. 20), the
+The same functions as in a particle run are used, in the same order: the Jaumann stress rate (Eq. (20)), the
 density from continuity (rho_dot = -rho tr l, integrated exactly over the step, rho exp(-dt tr l), as l is
-constant in a step; p follows Eq. 24), the predictor-corrector step and the
-Wilkins return map with Johnson-Cook hardening, rate and temperature (Eqs. 25-31), so curves from here test
+constant in a step; p follows Eq. (24)), the predictor-corrector step and the
+Wilkins return map with Johnson-Cook hardening, rate and temperature (Eqs. (25)-(31)), so curves from here test
 what the SPH solvers do to each particle.
 
 Two loadings are provided:
@@ -22,12 +22,13 @@ from typing import Callable
 import numpy as np
 
 from .material import ElasticMaterial, eos_pressure, jaumann_deviatoric_rate
-from .plasticity import JohnsonCook, equivalent_strain_rate, plastic_update, yield_stress
+from .plasticity import J2Plasticity, equivalent_strain_rate
+from .strength import plastic_update
 
 __all__ = ["material_point"]
 
 
-def _step(S, rho, eps_p, T, l, dt, mat: ElasticMaterial, jc: JohnsonCook | None, heating: bool):
+def _step(S, rho, eps_p, T, l, dt, mat: ElasticMaterial, jc: J2Plasticity | None, heating: bool):
     """One predictor-corrector step of a single particle with constant l over the step."""
     L = l[None]
     Szz = np.zeros(1)
@@ -52,13 +53,41 @@ def _step(S, rho, eps_p, T, l, dt, mat: ElasticMaterial, jc: JohnsonCook | None,
     return S_new, rho_new, deps, dw, dT, float(eps_dot[0])
 
 
-def material_point(mat: ElasticMaterial, jc: JohnsonCook | None, l, dt: float, n_steps: int, T0: float, *,
+def _uniaxial_step(trial, eps_dot_xx: float, lam: float, mat: ElasticMaterial):
+    """The step under uniaxial stress: l = diag(eps_dot_xx, lam, lam) with lam found by a secant iteration (from the
+    previous step's lam) so that sigma_yy = sigma_zz = 0 at its end. Returns (lam, l, the step's result)."""
+    def with_lam(x):
+        ll = np.zeros((3, 3))
+        ll[0, 0] = eps_dot_xx
+        ll[1, 1] = ll[2, 2] = x
+        return ll
+
+    def lateral_stress(res):
+        S_new, rho_new = res[0], res[1]
+        return float(S_new[0, 1, 1] - eos_pressure(rho_new, mat.rho0, mat.K))
+
+    a, fa = lam, lateral_stress(trial(with_lam(lam)))
+    b = lam + 1e-3 * abs(eps_dot_xx) + 1e-12
+    res = trial(with_lam(b))
+    fb = lateral_stress(res)
+    for _ in range(30):                                     # secant on sigma_yy(lam) = 0
+        if fb == fa:
+            break
+        a, fa, b = b, fb, b - fb * (b - a) / (fb - fa)
+        res = trial(with_lam(b))
+        fb = lateral_stress(res)
+        if abs(fb) < 1e-9 * max(mat.G * 1e-6, 1.0):
+            break
+    return b, with_lam(b), res                              # res is the step with this l
+
+
+def material_point(mat: ElasticMaterial, jc: J2Plasticity | None, l, dt: float, n_steps: int, T0: float, *,
                    heating: bool = True, lateral_stress_free: bool = False) -> dict:
     """Drive one particle; returns arrays over n_steps + 1 instants (index 0 = the stress-free start):
 
     t [s], strain (3, 3) [-] (integral of the symmetric part of l: the logarithmic strain for coaxial
     loading), sigma (3, 3) [Pa] Cauchy stress, S deviatoric stress, p [Pa], sigma_vm [Pa], sigma_y [Pa]
-    (Eq. 25 with the step's rate and the *start-of-step* eps_p and T: the yield stress the step returned to,
+    (Eq. (25) with the step's rate and the *start-of-step* eps_p and T: the yield stress the step returned to,
     so sigma_vm == sigma_y in every plastic step; index 0: the initial yield stress), eps_p [-],
     eps_dot [1/s], W_p [J/m^3], T [K], l (3, 3).
 
@@ -92,44 +121,22 @@ def material_point(mat: ElasticMaterial, jc: JohnsonCook | None, l, dt: float, n
     strain = np.zeros((3, 3))
     out["T"][0] = T0
     if jc is not None:
-        out["sigma_y"][0] = float(yield_stress(jc, 0.0, 0.0, T0))
+        out["sigma_y"][0] = float(jc.flow_stress(0.0, 0.0, T0))
     lam = -mat.nu * l0[0, 0]                                # elastic guess for the lateral rate
     t = 0.0
 
     def trial(l_step):
         return _step(S, rho, eps_p, T, l_step, dt, mat, jc, heating)
 
-    def lateral_stress(res):
-        S_new, rho_new = res[0], res[1]
-        return float(S_new[0, 1, 1] - eos_pressure(rho_new, mat.rho0, mat.K))
-
     for k in range(1, n + 1):
         l_step = np.array(l_of_t(t + 0.5 * dt), dtype=float)
         if lateral_stress_free:
-            def with_lam(x):
-                ll = np.zeros((3, 3))
-                ll[0, 0] = l_step[0, 0]
-                ll[1, 1] = ll[2, 2] = x
-                return ll
-            a, fa = lam, lateral_stress(trial(with_lam(lam)))
-            b = lam + 1e-3 * abs(l_step[0, 0]) + 1e-12
-            res = trial(with_lam(b))
-            fb = lateral_stress(res)
-            for _ in range(30):                             # secant on sigma_yy(lam) = 0
-                if fb == fa:
-                    break
-                a, fa, b = b, fb, b - fb * (b - a) / (fb - fa)
-                res = trial(with_lam(b))
-                fb = lateral_stress(res)
-                if abs(fb) < 1e-9 * max(mat.G * 1e-6, 1.0):
-                    break
-            lam = b
-            l_step = with_lam(lam)                          # res is the step with this l
+            lam, l_step, res = _uniaxial_step(trial, l_step[0, 0], lam, mat)
         else:
             res = trial(l_step)
         S, rho, deps, dw, dT, edot = res
         if jc is not None:                                  # the yield stress this step returned to
-            out["sigma_y"][k] = float(yield_stress(jc, eps_p[0], edot, T[0]))
+            out["sigma_y"][k] = float(jc.flow_stress(eps_p[0], edot, T[0]))
         eps_p = eps_p + deps
         W_p += dw
         T = T + dT

@@ -34,7 +34,7 @@ import scipy.sparse as sp
 from scipy.spatial import cKDTree
 
 __all__ = ["find_pairs", "VerletList", "scatter_add", "pair_count_per_particle", "PairSum", "PairBlocks",
-           "PAIR_BLOCK", "available_cores", "threads_per_job"]
+           "PAIR_BLOCK", "available_cores", "threads_per_job", "check_threads"]
 
 PAIR_BLOCK = 2**17        # pairs per block of a PairBlocks: 1 MB per float array (benchmarks/pair_blocks.py)
 
@@ -151,8 +151,7 @@ class PairBlocks:
         size = PAIR_BLOCK if size is None else size
         if size < 1:
             raise ValueError(f"block size must be a positive number of pairs, got {size!r}")
-        if threads < 1:
-            raise ValueError(f"threads must be at least 1, got {threads!r}")
+        threads = check_threads(threads)
         I, J = np.asarray(I), np.asarray(J)
         if len(I) and (min(I.min(), J.min()) < 0 or max(I.max(), J.max()) >= n):
             raise ValueError(f"pair indices must lie in [0, {n})")
@@ -197,6 +196,16 @@ def available_cores() -> int:
         return len(os.sched_getaffinity(0))
     except AttributeError:                                  # not on Linux
         return os.cpu_count() or 1
+
+
+def check_threads(threads, allow_auto: bool = False) -> int:
+    """The thread count as an int: a whole number >= 1, or 0 for one thread per available core where
+    ``allow_auto`` (``Numerics.threads``); ValueError otherwise. The one check of a thread count in refsph."""
+    low = 0 if allow_auto else 1
+    if isinstance(threads, bool) or not isinstance(threads, (int, np.integer)) or threads < low:
+        raise ValueError(f"threads must be a whole number >= {low}" + (" (0 = one thread per available core)"
+                                                                       if allow_auto else "") + f", got {threads!r}")
+    return available_cores() if threads == 0 else int(threads)
 
 
 def threads_per_job(n_jobs: int) -> int:

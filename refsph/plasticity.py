@@ -1,4 +1,4 @@
-"""Johnson-Cook viscoplasticity and adiabatic heating (Section 2.3.1, Eqs. 25-31).
+"""Johnson-Cook viscoplasticity and adiabatic heating (Section 2.3.1, Eqs. (25)-(31)).
 
     Eq. (25)  sigma_y = [A + B eps_p^n] [1 + C ln(epsdot*)] [1 - T*^m]
     Eq. (26)  epsdot* = epsdot / epsdot_0
@@ -32,30 +32,54 @@ Where the paper is silent or loose, refsph does the standard thing:
   sigma_y = 0 (melted), as in Abaqus and LS-DYNA.
 * **epsdot_0** is not printed in Table 1; Johnson & Cook's 4340 data use 1 /s, which refsph uses for Taylor.
 
-The **modified** Johnson-Cook law of Rodriguez Prieto, Larsson & Afrasiabi (Eqs. 8-9 of their paper): the
+The **modified** Johnson-Cook law of Rodriguez Prieto, Larsson & Afrasiabi (Eqs. (8)-(9) of their paper): the
 hardening term stops growing past a saturation strain (2 for AISI 1045), A + B min(eps_p, eps_sat)^n. It is
-switched on per material with ``hardening_saturation_strain`` (None = the original law).
+:class:`ModifiedJohnsonCook`.
+
+Every law here is a strength model of :mod:`refsph.strength` (the one interface the solvers call);
+:func:`refsph.strength.plastic_update` is the return map of a step for any of them.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
 import math
 import numbers
+from dataclasses import dataclass, fields
 
 import numpy as np
 
-__all__ = ["JohnsonCook", "homologous_temperature", "yield_stress", "equivalent_strain_rate",
-           "radial_return", "plastic_strain_increment", "effective_plastic_strain_increment",
-           "plastic_work_increment", "temperature_increment", "plastic_update"]
+from .state import PLASTIC_FIELDS
+
+__all__ = ["J2Plasticity", "JohnsonCook", "ModifiedJohnsonCook", "homologous_temperature", "yield_stress",
+           "equivalent_strain_rate", "radial_return", "plastic_strain_increment", "effective_plastic_strain_increment",
+           "plastic_work_increment", "temperature_increment"]
+
+
+class J2Plasticity:
+    """Von Mises plasticity with Wilkins' radial return (Eqs. (29)-(31)) for any flow stress: the shared part of
+    every plasticity law of the strength-model seam (:mod:`refsph.strength`). A subclass gives
+    ``flow_stress(eps_p, eps_dot, T)`` [Pa] and, for the heating of Eq. (28), the attributes ``chi`` and ``cp``."""
+
+    state_fields: tuple = PLASTIC_FIELDS
+
+    def flow_stress(self, eps_p, eps_dot, T):
+        raise NotImplementedError
+
+    def return_map(self, S, S_zz, eps_p, eps_dot, T, G: float):
+        """Eqs. (29)-(31): s_n = c_f s, c_f = min(sigma_y / sqrt(3 J2), 1); returns (S_n, S_zz_n, d_eps_p, d_w_p)."""
+        sy = self.flow_stress(eps_p, eps_dot, T)
+        cf, S_n, S_zz_n, svm = radial_return(S, S_zz, sy)
+        return S_n, S_zz_n, effective_plastic_strain_increment(svm, cf, G), plastic_work_increment(svm, cf, G)
+
+    def heat(self, d_w_p, rho):
+        """Eq. (28): d T = chi d w_p / (rho C_p)."""
+        return temperature_increment(d_w_p, rho, self)
 
 
 @dataclass(frozen=True)
-class JohnsonCook:
-    """Johnson-Cook constants, SI units; no defaults (Table 1 / Table 3 of the paper).
+class JohnsonCook(J2Plasticity):
+    """Johnson-Cook constants (Eq. (25)), SI units; no defaults (Table 1 / Table 3 of the paper).
 
-    A, B [Pa], n, C, m [-], eps_dot_0 [1/s], T_room, T_melt [K], cp [J/(kg K)], chi (Taylor-Quinney) [-],
-    hardening_saturation_strain: None for Eq. (25) as printed, or the strain past which hardening stops
-    (the modified law of Rodriguez Prieto et al.).
+    A, B [Pa], n, C, m [-], eps_dot_0 [1/s], T_room, T_melt [K], cp [J/(kg K)], chi (Taylor-Quinney) [-].
     """
 
     A: float
@@ -68,7 +92,6 @@ class JohnsonCook:
     T_melt: float
     cp: float
     chi: float
-    hardening_saturation_strain: float | None
 
     def __post_init__(self):
         for name in ("A", "B", "n", "C", "m", "eps_dot_0", "T_room", "T_melt", "cp", "chi"):
@@ -85,15 +108,11 @@ class JohnsonCook:
             raise ValueError(f"T_melt ({self.T_melt!r} K) must exceed T_room ({self.T_room!r} K)")
         if not 0.0 <= self.chi <= 1.0:
             raise ValueError(f"Taylor-Quinney coefficient chi must lie in [0, 1], got {self.chi!r}")
-        s = self.hardening_saturation_strain
-        if s is not None and (isinstance(s, bool) or not isinstance(s, numbers.Real) or not math.isfinite(s)
-                              or not s > 0):
-            raise ValueError(f"hardening_saturation_strain must be None or positive, got {s!r}")
 
     @classmethod
     def from_dict(cls, d: dict) -> "JohnsonCook":
         """From a dict with every field named; a missing key is named in the error."""
-        names = [f for f in cls.__dataclass_fields__]
+        names = [f.name for f in fields(cls)]
         missing = [k for k in names if k not in d]
         if missing:
             raise ValueError(f"missing Johnson-Cook constant(s): {', '.join(missing)}")
@@ -101,6 +120,33 @@ class JohnsonCook:
         if unknown:
             raise ValueError(f"unknown Johnson-Cook constant(s): {', '.join(unknown)}")
         return cls(**{k: d[k] for k in names})
+
+    def hardening_strain(self, eps_p: np.ndarray) -> np.ndarray:
+        """The plastic strain that enters the hardening term of Eq. (25): eps_p itself."""
+        return eps_p
+
+    def flow_stress(self, eps_p, eps_dot, T):
+        """Eq. (25), see :func:`yield_stress`."""
+        return yield_stress(self, eps_p, eps_dot, T)
+
+
+@dataclass(frozen=True)
+class ModifiedJohnsonCook(JohnsonCook):
+    """The modified Johnson-Cook law of Rodriguez Prieto, Larsson & Afrasiabi (their Eqs. (8)-(9)): Eq. (25) with
+    the hardening term frozen past ``hardening_saturation_strain`` (2 for their AISI 1045),
+    A + B min(eps_p, eps_sat)^n."""
+
+    hardening_saturation_strain: float
+
+    def __post_init__(self):
+        super().__post_init__()
+        s = self.hardening_saturation_strain
+        if isinstance(s, bool) or not isinstance(s, numbers.Real) or not math.isfinite(s) or not s > 0:
+            raise ValueError(f"hardening_saturation_strain must be a positive number, got {s!r}")
+
+    def hardening_strain(self, eps_p: np.ndarray) -> np.ndarray:
+        """min(eps_p, eps_sat) (their Eq. (9))."""
+        return np.minimum(eps_p, self.hardening_saturation_strain)
 
 
 def homologous_temperature(T, T_room: float, T_melt: float):
@@ -111,13 +157,11 @@ def homologous_temperature(T, T_room: float, T_melt: float):
 def yield_stress(jc: JohnsonCook, eps_p, eps_dot, T):
     """Eq. (25): sigma_y = [A + B eps_p^n] [1 + C ln(max(epsdot*, 1))] [1 - T*^m], T* clipped to [0, 1].
 
-    eps_p: accumulated effective plastic strain; eps_dot: equivalent strain rate [1/s] (Eq. 26 with
-    epsdot* = eps_dot / eps_dot_0); T: temperature [K]. With ``hardening_saturation_strain`` set, eps_p is
-    capped there (modified law, Rodriguez Prieto et al. Eq. 9). Arrays broadcast.
+    eps_p: accumulated effective plastic strain; eps_dot: equivalent strain rate [1/s] (Eq. (26) with
+    epsdot* = eps_dot / eps_dot_0); T: temperature [K]. A :class:`ModifiedJohnsonCook` caps eps_p at its saturation
+    strain (``jc.hardening_strain``). Arrays broadcast.
     """
-    eps_p = np.maximum(np.asarray(eps_p, dtype=float), 0.0)
-    if jc.hardening_saturation_strain is not None:
-        eps_p = np.minimum(eps_p, jc.hardening_saturation_strain)
+    eps_p = jc.hardening_strain(np.maximum(np.asarray(eps_p, dtype=float), 0.0))
     hardening = jc.A + jc.B * eps_p**jc.n
     rate = 1.0 + jc.C * np.log(np.maximum(np.asarray(eps_dot, dtype=float) / jc.eps_dot_0, 1.0))
     Ts = np.clip(homologous_temperature(T, jc.T_room, jc.T_melt), 0.0, 1.0)
@@ -126,7 +170,7 @@ def yield_stress(jc: JohnsonCook, eps_p, eps_dot, T):
 
 
 def equivalent_strain_rate(l: np.ndarray) -> np.ndarray:
-    """sqrt(2/3 e':e') with e' the deviatoric part of eps_dot = (l + l^T)/2 (Eq. 21), for l (N, d, d).
+    """sqrt(2/3 e':e') with e' the deviatoric part of eps_dot = (l + l^T)/2 (Eq. (21)), for l (N, d, d).
 
     In 2D plane strain eps_dot_zz = 0 but its deviatoric part -tr/3 is not, and it is included."""
     n, d, _ = l.shape
@@ -165,22 +209,6 @@ def plastic_work_increment(svm_trial: np.ndarray, cf: np.ndarray, G: float) -> n
     return (1.0 - cf) * cf * svm_trial * svm_trial / (3.0 * G)
 
 
-def temperature_increment(dw_p: np.ndarray, rho: np.ndarray, jc: JohnsonCook) -> np.ndarray:
-    """Eq. (28), increment form: dT = chi d w_p / (rho C_p)."""
+def temperature_increment(dw_p: np.ndarray, rho: np.ndarray, jc) -> np.ndarray:
+    """Eq. (28), increment form: dT = chi d w_p / (rho C_p) (``jc``: any law with ``chi`` and ``cp``)."""
     return jc.chi * dw_p / (rho * jc.cp)
-
-
-def plastic_update(S: np.ndarray, S_zz: np.ndarray, eps_p: np.ndarray, T: np.ndarray, rho: np.ndarray,
-                   eps_dot: np.ndarray, jc: JohnsonCook, G: float, heating: bool = True):
-    """One return map at the end of a step, Eqs. (25)-(31).
-
-    S, S_zz: trial deviatoric stress (the elastic update); eps_p, T: values at the start of the step; rho:
-    density; eps_dot: equivalent strain rate of the step. The yield stress is evaluated with the start-of-step
-    eps_p and T (explicit, as in the paper). Returns (S_n, S_zz_n, d_eps_p, d_w_p, d_T); d_T is zero if
-    ``heating`` is False (isothermal material-point curves)."""
-    sy = yield_stress(jc, eps_p, eps_dot, T)
-    cf, S_n, S_zz_n, svm = radial_return(S, S_zz, sy)
-    deps = effective_plastic_strain_increment(svm, cf, G)
-    dw = plastic_work_increment(svm, cf, G)
-    dT = temperature_increment(dw, rho, jc) if heating else np.zeros_like(dw)
-    return S_n, S_zz_n, deps, dw, dT

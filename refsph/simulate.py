@@ -1,8 +1,13 @@
-"""The run driver: scene -> solver -> time loop -> summary.json and snapshots.
+"""The run driver: setup -> solver -> time loop -> summary.json and snapshots.
 
-Nothing is lost on a crash: snapshots are written as the run goes, ``summary.json`` is written at the
-end *and* on failure (``status`` says which), and a run that produces NaN/inf stops, reports the field,
-particle, step and time, and writes ``snapshots/last_good.npz`` with the last finite state.
+``simulate`` is four named steps: the initial record (:class:`RunRecord`: summary, history, output files), the
+snapshot schedule (:func:`snapshot_times`), one step after another (:func:`step_or_fail`), the final record
+(metrics and ``summary.json``). ``run`` builds a registered scene first (what ``refsph run`` calls).
+
+Nothing is lost on a crash: snapshots are written as the run goes, ``summary.json`` is written at every snapshot
+(``status: "running"``), at the end *and* on failure (``status`` says which), and a run that produces NaN/inf
+stops, reports the field, particle, step and time, and writes ``snapshots/last_good.npz`` with the last finite
+state.
 """
 from __future__ import annotations
 
@@ -11,27 +16,30 @@ import sys
 import time
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Callable
 
 import numpy as np
 
 from . import __version__
 from .contact import PinballContact
 from .esph import ESPHParams
-from .integrate import ESPHSolver, TLSPHSolver, cfl_time_step, predictor_corrector_step
+from .integrate import Solver, cfl_time_step, get_stepper
 from .io import save_reactions, save_snapshot, write_json
 from .kernels import get_kernel
-from .neighbours import available_cores
-from .scenes import Setup, convert_options, get_scene
+from .neighbours import check_threads
+from .scenes import Scene, Setup, get_scene
+from .solvers import ESPHSolver, TLSPHSolver
 from .state import State
 from .tlsph import TLSPHParams
 
-__all__ = ["SimulationError", "RunResult", "make_solver", "run", "simulate", "METHODS"]
+__all__ = ["SimulationError", "RunResult", "RunRecord", "make_solver", "run", "simulate", "snapshot_times",
+           "step_or_fail", "METHODS"]
 
 METHODS = ("esph", "tlsph")
 
 
 class SimulationError(RuntimeError):
-    """A run stopped because the state became non-finite (message says where and when)."""
+    """A run stopped because the state became non-finite or a step failed (message says where and when)."""
 
 
 @dataclass
@@ -42,24 +50,21 @@ class RunResult:
     setup: Setup
 
 
-def make_solver(method: str, setup: Setup):
-    """ESPH or TLSPH solver for a setup."""
+def make_solver(method: str, setup: Setup) -> Solver:
+    """The ESPH or TLSPH solver of a setup (its Numerics, boundaries, strength model and contact)."""
     nm = setup.numerics
-    if isinstance(nm.threads, bool) or not isinstance(nm.threads, (int, np.integer)) or nm.threads < 0:
-        raise ValueError(f"Numerics.threads must be a whole number >= 0 (0 = one thread per available core), "
-                         f"got {nm.threads!r}")
-    threads = available_cores() if nm.threads == 0 else int(nm.threads)    # (numbers do not depend on it)
+    threads = check_threads(nm.threads, allow_auto=True)   # (the numbers do not depend on it)
     kernel = get_kernel(nm.kernel)
     h = setup.h
+    common = dict(strength=setup.strength, heating=setup.heating, mirror=setup.mirror, walls=setup.walls,
+                  rigid=setup.rigid, clamps=setup.clamps, threads=threads)
     if method == "esph":
         if setup.friction is not None:
             raise ValueError("friction is a law of the TLSPH pinball contact; ESPH tools act through the SPH "
                              "sums and have no friction model (run TLSPH, or set friction=None)")
         prm = ESPHParams(h=h, dp=setup.dp, beta1=nm.beta1, beta2=nm.beta2, gamma=nm.gamma, n_ap=nm.n_ap,
                          eps=nm.eps, kernel=kernel)
-        return ESPHSolver(setup.material, prm, skin_factor=nm.skin_factor, plasticity=setup.plasticity,
-                          mirror=setup.mirror, walls=setup.walls, rigid=setup.rigid, clamps=setup.clamps,
-                          threads=threads)
+        return ESPHSolver(setup.material, prm, skin_factor=nm.skin_factor, **common)
     if method == "tlsph":
         prm = TLSPHParams(h=h, beta1=nm.beta1, beta2=nm.beta2, eps=nm.eps, kernel=kernel,
                           corrected=nm.corrected, ref_update_strain=nm.ref_update_strain)
@@ -69,9 +74,7 @@ def make_solver(method: str, setup: Setup):
         if setup.rigid:
             k = nm.contact_k if nm.contact_k is not None else setup.dp / (2.0 * h)
             contact = PinballContact(k=k, K_p=nm.contact_Kp, friction=setup.friction)
-        return TLSPHSolver(setup.material, prm, plasticity=setup.plasticity, mirror=setup.mirror,
-                           walls=setup.walls, rigid=setup.rigid, clamps=setup.clamps, contact=contact,
-                           dp=setup.dp, threads=threads)
+        return TLSPHSolver(setup.material, prm, contact=contact, dp=setup.dp, **common)
     raise ValueError(f"unknown method {method!r}; choose one of {', '.join(METHODS)}")
 
 
@@ -91,152 +94,211 @@ def _validate(method, dim, dp, setup_numerics=None, t_end=None, dt=None):
                          f"{setup_numerics.h_over_dp!r} < 1)")
 
 
-def simulate(setup: Setup, method: str, *, scene=None, out=None, dt: float | None = None,
-             progress: bool = True, label: str = "", record_every: int | None = None) -> RunResult:
-    """Run a prepared setup. ``dt=None``: CFL step every step; else fixed ``dt`` (checked against CFL)."""
-    _validate(method, setup.state.dim, setup.dp, setup.numerics, setup.t_end, dt)
-    state = setup.state.copy()
-    state.check()
-    solver = make_solver(method, setup)
-    solver.check_state(state)
-    out = Path(out) if out is not None else None
-    if out is not None:
-        (out / "snapshots").mkdir(parents=True, exist_ok=True)
-        for old in (out / "snapshots").glob("*.npz"):
-            old.unlink()
-
-    def F_of(s):
-        return solver.deformation_gradient(s) if method == "tlsph" else None
-
-    history: dict[str, list] = {}
-
-    def record(s):
-        if scene is not None:
-            for k, val in scene.record(s, setup).items():
-                history.setdefault(k, []).append(val)
-
-    snap_times = np.linspace(0.0, setup.t_end, setup.n_snapshots + 1)
+def snapshot_times(setup: Setup) -> np.ndarray:
+    """Output times: ``n_snapshots`` + 1 evenly spaced from 0 to t_end, and the setup's extra times."""
+    times = np.linspace(0.0, setup.t_end, setup.n_snapshots + 1)
     extra = [t for t in setup.snapshot_times if 0.0 < t < setup.t_end]
-    snap_times = np.unique(np.concatenate([snap_times, extra]))
-    snap_next = 0
-    snapshots = []
+    return np.unique(np.concatenate([times, extra]))
 
-    def update_outputs(s):
-        """The summary's run record and the reaction history (and its CSV) as they stand at state s."""
-        wall = time.perf_counter() - t0
-        summary.update(n_steps=n_steps, wall_time_s=wall, cpu_time_s=time.process_time() - c0, t_final=s.t,
-                       dt_min=float(min(dts)) if dts else None, dt_max=float(max(dts)) if dts else None,
-                       particle_steps_per_s=s.n * n_steps / wall if wall > 0 else None,
-                       snapshots=list(snapshots), diagnostics=solver.diagnostics())
-        reactions = solver.reaction_history()
-        if reactions:
-            history["reaction"] = reactions
-            if out is not None:
-                save_reactions(out / "reaction_forces.csv", reactions, s.dim)
-                summary["reaction_forces_file"] = "reaction_forces.csv"
 
-    def maybe_snapshot(s, force=False):
-        nonlocal snap_next
-        while snap_next < len(snap_times) and (s.t >= snap_times[snap_next] * (1 - 1e-12) or force):
-            if out is not None:
-                name = f"snap_{snap_next:05d}.npz"
-                save_snapshot(out / "snapshots" / name, s, setup.material, F_of(s))
-                snapshots.append(name)
-                if 0 < snap_next < len(snap_times) - 1:     # a killed run keeps its record up to here
-                    update_outputs(s)
-                    write_json(out / "summary.json", summary)
-            snap_next += 1
-            force = False
-            if s.t < setup.t_end * (1 - 1e-12):
+def _as_dict(obj) -> dict:
+    """A strength model, wall, body ... as {'model': its class, its fields}."""
+    fields = dataclasses.asdict(obj) if dataclasses.is_dataclass(obj) else {}
+    return dict(model=type(obj).__name__, **fields)
+
+
+class RunRecord:
+    """What a run leaves: ``summary`` (summary.json), ``history`` (the recorded scalars), snapshots and the
+    reaction-force CSV in ``out`` (None: nothing is written)."""
+
+    def __init__(self, setup: Setup, solver: Solver, out, dt, name: str, record: Callable | None, times):
+        self.setup, self.solver, self.record_fn = setup, solver, record
+        self.out = Path(out) if out is not None else None
+        if self.out is not None:
+            (self.out / "snapshots").mkdir(parents=True, exist_ok=True)
+            for old in (self.out / "snapshots").glob("*.npz"):
+                old.unlink()
+        self.history: dict[str, list] = {}
+        self.snapshots: list[str] = []
+        self.times, self.next_snap = times, 0
+        self.n_steps, self.dts = 0, []
+        self.t0, self.c0 = time.perf_counter(), time.process_time()
+        self.summary = self._initial_summary(setup, solver, dt, name)
+
+    def _initial_summary(self, setup: Setup, solver: Solver, dt, name: str) -> dict:
+        state = setup.state
+        return dict(
+            scene=name, method=solver.method, dim=state.dim, dp=setup.dp, h=setup.h, n_particles=state.n,
+            t_end=setup.t_end, n_steps=0, dt_mode="fixed" if dt is not None else "cfl",
+            courant=setup.numerics.courant, numerics=dataclasses.asdict(setup.numerics), threads=solver.threads,
+            material=dataclasses.asdict(setup.material), strength=_as_dict(setup.strength), heating=setup.heating,
+            boundaries=dict(symmetry_axes=list(setup.mirror.axes) if setup.mirror is not None else [],
+                            walls=[dataclasses.asdict(w) for w in setup.walls],
+                            rigid_bodies=[dataclasses.asdict(b) for b in setup.rigid],
+                            clamps=[c.to_dict() for c in setup.clamps],
+                            friction=(dataclasses.asdict(setup.friction) if setup.friction is not None else None)),
+            scene_info=setup.info, snapshot_times=[float(t) for t in self.times], refsph_version=__version__,
+            status="running", metrics={})
+
+    def record(self, state: State) -> None:
+        if self.record_fn is not None:
+            for k, val in self.record_fn(state, self.setup).items():
+                self.history.setdefault(k, []).append(val)
+
+    def save(self, name: str, state: State) -> Path:
+        path = self.out / "snapshots" / name
+        save_snapshot(path, state, self.setup.material, self.solver.deformation_gradient(state))
+        return path
+
+    def snapshot_if_due(self, state: State) -> None:
+        """Write every snapshot whose time has come (a killed run keeps its summary up to the last of them)."""
+        while self.next_snap < len(self.times) and state.t >= self.times[self.next_snap] * (1 - 1e-12):
+            if self.out is not None:
+                name = f"snap_{self.next_snap:05d}.npz"
+                self.save(name, state)
+                self.snapshots.append(name)
+                if 0 < self.next_snap < len(self.times) - 1:
+                    self.update(state)
+                    write_json(self.out / "summary.json", self.summary)
+            self.next_snap += 1
+            if state.t < self.setup.t_end * (1 - 1e-12):
                 break
 
-    summary = dict(scene=scene.name if scene is not None else label, method=method, dim=state.dim,
-                   dp=setup.dp, h=setup.h, n_particles=state.n, t_end=setup.t_end, n_steps=0,
-                   dt_mode="fixed" if dt is not None else "cfl", courant=setup.numerics.courant,
-                   numerics=dataclasses.asdict(setup.numerics), threads=solver.threads,
-                   material=dataclasses.asdict(setup.material),
-                   plasticity=dataclasses.asdict(setup.plasticity) if setup.plasticity is not None else None,
-                   boundaries=dict(symmetry_axes=list(setup.mirror.axes) if setup.mirror is not None else [],
-                                   walls=[dataclasses.asdict(w) for w in setup.walls],
-                                   rigid_bodies=[dataclasses.asdict(b) for b in setup.rigid],
-                                   clamps=[c.to_dict() for c in setup.clamps],
-                                   friction=(dataclasses.asdict(setup.friction) if setup.friction is not None
-                                             else None)),
-                   scene_info=setup.info, snapshot_times=[float(t) for t in snap_times],
-                   refsph_version=__version__,
-                   status="running", metrics={})
+    def update(self, state: State) -> None:
+        """The summary's run record and the reaction history (and its CSV) as they stand at ``state``."""
+        wall = time.perf_counter() - self.t0
+        dts = self.dts
+        self.summary.update(
+            n_steps=self.n_steps, wall_time_s=wall, cpu_time_s=time.process_time() - self.c0, t_final=state.t,
+            dt_min=float(min(dts)) if dts else None, dt_max=float(max(dts)) if dts else None,
+            particle_steps_per_s=state.n * self.n_steps / wall if wall > 0 else None,
+            snapshots=list(self.snapshots), diagnostics=self.solver.diagnostics())
+        reactions = self.solver.reaction_history()
+        if reactions:
+            self.history["reaction"] = reactions
+            if self.out is not None:
+                save_reactions(self.out / "reaction_forces.csv", reactions, state.dim)
+                self.summary["reaction_forces_file"] = "reaction_forces.csv"
 
-    t0, c0 = time.perf_counter(), time.process_time()
-    last_print = t0
-    n_steps = 0
-    dts = []
-    if record_every is None:
-        dt_est = dt if dt is not None else cfl_time_step(state, setup.material, setup.h, setup.numerics.courant)
-        record_every = max(1, int(setup.t_end / dt_est / 400))
+    def fail(self, status: str, msg: str, last_good: State) -> SimulationError:
+        """Record a failed step (``last_good.npz``, status and message); the error to raise."""
+        if self.out is not None:
+            path = self.save("last_good.npz", last_good)
+            msg += f"; last good state written to {path}"
+        self.summary.update(status=status, error=msg)
+        return SimulationError(msg)
+
+    def finish(self, state: State, metrics: Callable | None) -> None:
+        self.update(state)
+        if metrics is not None and self.history and self.summary["status"] == "ok":
+            self.summary["metrics"] = metrics(self.history, state, self.setup)
+        if self.out is not None:
+            write_json(self.out / "summary.json", self.summary)
+
+
+def step_or_fail(state: State, solver: Solver, dt: float, rec: RunRecord, step=None) -> State:
+    """One step (``step``: the stepper, default the setup's integrator), or a :class:`SimulationError` that
+    names the step, the time and (for a non-finite state) the field and particle, after writing the last good
+    state."""
+    step = step or get_stepper(rec.setup.numerics.integrator)
+    try:
+        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):     # non-finite: caught below
+            new = step(state, solver, dt)
+    except ValueError as e:                                 # e.g. a particle crossed a symmetry plane
+        raise rec.fail("error", f"step {rec.n_steps + 1} (t = {state.t:.6e} s) failed: {e}", state) from e
+    rec.n_steps += 1
+    if not (np.isfinite(new.v).all() and np.isfinite(new.x).all()):
+        bad = new.first_nonfinite() or ("x/v", -1)
+        raise rec.fail("nan", f"non-finite {bad[0]} at particle {bad[1]} in step {rec.n_steps} "
+                              f"(t = {state.t:.6e} s -> {new.t:.6e} s)", state)
+    return new
+
+
+def _time_step(setup: Setup, dt: float | None, state: State) -> float:
+    return dt if dt is not None else cfl_time_step(state, setup.material, setup.h, setup.numerics.courant)
+
+
+def _warn_fixed_dt(setup: Setup, dt: float | None, state: State) -> None:
     if dt is not None:
         dt_cfl = cfl_time_step(state, setup.material, setup.h, setup.numerics.courant)
         if dt > dt_cfl:
             print(f"refsph: warning: fixed dt = {dt:.3e} s exceeds the CFL estimate {dt_cfl:.3e} s "
                   f"(Courant {setup.numerics.courant}); the run may become unstable", file=sys.stderr)
-    record(state)
-    maybe_snapshot(state)
-    tag = label or f"{summary['scene']} {method} {state.dim}D"
+
+
+class _Progress:
+    """A progress line on stderr every 2 s."""
+
+    def __init__(self, tag: str, t_end: float, on: bool):
+        self.tag, self.t_end, self.on = tag, t_end, on
+        self.t0 = self.last = time.perf_counter()
+
+    def __call__(self, n_steps: int, t: float, dt: float) -> None:
+        now = time.perf_counter()
+        if self.on and now - self.last > 2.0:
+            frac, el = t / self.t_end, now - self.t0
+            print(f"[{self.tag}] step {n_steps:6d}  t = {t:.3e} s ({100 * frac:5.1f} %)  dt = {dt:.2e} s  "
+                  f"elapsed {el:6.1f} s, ~{el / max(frac, 1e-9) - el:6.1f} s left", file=sys.stderr, flush=True)
+            self.last = now
+
+
+def simulate(setup: Setup, method: str | None = None, *, scene: Scene | None = None,
+             record: Callable[[State, Setup], dict] | None = None,
+             metrics: Callable[[dict, State, Setup], dict] | None = None, solver: Solver | None = None,
+             hook: Callable[[State, Solver], State | None] | None = None, out=None, dt: float | None = None,
+             progress: bool = True, label: str = "", record_every: int | None = None) -> RunResult:
+    """Run a prepared setup with ``method`` ('esph' | 'tlsph'), or with a ``solver`` of one's own (any
+    :class:`~refsph.integrate.Solver`, e.g. one that wraps ``make_solver(method, setup)`` to add a force).
+
+    ``record(state, setup) -> dict`` of scalars is called on the initial state, every ``record_every`` steps
+    (default: about 400 records per run) and on the final state; the lists it builds are the ``history``, which
+    ``metrics(history, state, setup) -> dict`` turns into ``summary['metrics']``. ``scene``: take both (and the
+    name) from a :class:`~refsph.scenes.Scene`. ``hook(state, solver)`` is called after every step and may return
+    a changed state (prescribed kinematics). ``dt=None``: the CFL step every step; else a fixed ``dt``.
+    ``out``: the run folder (summary.json, snapshots/, reaction_forces.csv), None: nothing written."""
+    method = method if solver is None else solver.method
+    _validate(method, setup.state.dim, setup.dp, setup.numerics, setup.t_end, dt)
+    record = record or (scene.record if scene is not None else None)
+    metrics = metrics or (scene.metrics if scene is not None else None)
+    state = setup.state.copy()
+    state.check()
+    solver = solver if solver is not None else make_solver(method, setup)
+    stepper = get_stepper(setup.numerics.integrator)
+    solver.check_state(state)
+    name = scene.name if scene is not None else label
+    rec = RunRecord(setup, solver, out, dt, name, record, snapshot_times(setup))
+    if record_every is None:
+        record_every = max(1, int(setup.t_end / _time_step(setup, dt, state) / 400))
+    _warn_fixed_dt(setup, dt, state)
+    show = _Progress(label or f"{name} {method} {state.dim}D", setup.t_end, progress)
+    rec.record(state)
+    rec.snapshot_if_due(state)
     try:
         while state.t < setup.t_end * (1 - 1e-12):
-            step_dt = dt if dt is not None else cfl_time_step(state, setup.material, setup.h,
-                                                               setup.numerics.courant)
-            dts.append(step_dt)                             # the step size chosen (before any cut to land on t_end)
+            step_dt = _time_step(setup, dt, state)
+            rec.dts.append(step_dt)                         # the step size chosen (before any cut to land on t_end)
             step_dt = min(step_dt, setup.t_end - state.t)
-            prev = state
-            try:
-                with np.errstate(divide="ignore", invalid="ignore", over="ignore"):  # non-finite: caught below
-                    state = predictor_corrector_step(state, solver, step_dt)
-            except ValueError as e:                         # e.g. a particle crossed a symmetry plane
-                msg = f"step {n_steps + 1} (t = {prev.t:.6e} s) failed: {e}"
-                if out is not None:
-                    save_snapshot(out / "snapshots" / "last_good.npz", prev, setup.material, F_of(prev))
-                    msg += f"; last good state written to {out / 'snapshots' / 'last_good.npz'}"
-                summary.update(status="error", error=msg)
-                raise SimulationError(msg) from e
-            n_steps += 1
-            if not (np.isfinite(state.v).all() and np.isfinite(state.x).all()):
-                bad = state.first_nonfinite() or ("x/v", -1)
-                msg = (f"non-finite {bad[0]} at particle {bad[1]} in step {n_steps} "
-                       f"(t = {prev.t:.6e} s -> {state.t:.6e} s)")
-                if out is not None:
-                    save_snapshot(out / "snapshots" / "last_good.npz", prev, setup.material, F_of(prev))
-                    msg += f"; last good state written to {out / 'snapshots' / 'last_good.npz'}"
-                summary.update(status="nan", error=msg)
-                raise SimulationError(msg)
-            if n_steps % record_every == 0:
+            state = step_or_fail(state, solver, step_dt, rec, stepper)
+            if hook is not None:
+                state = hook(state, solver) or state
+            if rec.n_steps % record_every == 0:
                 with np.errstate(over="ignore", invalid="ignore"):  # near-blow-up states are caught above
-                    record(state)
-            maybe_snapshot(state)
-            now = time.perf_counter()
-            if progress and now - last_print > 2.0:
-                frac = state.t / setup.t_end
-                el = now - t0
-                print(f"[{tag}] step {n_steps:6d}  t = {state.t:.3e} s ({100 * frac:5.1f} %)  "
-                      f"dt = {step_dt:.2e} s  elapsed {el:6.1f} s, ~{el / max(frac, 1e-9) - el:6.1f} s left",
-                      file=sys.stderr, flush=True)
-                last_print = now
-        if n_steps % record_every != 0:
-            record(state)
-        summary["status"] = "ok"
+                    rec.record(state)
+            rec.snapshot_if_due(state)
+            show(rec.n_steps, state.t, step_dt)
+        if rec.n_steps % record_every != 0:
+            rec.record(state)
+        rec.summary["status"] = "ok"
     except KeyboardInterrupt:
-        summary["status"] = "interrupted"
+        rec.summary["status"] = "interrupted"
         raise
     except Exception as e:
-        if summary["status"] == "running":
-            summary.update(status="error", error=f"{type(e).__name__}: {e}")
+        if rec.summary["status"] == "running":
+            rec.summary.update(status="error", error=f"{type(e).__name__}: {e}")
         raise
     finally:
-        update_outputs(state)
-        if scene is not None and history and summary["status"] == "ok":
-            summary["metrics"] = scene.metrics(history, state, setup)
-        if out is not None:
-            write_json(out / "summary.json", summary)
-    return RunResult(summary=summary, state=state, history=history, setup=setup)
+        rec.finish(state, metrics)
+    return RunResult(summary=rec.summary, state=state, history=rec.history, setup=setup)
 
 
 def run(scene_name: str, method: str, *, dim: int | None = None, dp: float | None = None,
@@ -245,13 +307,9 @@ def run(scene_name: str, method: str, *, dim: int | None = None, dp: float | Non
     """Build scene ``scene_name`` and run it. ``dim``: None = the scene's default; ``numerics`` overrides
     fields of the scene's Numerics; ``options`` sets the scene's own options (``Scene.options``)."""
     scene = get_scene(scene_name)
-    if dim is None:
-        dim = scene.default_dim
+    dim = scene.default_dim if dim is None else dim
     _validate(method, dim, dp, None, t_end, dt)
-    options = convert_options(scene, options or {})
-    if dp is None:
-        dp = scene.default_dp(dim, quick)
-    setup = scene.build(dim, dp, quick, **options)
+    setup = scene.setup(dim, dp, quick, **(options or {}))
     if numerics:
         unknown = set(numerics) - {f.name for f in dataclasses.fields(setup.numerics)}
         if unknown:

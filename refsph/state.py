@@ -10,27 +10,30 @@ out-of-plane normal stress is not, so the deviatoric stress carries its zz compo
 | x     | (N, d)    | m               | current position                                         |
 | v     | (N, d)    | m/s             | velocity                                                 |
 | m     | (N,)      | kg (2D: kg/m)   | mass, constant                                           |
-| rho   | (N,)      | kg/m^3          | density (ESPH: integrated by Eq. 10; TLSPH: m/(J V0))    |
+| rho   | (N,)      | kg/m^3          | density (ESPH: integrated by Eq. (10); TLSPH: m/(J V0))    |
 | S     | (N, d, d) | Pa              | deviatoric Cauchy stress (in-plane block in 2D)          |
 | S_zz  | (N,)      | Pa              | out-of-plane deviatoric normal stress (2D plane strain; zero and unused in 3D) |
 | X     | (N, d)    | m               | reference position (TLSPH; the initial position for ESPH)|
 | V0    | (N,)      | m^3 (2D: m^2)   | reference volume (TLSPH; V <- J V at a reference update) |
 | t     | scalar    | s               | time                                                     |
 
-Thermo-mechanical fields, present (arrays) only when the scene's material is Johnson-Cook (else None):
+Plastic and thermal fields, present (arrays) only when the scene's strength model is a plasticity law
+(``PLASTIC_FIELDS``, see :mod:`refsph.strength`; else None):
 
 | field     | shape | unit    | meaning                                                          |
 |-----------|-------|---------|------------------------------------------------------------------|
-| eps_p     | (N,)  | -       | accumulated effective plastic strain (Eq. 30 summed)             |
+| eps_p     | (N,)  | -       | accumulated effective plastic strain (Eq. (30) summed)             |
 | eps_dot_p | (N,)  | 1/s     | effective plastic strain rate of the last step, d eps_p / dt     |
-| W_p       | (N,)  | J/m^3   | accumulated plastic work density (Eq. 31 summed)                 |
-| T         | (N,)  | K       | temperature (Eq. 28, adiabatic)                                  |
+| W_p       | (N,)  | J/m^3   | accumulated plastic work density (Eq. (31) summed)                 |
+| T         | (N,)  | K       | temperature (Eq. (28), adiabatic)                                  |
 
 Scenes with several bodies (a workpiece and rigid tools) also carry
 
 | field | shape | unit | meaning                                                                        |
 |-------|-------|------|--------------------------------------------------------------------------------|
-| body  | (N,)  | -    | body id of each particle (0: the deformable workpiece; rigid tools: their own id, see :class:`~refsph.boundaries.RigidBody`); None means every particle is body 0 |
+| body  | (N,)  | -    | body id of each particle (0: the deformable workpiece; rigid tools: their own id) |
+
+(see :class:`~refsph.boundaries.RigidBody`); ``body = None`` means every particle is body 0.
 """
 from __future__ import annotations
 
@@ -38,7 +41,7 @@ from dataclasses import dataclass, fields, replace
 
 import numpy as np
 
-__all__ = ["State", "FIELD_UNITS", "THERMAL_FIELDS", "make_state", "concatenate_states"]
+__all__ = ["State", "Rates", "FIELD_UNITS", "PLASTIC_FIELDS", "make_state", "concatenate_states"]
 
 FIELD_UNITS = {
     "x": "m",
@@ -57,7 +60,7 @@ FIELD_UNITS = {
     "body": "1 (body id)",
 }
 
-THERMAL_FIELDS = ("eps_p", "eps_dot_p", "W_p", "T")
+PLASTIC_FIELDS = ("eps_p", "eps_dot_p", "W_p", "T")
 
 
 @dataclass
@@ -105,11 +108,11 @@ class State:
             a = getattr(self, name)
             if a.shape != shape:
                 raise ValueError(f"state field {name} must have shape {shape}, got {a.shape}")
-        present = [getattr(self, k) is not None for k in THERMAL_FIELDS]
+        present = [getattr(self, k) is not None for k in PLASTIC_FIELDS]
         if any(present) and not all(present):
-            raise ValueError(f"state fields {', '.join(THERMAL_FIELDS)} must be all present or all None")
+            raise ValueError(f"state fields {', '.join(PLASTIC_FIELDS)} must be all present or all None")
         if all(present):
-            for name in THERMAL_FIELDS:
+            for name in PLASTIC_FIELDS:
                 if getattr(self, name).shape != (n,):
                     raise ValueError(f"state field {name} must have shape {(n,)}, got {getattr(self, name).shape}")
             if np.any(self.T <= 0):
@@ -123,7 +126,7 @@ class State:
 
     def first_nonfinite(self) -> tuple[str, int] | None:
         """(field, particle index) of the first NaN/inf in an evolving field, or None."""
-        for name in ("x", "v", "rho", "S", "S_zz") + (THERMAL_FIELDS if self.plastic else ()):
+        for name in ("x", "v", "rho", "S", "S_zz") + (PLASTIC_FIELDS if self.plastic else ()):
             a = getattr(self, name)
             bad = ~np.isfinite(a.reshape(a.shape[0], -1)).all(axis=1)
             if bad.any():
@@ -131,13 +134,43 @@ class State:
         return None
 
 
-def make_state(x: np.ndarray, v: np.ndarray, rho0: float, volume: np.ndarray | float,
-               T0: float | None = None, body: np.ndarray | None = None) -> State:
-    """A stress-free state at rest density ``rho0``: m = rho0 V, X = x, V0 = V.
+@dataclass
+class Rates:
+    """Time derivatives of the evolved fields of a :class:`State` (same shapes). ``rho`` is None where density is not
+    integrated (TLSPH, Eq. (2)); ``l`` is the velocity gradient the stress rate came from (the strength model takes
+    its strain rate from it)."""
 
-    ``T0`` (kelvin): give it for a Johnson-Cook material; the state then carries eps_p = eps_dot_p = W_p = 0
-    and T = T0. Without it those fields are None (elastic material). ``body``: body id per particle (see the
-    table above), or None for a single body."""
+    x: np.ndarray
+    v: np.ndarray
+    rho: np.ndarray | None
+    S: np.ndarray
+    S_zz: np.ndarray
+    l: np.ndarray | None = None
+
+    def rows(self, n: int) -> "Rates":
+        """The rates of the first n rows (the real particles of a real + ghost evaluation)."""
+        return Rates(x=self.x[:n], v=self.v[:n], rho=None if self.rho is None else self.rho[:n], S=self.S[:n],
+                     S_zz=self.S_zz[:n], l=None if self.l is None else self.l[:n])
+
+
+def make_state(x: np.ndarray, v: np.ndarray, rho0: float, volume: np.ndarray | float,
+               T0: float | None = None, body: np.ndarray | None = None, *, S: np.ndarray | None = None,
+               S_zz: np.ndarray | float | None = None, rho: np.ndarray | float | None = None) -> State:
+    """A state at rest density ``rho0`` unless told otherwise: m = rho0 V, X = x, V0 = V.
+
+    ``T0`` (kelvin): give it for a plasticity law; the state then carries eps_p = eps_dot_p = W_p = 0 and T = T0.
+    Without it those fields are None (elastic material). ``body``: body id per particle (see the table above),
+    or None for a single body.
+
+    An initial stress: ``S`` (N, d, d) or (d, d) deviatoric stress (traceless; in 2D with ``S_zz``, so that
+    S_xx + S_yy + S_zz = 0), and ``rho``, the current density, which sets the pressure p = K (rho / rho0 - 1)
+    (Eq. (24)). What each method reads of it:
+
+    * ESPH reads ``S``, ``S_zz`` and ``rho`` (it integrates rho by Eq. (10)): both parts of the stress are used;
+    * TLSPH reads ``S`` and ``S_zz``, and computes rho and p from m, V0 and J = det F (Eq. (2)), so it cannot
+      start from a pressure that the configuration does not carry: its solver refuses a state whose rho is not
+      m / (J V0) (start from a deformed configuration, x != X, instead).
+    """
     x = np.array(x, dtype=float)
     n, d = x.shape
     V = np.broadcast_to(np.asarray(volume, dtype=float), (n,)).copy()
@@ -149,13 +182,22 @@ def make_state(x: np.ndarray, v: np.ndarray, rho0: float, volume: np.ndarray | f
         raise ValueError(f"initial temperature T0 must be positive (kelvin), got {T0!r}")
     thermal = {} if T0 is None else dict(eps_p=np.zeros(n), eps_dot_p=np.zeros(n), W_p=np.zeros(n),
                                          T=np.full(n, float(T0)))
+    S = np.zeros((n, d, d)) if S is None else np.broadcast_to(np.asarray(S, dtype=float), (n, d, d)).copy()
+    S_zz = np.zeros(n) if S_zz is None else np.broadcast_to(np.asarray(S_zz, dtype=float), (n,)).copy()
+    trace = np.trace(S, axis1=1, axis2=2) + (S_zz if d == 2 else 0.0)
+    if not np.all(np.abs(trace) <= 1e-12 * np.max(np.abs(S), initial=1.0)):
+        raise ValueError("initial deviatoric stress S must be traceless (in 2D: S_xx + S_yy + S_zz = 0); put the "
+                         "mean stress into the density rho")
+    if d == 3 and np.any(S_zz != 0):
+        raise ValueError("S_zz is the 2D plane-strain component; in 3D it is S[:, 2, 2]")
+    rho = np.full(n, float(rho0)) if rho is None else np.broadcast_to(np.asarray(rho, dtype=float), (n,)).copy()
     return State(
         x=x,
         v=np.broadcast_to(np.asarray(v, dtype=float), (n, d)).copy(),
         m=rho0 * V,
-        rho=np.full(n, float(rho0)),
-        S=np.zeros((n, d, d)),
-        S_zz=np.zeros(n),
+        rho=rho,
+        S=S,
+        S_zz=S_zz,
         X=x.copy(),
         V0=V,
         body=None if body is None else np.asarray(body, dtype=np.int32).copy(),

@@ -6,6 +6,9 @@ reference configuration is updated, so every sum below is a product with a fixed
 terms depend on the current x_ij and v_ij, is summed block by block with the operator's
 :class:`~refsph.neighbours.PairBlocks` (fixed sparse patterns, new values at each evaluation).
 
+    Eq. (15)  f(X_i)  = sum_j V_j f(X_j) W(X_ij),  V_j = m_j / rho_0j         (interpolation; refsph needs only
+                                                                               its gradient, Eq. (16))
+    Eq. (16)  grad f(X_i) = - sum_j V_j (f(X_i) - f(X_j)) (x) grad_i W(X_ij)  (:meth:`ReferenceOperator.gradient`)
     Eq. (18)  F_i     = - sum_j V_j (x_i - x_j) (x) grad_i W(X_ij)            (deformation gradient)
     Eq. (19)  Fdot_i  = - sum_j V_j (v_i - v_j) (x) grad_i W(X_ij)
               l_i     = Fdot_i F_i^-1                                          (velocity gradient)
@@ -37,21 +40,21 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
-from .esph import Rates, artificial_viscosity
+from .esph import artificial_viscosity
 from .kernels import Kernel
 from .material import ElasticMaterial, cauchy_stress, eos_pressure, jaumann_deviatoric_rate
 from .neighbours import PairBlocks, find_pairs, scatter_add
-from .state import State
+from .state import Rates, State
 from .tensor import component_major, det, identity, inv, matmul, rowdot, transpose
 
 __all__ = ["TLSPHParams", "ReferenceOperator", "tlsph_rates", "first_piola", "green_lagrange_norm",
-           "reference_update", "reset_reference", "reference_viscosity"]
+           "reference_update", "reference_viscosity", "correction_matrix"]
 
 
 @dataclass(frozen=True)
 class TLSPHParams:
     """Numerical parameters of TLSPH. h: smoothing length in the reference configuration [m];
-    beta1, beta2, eps: artificial viscosity (Eqs. 12-13); corrected: kernel-gradient correction;
+    beta1, beta2, eps: artificial viscosity (Eqs. (12)-(13)); corrected: kernel-gradient correction;
     ref_update_strain: update the reference configuration when max_i |E_i| exceeds it, with
     E = (F^T F - I)/2 the Green-Lagrange strain (None: never)."""
 
@@ -72,7 +75,7 @@ class ReferenceOperator:
         G[k][i, j] = V_j (L_i grad_i W(X_ij))_k      (j != i; L = I when not corrected)
 
     so that  sum_j V_j f_j (x) grad~_i W_ij = (G[k] @ f)_i  and  sum_j V_j grad~_i W_ij = G[k] @ 1.
-    ``GT[k]`` is its transpose (CSR), used for the j-side term of the momentum sum (Eq. 17).
+    ``GT[k]`` is its transpose (CSR), used for the j-side term of the momentum sum (Eq. (17)).
     The kernel-gradient correction L is baked into the entries, so F needs no per-step matrix product.
     Products are taken one column at a time: SciPy's single-vector CSR product is its fastest sparse
     kernel (about 0.5 ns per stored entry), faster than its multi-vector one.
@@ -123,6 +126,7 @@ class ReferenceOperator:
         for blk in self.pairs.blocks:                          # its reference gradients, per component
             blk.gW = [np.ascontiguousarray(self.gW[blk.sl, k]) for k in range(d)]
         self._sm, self._sm_m = None, None
+        self.momentum_cache_hits = self.momentum_cache_misses = 0
 
     def gradient(self, f: np.ndarray) -> np.ndarray:
         """Eq. (16) with the corrected gradient: sum_j V_j (f_j - f_i) (x) grad~_i W_ij, (N, c) -> (N, c, d).
@@ -151,10 +155,13 @@ class ReferenceOperator:
         the j-side term uses the transposed operator: m_j grad~_j W_ji = (m_j / V_i) G[k][j, i].
         The pair term is antisymmetric, so sum_i m_i dv_i/dt = 0 (momentum conserved to round-off).
         """
-        if self._sm is None or self._sm_m is not m:
+        if self._sm is None or self._sm_m is not m:          # cached per mass array (the masses are constant)
             rho_ref = m / self.V
             self._sm = np.stack([Gk @ rho_ref for Gk in self.G], axis=1)  # sum_j m_j grad~_i W_ij (fixed)
             self._sm_m = m
+            self.momentum_cache_misses += 1
+        else:
+            self.momentum_cache_hits += 1
         sm = self._sm
         Q = component_major(Q)
         d = self.dim
@@ -189,7 +196,7 @@ def correction_matrix(M: np.ndarray, tol: float = 1e-6) -> tuple[np.ndarray, np.
     return L, bad
 
 
-def first_piola(sigma: np.ndarray, F: np.ndarray, J: np.ndarray, Finv: np.ndarray) -> np.ndarray:
+def first_piola(sigma: np.ndarray, J: np.ndarray, Finv: np.ndarray) -> np.ndarray:
     """P = J sigma F^-T (the transpose of the paper's printed J F^-1 sigma; see the module docstring)."""
     return matmul(J[:, None, None] * sigma, transpose(Finv))
 
@@ -255,7 +262,7 @@ def tlsph_rates(state: State, mat: ElasticMaterial, prm: TLSPHParams, op: Refere
                 out: dict | None = None, F: np.ndarray | None = None) -> Rates:
     """All TLSPH time derivatives. If ``out`` is a dict, F, J, P and l are stored in it (diagnostics).
 
-    ``F``: the deformation gradient of ``state.x`` on ``op`` (Eq. 18), if the caller already has it."""
+    ``F``: the deformation gradient of ``state.x`` on ``op`` (Eq. (18)), if the caller already has it."""
     n, d = state.x.shape
     x, v, m = state.x, state.v, state.m
 
@@ -270,7 +277,7 @@ def tlsph_rates(state: State, mat: ElasticMaterial, prm: TLSPHParams, op: Refere
     rho = rho_ref / J                                       # Eq. (2)
     p = eos_pressure(rho, mat.rho0, mat.K)                  # Eq. (24)
     sigma = cauchy_stress(state.S, p)
-    P = first_piola(sigma, F, J, Finv)
+    P = first_piola(sigma, J, Finv)
 
     # Eq. (17), stress part: a_i = sum_j m_j (P_i / rho_0i^2 grad~_i W_ij - P_j / rho_0j^2 grad~_j W_ji)
     a = op.momentum_sum(P / (rho_ref**2)[:, None, None], m)
@@ -286,24 +293,13 @@ def tlsph_rates(state: State, mat: ElasticMaterial, prm: TLSPHParams, op: Refere
     return Rates(x=v.copy(), v=a, rho=None, S=dS, S_zz=dS_zz, l=l)
 
 
-def reset_reference(state: State, F: np.ndarray) -> State:
-    """X <- x, V <- J V (Section 3), J = det F; stress and every other field kept. A new state."""
+def reference_update(state: State, F: np.ndarray) -> State:
+    """Reference-configuration update (Section 3): X <- x, V0 <- J V0, J = det F, rho = m / V0; stress and every
+    other field kept. ``F``: the deformation gradient of ``state.x`` on the old reference configuration (Eq. (18)).
+    A new state; the operator of the new configuration is ``ReferenceOperator(new.X, new.V0, ...)``."""
     J = det(F)
     new = state.copy()
     new.X = state.x.copy()
     new.V0 = J * state.V0
     new.rho = state.m / new.V0
     return new
-
-
-def reference_update(state: State, op: ReferenceOperator,
-                     F: np.ndarray | None = None) -> tuple[State, ReferenceOperator]:
-    """X <- x, V <- J V (Section 3); stress kept. Returns the new state and the rebuilt operator.
-
-    ``F``: the deformation gradient of ``state.x`` on ``op`` (Eq. 18), if the caller already has it."""
-    if F is None:
-        F = op.deformation_gradient(state.x)
-    new = reset_reference(state, F)
-    new_op = ReferenceOperator(new.X, new.V0, op.h, op.kernel, op.corrected, threads=op.pairs.threads,
-                               block_size=op.pairs.size)
-    return new, new_op

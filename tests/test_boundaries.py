@@ -6,7 +6,7 @@ from refsph.boundaries import MirrorPlanes, RigidWall
 from refsph.scenes import Numerics, Setup, lattice
 from refsph.simulate import run, simulate
 from refsph.state import make_state
-from refsph.taylor import taylor_material
+from refsph.scenes.taylor import taylor_material
 
 
 def test_mirror_ghosts_quarter():
@@ -88,7 +88,7 @@ def test_symmetry_plane_equals_whole_body(method):
 def test_quarter_model_equals_whole_body_3d(method):
     """3D: two symmetry planes (plane and edge ghosts), the wall, plasticity and -- for TLSPH -- reference
     updates forced by a low threshold: the quarter reproduces the whole block particle by particle."""
-    from refsph.taylor import taylor_johnson_cook
+    from refsph.scenes.taylor import taylor_johnson_cook
     mat = taylor_material()
     jc = taylor_johnson_cook(1293.0, 1.0)
     dp = 1e-3
@@ -101,7 +101,7 @@ def test_quarter_model_equals_whole_body_3d(method):
         v[:, 2] = -181.0
         st = make_state(x, v, mat.rho0, dp**3, T0=293.0)
         return Setup(state=st, material=mat, dp=dp, numerics=Numerics(ref_update_strain=0.02), t_end=3e-6,
-                     n_snapshots=1, plasticity=jc, mirror=mirror,
+                     n_snapshots=1, strength=jc, mirror=mirror,
                      walls=(RigidWall(axis=2, position=0.0, gap=0.5 * dp),))
     rq = simulate(setup(q, MirrorPlanes((0, 1))), method, progress=False)
     rw = simulate(setup(w, None), method, progress=False)

@@ -3,7 +3,6 @@
 Chapters are jupytext percent-format .py files; each one compares the package's fast code with its plain
 pair-by-pair version in ``assert`` cells, so a failing comparison fails this test.
 """
-import os
 import time
 from pathlib import Path
 
@@ -30,5 +29,6 @@ def test_chapter_runs_quick(path, tmp_path, monkeypatch):
 
 def test_chapters_exist():
     names = {p.stem for p in CHAPTERS}
-    for stem in ("01_kernel", "02_esph", "03_tlsph", "04_johnson_cook", "05_contact", "06_taylor", "07_pressing", "08_cutting"):
+    for stem in ("01_kernel", "02_esph", "03_tlsph", "04_johnson_cook", "05_contact", "06_taylor", "07_pressing",
+                 "08_cutting"):
         assert stem in names

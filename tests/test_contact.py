@@ -8,16 +8,15 @@ from refsph.boundaries import Clamp, MirrorPlanes, RigidBody
 from refsph.contact import (CoulombFriction, PinballContact, hertz_force, penetration, pinball_contact,
                             pinball_force, rate_force, reduced)
 from refsph.esph import ESPHParams
-from refsph.integrate import ESPHSolver, TLSPHSolver
+from refsph.solvers import ESPHSolver, TLSPHSolver
 from refsph.io import load_reactions
 from refsph.kernels import get_kernel
-from refsph.material import ElasticMaterial
-from refsph.scenes import AISI4340_ELASTIC, Numerics, Setup, lattice
+from refsph.scenes import aisi4340_material, Numerics, Setup, lattice
 from refsph.simulate import simulate
 from refsph.state import concatenate_states, make_state
 from refsph.tlsph import TLSPHParams
 
-MAT = ElasticMaterial(**AISI4340_ELASTIC)
+MAT = aisi4340_material()
 
 
 # ----------------------------------------------------------------------------- formulas

@@ -6,14 +6,16 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from refsph.cutting import CUTTING_GEOMETRY, TOOL_BODY, analyse_run, chip_thickness, shear_bands
+from refsph.paper_data import CUTTING_GEOMETRY
+from refsph.scenes.cutting import analyse_run, chip_thickness, shear_bands
+from refsph.scenes.measure import TOOL_BODY
 from refsph.scenes import get_scene
 from refsph.simulate import run
 
 
 @pytest.mark.parametrize("feed", [0.3e-3, 0.5e-3])
 def test_geometry(feed):
-    setup = get_scene("cutting").build(2, 0.01e-3, False, feed=feed)
+    setup = get_scene("cutting").setup(2, 0.01e-3, False, feed=feed)
     s, info = setup.state, setup.info
     n = info["n_work"]
     (Lx, Ly) = CUTTING_GEOMETRY["workpiece_m"]
@@ -32,11 +34,11 @@ def test_geometry(feed):
 def test_bad_input():
     sc = get_scene("cutting")
     with pytest.raises(ValueError, match="2D"):
-        sc.build(3, 0.01e-3, False)
+        sc.setup(3, 0.01e-3, False)
     with pytest.raises(ValueError, match="feed"):
-        sc.build(2, 0.01e-3, False, feed=1.2e-3)
+        sc.setup(2, 0.01e-3, False, feed=1.2e-3)
     with pytest.raises(ValueError, match="travel"):
-        sc.build(2, 0.01e-3, False, travel=-1.0)
+        sc.setup(2, 0.01e-3, False, travel=-1.0)
 
 
 def test_chip_thickness_of_a_slab():
@@ -160,7 +162,7 @@ def test_cli_option_flags_and_numerics(tmp_path, capsys):
 
 def test_report_reads_summary_files(coarse):
     """The report table takes summaries as written to summary.json (unmeasurable values are null there)."""
-    from refsph.cutting import cutting_table
+    from refsph.scenes.cutting import cutting_table
     from refsph.io import load_run
     summaries = [load_run(out)[0] for _, out in coarse.values()]
     assert any(v is None for s in summaries for v in s["metrics"].values())   # e.g. no band spacing at 0.2 mm

@@ -22,7 +22,7 @@ def test_run_writes_summary_and_snapshots(tmp_path, method):
     assert summary["status"] == "ok"
     assert summary["n_particles"] == res.state.n and summary["n_steps"] > 0
     assert summary["method"] == method and summary["dim"] == 2
-    assert len(snaps) == get_scene("bar").build(2, summary["dp"], True).n_snapshots + 1
+    assert len(snaps) == get_scene("bar").setup(2, summary["dp"], True).n_snapshots + 1
     last = load_snapshot(snaps[-1])
     assert last["t"] == pytest.approx(2e-6)
     np.testing.assert_allclose(last["x"], res.state.x)
@@ -54,7 +54,7 @@ def test_summary_is_written_at_every_snapshot(tmp_path, monkeypatch):
 
 def test_nan_stops_and_keeps_last_good(tmp_path):
     out = tmp_path / "bad"
-    setup = get_scene("bar").build(2, get_scene("bar").default_dp(2, True), True)
+    setup = get_scene("bar").setup(2, get_scene("bar").default_dp(2, True), True)
     setup.t_end = 2e-5                           # a fixed dt 5 x above the CFL limit blows TLSPH up
     with pytest.raises(SimulationError, match=r"non-finite .* at particle \d+ in step \d+"):
         simulate(setup, "tlsph", scene=get_scene("bar"), out=out, dt=8e-8, progress=False)

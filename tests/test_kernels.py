@@ -96,7 +96,8 @@ def test_gradient_matches_finite_differences(name, dim):
     for k in range(dim):
         e = np.zeros(dim)
         e[k] = eps
-        g_fd[:, k] = (K.w(np.linalg.norm(x + e, axis=1), h, dim) - K.w(np.linalg.norm(x - e, axis=1), h, dim)) / (2 * eps)
+        g_fd[:, k] = (K.w(np.linalg.norm(x + e, axis=1), h, dim)
+                      - K.w(np.linalg.norm(x - e, axis=1), h, dim)) / (2 * eps)
     assert np.max(np.abs(g - g_fd)) < 1e-7 * np.max(np.abs(g))
     # and the radial derivative against FD in r
     r = np.linspace(0.01, 2.2, 300) * h

@@ -5,11 +5,12 @@ import numpy as np
 import pytest
 
 from refsph.material_point import material_point
-from refsph.plasticity import (JohnsonCook, effective_plastic_strain_increment, equivalent_strain_rate,
-                               plastic_strain_increment, plastic_update, plastic_work_increment, radial_return,
+from refsph.strength import plastic_update
+from refsph.plasticity import (JohnsonCook, ModifiedJohnsonCook, effective_plastic_strain_increment,
+                               equivalent_strain_rate, plastic_strain_increment, plastic_work_increment, radial_return,
                                yield_stress)
-from refsph.reference import AISI1045_RLA
-from refsph.taylor import taylor_johnson_cook, taylor_material
+from refsph.paper_data import AISI1045_RLA
+from refsph.scenes.taylor import taylor_johnson_cook, taylor_material
 
 MAT = taylor_material()
 JC = taylor_johnson_cook(1293.0, 1.0)
@@ -34,8 +35,8 @@ def test_modified_law_saturates():
     base = dict(A=AISI1045_RLA["A_Pa"], B=AISI1045_RLA["B_Pa"], n=AISI1045_RLA["n"], C=AISI1045_RLA["C"],
                 m=AISI1045_RLA["m"], eps_dot_0=AISI1045_RLA["eps_dot_0"], T_room=AISI1045_RLA["T_room_K"],
                 T_melt=AISI1045_RLA["T_melt_K"], cp=AISI1045_RLA["cp_J_kgK"], chi=0.9)
-    orig = JohnsonCook(**base, hardening_saturation_strain=None)
-    mod = JohnsonCook(**base, hardening_saturation_strain=2.0)
+    orig = JohnsonCook(**base)
+    mod = ModifiedJohnsonCook(**base, hardening_saturation_strain=2.0)
     e = np.linspace(0, 4, 81)
     so, sm = yield_stress(orig, e, 1.0, 293.0), yield_stress(mod, e, 1.0, 293.0)
     assert np.allclose(so[e <= 2], sm[e <= 2], rtol=1e-14)

@@ -6,10 +6,10 @@ import numpy as np
 import pytest
 
 from refsph.cli import main
-from refsph.reference import TAYLOR_GEOMETRY, TAYLOR_RESULTS
+from refsph.paper_data import TAYLOR_GEOMETRY, TAYLOR_RESULTS
 from refsph.scenes import get_scene
 from refsph.simulate import run
-from refsph.taylor import bar_diameter, bar_length
+from refsph.scenes.taylor import bar_diameter, bar_length
 
 REGRESSION = Path(__file__).parent / "regression" / "taylor_3d_1mm.json"
 L0, D0 = TAYLOR_GEOMETRY["length_m"], TAYLOR_GEOMETRY["diameter_m"]
@@ -18,7 +18,7 @@ L0, D0 = TAYLOR_GEOMETRY["length_m"], TAYLOR_GEOMETRY["diameter_m"]
 @pytest.mark.parametrize("dim,symmetry,dp", [(2, True, 0.5e-3), (2, False, 0.3e-3), (3, True, 0.5e-3),
                                              (3, False, 1.0e-3)])
 def test_initial_geometry_measures_exactly(dim, symmetry, dp):
-    setup = get_scene("taylor").build(dim, dp, False, symmetry=symmetry)
+    setup = get_scene("taylor").setup(dim, dp, False, symmetry=symmetry)
     s, info = setup.state, setup.info
     assert bar_length(s.x, info["dz"]) == pytest.approx(L0, rel=1e-12)
     assert bar_diameter(s.x, info["dr"]) == pytest.approx(D0, rel=1e-12)
@@ -81,7 +81,7 @@ def test_cli_taylor_table(tmp_path, capsys):
     assert "experiment" in out and "refsph ESPH" in out and "refsph TLSPH" in out
     for m in ("esph", "tlsph"):
         s = json.loads((tmp_path / m / "summary.json").read_text())
-        assert s["plasticity"]["T_melt"] == 1293.0
+        assert s["strength"]["T_melt"] == 1293.0
         assert {"final_length_mm", "final_diameter_mm", "length_history", "max_plastic_strain",
                 "max_temperature_K"} <= set(s["metrics"])
         assert s["metrics"]["reference"] == TAYLOR_RESULTS
@@ -95,7 +95,7 @@ def test_cli_options(tmp_path, capsys):
                "--option", "T_melt=1793", "--out", str(tmp_path)])
     assert rc == 0
     s = json.loads((tmp_path / "summary.json").read_text())
-    assert s["plasticity"]["T_melt"] == 1793.0
+    assert s["strength"]["T_melt"] == 1793.0
     snaps = sorted((tmp_path / "snapshots").glob("snap_*.npz"))
     z = np.load(snaps[-1])
     assert {"eps_p", "T", "W_p", "eps_dot_p"} <= set(z.files)

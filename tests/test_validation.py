@@ -1,5 +1,4 @@
 """Elastic validation on whole runs: wave speed, momentum, energy, tensile instability."""
-import numpy as np
 import pytest
 
 from refsph.scenes import get_scene
@@ -9,7 +8,7 @@ W = 2e-3  # bar width in scene 'bar'
 
 
 def _period(dim=2):
-    setup = get_scene("bar").build(dim, W / 4, True)
+    setup = get_scene("bar").setup(dim, W / 4, True)
     return setup.info["period_theory"]
 
 

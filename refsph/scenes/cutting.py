@@ -40,22 +40,19 @@ from pathlib import Path
 
 import numpy as np
 
-from .boundaries import Clamp, RigidBody
-from .pressing import _binned, _time_mean, block_lattice, pressing_johnson_cook, pressing_material
-from .state import concatenate_states, make_state
+from ..boundaries import Clamp, RigidBody
+from ..io import load_reactions, load_run, load_snapshot
+from ..paper_data import CUTTING_GEOMETRY, CUTTING_OBSERVED, CUTTING_TABLE5
+from ..state import concatenate_states, make_state
+from .base import Numerics, Scene, Setup
+from .measure import (N_FORCE_BINS, TOOL_BODY, aisi4340_johnson_cook, aisi4340_material, binned_mean,
+                      block_lattice, time_mean)
 
-__all__ = ["make_scene", "cutting_particles", "CUTTING_GEOMETRY", "TOOL_BODY"]
-
-TOOL_BODY = 1
-N_FORCE_BINS = 400
+__all__ = ["SCENE", "cutting_particles", "chip_thickness", "lattice_shape", "shear_bands", "cutting_metrics",
+           "analyse_run", "cutting_table", "STEADY_FROM", "BAND_REL_PROMINENCE"]
 STEADY_FROM = 0.5             # force means over the second half of the run (t > STEADY_FROM t_end)
 BAND_REL_PROMINENCE = 0.5     # a shear band: a strain peak along the chip at least this x the median above its
 #                               surroundings (see shear_bands)
-# Section 3.3 and Table 5
-CUTTING_GEOMETRY = dict(workpiece_m=(3.0e-3, 1.0e-3), tool_m=(0.5e-3, 1.0e-3), tool_speed_m_s=50.0,
-                        feeds_m=(0.3e-3, 0.5e-3), particle_spacing_m=0.01e-3, smoothing_length_m=0.018e-3,
-                        time_step_s=1e-10, beta1=0.5, beta2=0.5)
-
 CUTTING_OPTIONS = {
     "feed": (0.3e-3, "depth of cut (the paper's 'feeding length') [m]: 0.3e-3 or 0.5e-3 in the paper"),
     "travel": (1.0e-3, "length of cut at the end of the run [m] (not printed in the paper)"),
@@ -82,22 +79,21 @@ def cutting_particles(dp: float, feed: float, n_tool_layers: int):
 
 
 def _default_dp(dim, quick):
-    return 0.025e-3 if quick else CUTTING_GEOMETRY["particle_spacing_m"]
+    return 0.025e-3 if quick else CUTTING_TABLE5["particle_spacing_m"]
 
 
-def _build(dim, dp, quick, feed=CUTTING_OPTIONS["feed"][0], travel=CUTTING_OPTIONS["travel"][0], eps_dot_0=1.0):
-    from .scenes import Numerics, Setup
+def _build(dim, dp, quick, *, feed, travel, eps_dot_0):
     if dim != 2:
         raise ValueError("the cutting scene is 2D plane strain")
     if not (np.isfinite(travel) and 0 < travel <= 2.0e-3):
         raise ValueError(f"travel must lie in (0, 2 mm], got {travel!r} m")
-    g = CUTTING_GEOMETRY
-    numerics = Numerics(h_over_dp=g["smoothing_length_m"] / g["particle_spacing_m"], beta1=g["beta1"],
-                        beta2=g["beta2"], gamma=0.3, skin_factor=0.15)
+    g, t5 = CUTTING_GEOMETRY, CUTTING_TABLE5
+    numerics = Numerics(h_over_dp=t5["smoothing_length_m"] / t5["particle_spacing_m"], beta1=t5["beta1"],
+                        beta2=t5["beta2"], gamma=t5["artificial_pressure_gamma_esph"], skin_factor=0.15)
     layers = math.ceil(2.0 * numerics.h_over_dp - 1e-9)
     xw, xt, dx, dy, clamp, y0 = cutting_particles(dp, float(feed), layers)
-    mat = pressing_material()                           # Table 3 (the same AISI 4340 as the pressing)
-    jc = pressing_johnson_cook(eps_dot_0)
+    mat = aisi4340_material()                           # Table 3 (the same AISI 4340 as the pressing)
+    jc = aisi4340_johnson_cook(eps_dot_0)
     speed = g["tool_speed_m_s"]
     work = make_state(xw, [0.0, 0.0], mat.rho0, dx * dy, T0=jc.T_room)
     tool = make_state(xt, [-speed, 0.0], mat.rho0, dx * dy, T0=jc.T_room, body=np.full(len(xt), TOOL_BODY))
@@ -106,7 +102,7 @@ def _build(dim, dp, quick, feed=CUTTING_OPTIONS["feed"][0], travel=CUTTING_OPTIO
                  n_snapshots=8, info=dict(n_work=work.n, n_tool=tool.n, dx=dx, dy=dy, feed_m=float(feed), y0=y0,
                                           tool_layers=layers, travel_m=float(travel), tool_speed_m_s=speed,
                                           eps_dot_0=float(eps_dot_0)),
-                 plasticity=jc, rigid=(RigidBody("tool", TOOL_BODY, (-speed, 0.0)),),
+                 strength=jc, rigid=(RigidBody("tool", TOOL_BODY, (-speed, 0.0)),),
                  clamps=(Clamp("held", clamp),))
 
 
@@ -220,8 +216,8 @@ def cutting_metrics(reaction: dict, x: np.ndarray, eps_p: np.ndarray, T: np.ndar
     F = np.asarray(reaction["tool"])
     Fc, Ft = F[:, 0], F[:, 1]         # Fc against the cut (the tool moves along -x); Ft pushes the tool up (+y)
     nb = min(N_FORCE_BINS, max(1, len(t_r)))
-    tb, cb = _binned(t_r, dt, Fc, t_end, nb)
-    _, tb_ = _binned(t_r, dt, Ft, t_end, nb)
+    tb, cb = binned_mean(t_r, dt, Fc, t_end, nb)
+    _, tb_ = binned_mean(t_r, dt, Ft, t_end, nb)
     x_tip = float(x[n:, 0].min()) - 0.5 * info["dx"]     # the rake face (and the cutting edge) at time t
     nx, ny = lattice_shape(info)
     X0 = block_lattice(nx, ny, info["dx"], info["dy"])[0]          # initial positions (the lattice)
@@ -232,8 +228,8 @@ def cutting_metrics(reaction: dict, x: np.ndarray, eps_p: np.ndarray, T: np.ndar
     return dict(
         cutting_force_history=np.stack([tb, cb], axis=1),
         thrust_force_history=np.stack([tb, tb_], axis=1),
-        cutting_force_mean_N_per_m=_time_mean(t_r, dt, Fc, STEADY_FROM * t_end),
-        thrust_force_mean_N_per_m=_time_mean(t_r, dt, Ft, STEADY_FROM * t_end),
+        cutting_force_mean_N_per_m=time_mean(t_r, dt, Fc, STEADY_FROM * t_end),
+        thrust_force_mean_N_per_m=time_mean(t_r, dt, Ft, STEADY_FROM * t_end),
         max_plastic_strain=float(np.max(eps_p[:n])),
         max_temperature_K=float(np.max(T[:n])),
         chip_thickness_mm=1e3 * tc,
@@ -258,7 +254,6 @@ def analyse_run(directory, snapshot: int = -1) -> dict:
     """:func:`cutting_metrics` of a cutting run folder (``refsph run cutting --out DIR``) from its
     ``summary.json``, ``reaction_forces.csv`` and snapshot number ``snapshot`` (default: the last); the forces
     cover the whole run. Lets a changed measurement be applied to earlier runs without running them again."""
-    from .io import load_reactions, load_run, load_snapshot
     directory = Path(directory)
     summary, snaps = load_run(directory)
     if summary.get("scene") != "cutting":
@@ -279,7 +274,6 @@ def _cell(value, width: int, fmt: str, scale: float = 1.0) -> str:
 
 def cutting_table(summaries: list) -> str:
     """The runs side by side, with what the paper reports (in words; no forces are printed)."""
-    from .reference import CUTTING_OBSERVED
     rows = ["Orthogonal cutting, 2D plane strain (Section 3.3). The paper prints no forces; it reports bands from the",
             f"tool tip to the free surface at about {CUTTING_OBSERVED['band_angle_deg']:.0f} deg, and for the deeper "
             f"feed: {CUTTING_OBSERVED['deeper_feed']}.",
@@ -297,19 +291,20 @@ def cutting_table(summaries: list) -> str:
         mm = lambda key, width, fmt, scale=1.0: _cell(m.get(key), width, fmt, scale)  # noqa: E731
         rows.append(f"{s['method']:7s} {feed:5.2f} {s['dp'] * 1e6:6.2f} {s['n_particles']:9d} {s['n_steps']:6d} "
                     f"{s['wall_time_s']:7.0f} {'-' if upd is None else upd:>7} "
-                    f"{mm('cutting_force_mean_N_per_m', 9, '.3f', 1e-6)} {mm('thrust_force_mean_N_per_m', 9, '.3f', 1e-6)} "
-                    f"{mm('chip_thickness_mm', 8, '.3f')} {mm('n_shear_bands', 5, 'd')} {mm('band_spacing_mm', 11, '.3f')} "
+                    f"{mm('cutting_force_mean_N_per_m', 9, '.3f', 1e-6)} "
+                    f"{mm('thrust_force_mean_N_per_m', 9, '.3f', 1e-6)} "
+                    f"{mm('chip_thickness_mm', 8, '.3f')} {mm('n_shear_bands', 5, 'd')} "
+                    f"{mm('band_spacing_mm', 11, '.3f')} "
                     f"{mm('band_angle_deg', 10, '.1f')} {CUTTING_OBSERVED['band_angle_deg']:5.0f} "
                     f"{mm('max_plastic_strain', 9, '.2f')} {mm('max_temperature_K', 8, '.0f')}")
     rows.append(f"(Fc, Ft: cutting and thrust force on the tool per unit thickness, means over the last "
-                f"{100 * (1 - STEADY_FROM):.0f} % of the cut; kN per mm = MN/m. Bands: see refsph.cutting.shear_bands)")
+                f"{100 * (1 - STEADY_FROM):.0f} % of the cut; kN per mm = MN/m. "
+                "Bands: see refsph.scenes.cutting.shear_bands)")
     return "\n".join(rows)
 
 
-def make_scene():
-    from .scenes import Scene                               # late import: scenes imports this module
-    return Scene(
-        "cutting",
-        "orthogonal cutting: AISI 4340 3 x 1 mm, rigid tool 0.5 x 1 mm at 50 m/s (Section 3.3)",
-        _default_dp, _build, _record, _metrics, options=CUTTING_OPTIONS, default_dim=2,
-        methods=("esph", "tlsph"), report=cutting_table)
+SCENE = Scene(
+    "cutting",
+    "orthogonal cutting: AISI 4340 3 x 1 mm, rigid tool 0.5 x 1 mm at 50 m/s (Section 3.3)",
+    _default_dp, _build, _record, _metrics, options=CUTTING_OPTIONS, default_dim=2,
+    methods=("esph", "tlsph"), report=cutting_table)

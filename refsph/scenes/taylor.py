@@ -28,13 +28,15 @@ from __future__ import annotations
 
 import numpy as np
 
-from .boundaries import MirrorPlanes, RigidWall
-from .material import ElasticMaterial
-from .plasticity import JohnsonCook
-from .reference import TAYLOR_GEOMETRY, TAYLOR_RESULTS, TAYLOR_TABLE1, TAYLOR_TABLE2
-from .state import make_state
+from ..boundaries import MirrorPlanes, RigidWall
+from ..material import ElasticMaterial
+from ..paper_data import TAYLOR_GEOMETRY, TAYLOR_RESULTS, TAYLOR_TABLE1, TAYLOR_TABLE2
+from ..plasticity import JohnsonCook
+from ..state import make_state
+from .base import Numerics, Scene, Setup
+from .measure import kinetic_energy
 
-__all__ = ["make_scene", "comparison_table", "taylor_material", "taylor_johnson_cook", "taylor_particles", "bar_length",
+__all__ = ["SCENE", "comparison_table", "taylor_material", "taylor_johnson_cook", "taylor_particles", "bar_length",
            "bar_diameter"]
 
 REST_WINDOW = 30e-6      # s: the final length is the mean over this last stretch (two free-ringing periods)
@@ -53,11 +55,10 @@ def taylor_material() -> ElasticMaterial:
 
 
 def taylor_johnson_cook(T_melt: float, eps_dot_0: float) -> JohnsonCook:
-    """Table 1 Johnson-Cook constants with the given T_melt and reference rate; chi = 0.9 (Eq. 28)."""
+    """Table 1 Johnson-Cook constants with the given T_melt and reference rate; chi = 0.9 (Eq. (28))."""
     t = TAYLOR_TABLE1
     return JohnsonCook(A=t["A_Pa"], B=t["B_Pa"], n=t["n"], C=t["C"], m=t["m"], eps_dot_0=float(eps_dot_0),
-                       T_room=t["T_room_K"], T_melt=float(T_melt), cp=t["cp_J_kgK"], chi=t["taylor_quinney"],
-                       hardening_saturation_strain=None)
+                       T_room=t["T_room_K"], T_melt=float(T_melt), cp=t["cp_J_kgK"], chi=t["taylor_quinney"])
 
 
 def taylor_particles(dim: int, dp: float, symmetry: bool, length: float, diameter: float):
@@ -98,12 +99,11 @@ def _default_dp(dim, quick):
     return 1.0e-3 if quick else 0.75e-3
 
 
-def _build(dim, dp, quick, T_melt=TAYLOR_OPTIONS["T_melt"][0], symmetry=True, eps_dot_0=1.0):
-    from .scenes import Numerics, Setup                     # late import: scenes imports this module
+def _build(dim, dp, quick, *, T_melt, symmetry, eps_dot_0):
     g = TAYLOR_GEOMETRY
     mat = taylor_material()
     jc = taylor_johnson_cook(T_melt, eps_dot_0)
-    if not isinstance(symmetry, (bool, np.bool_)):         # strings are converted by scenes.convert_options
+    if not isinstance(symmetry, (bool, np.bool_)):         # strings are converted by Scene.setup
         raise ValueError(f"option symmetry must be True or False, got {symmetry!r}")
     symmetry = bool(symmetry)
     if not (np.isfinite(T_melt) and T_melt > 293.0):
@@ -121,11 +121,12 @@ def _build(dim, dp, quick, T_melt=TAYLOR_OPTIONS["T_melt"][0], symmetry=True, ep
     fraction_inv = (4.0 if dim == 3 else 2.0) if symmetry else 1.0     # whole body / model
     m_total = float(np.sum(state.m)) * fraction_inv
     return Setup(state=state, material=mat, dp=dp, numerics=numerics, t_end=t_end, n_snapshots=10,
-                 plasticity=jc, mirror=mirror, walls=(wall,), snapshot_times=(15e-6, 30e-6),
+                 strength=jc, mirror=mirror, walls=(wall,), snapshot_times=(15e-6, 30e-6),
                  info=dict(dr=dr, dz=dz, symmetry=symmetry, length0=g["length_m"], diameter0=g["diameter_m"],
                            v0=g["impact_velocity_m_s"], mass_per_model=float(np.sum(state.m)),
-                           mass_full_body=m_total, model_fraction_inverse=fraction_inv, model=("quarter" if dim == 3 else "half") if symmetry
-                           else "whole", reference=TAYLOR_RESULTS))
+                           mass_full_body=m_total, model_fraction_inverse=fraction_inv,
+                           model=("quarter" if dim == 3 else "half") if symmetry else "whole",
+                           reference=TAYLOR_RESULTS))
 
 
 def bar_length(x: np.ndarray, dz: float) -> float:
@@ -143,7 +144,7 @@ def bar_diameter(x: np.ndarray, dr: float) -> float:
 def _record(state, setup):
     info = setup.info
     return dict(t=state.t, length=bar_length(state.x, info["dz"]), diameter=bar_diameter(state.x, info["dr"]),
-                E_kin=float(0.5 * np.sum(state.m * np.einsum("ik,ik->i", state.v, state.v))),
+                E_kin=kinetic_energy(state),
                 plastic_work=float(np.sum(state.W_p * state.m / state.rho)),
                 max_eps_p=float(state.eps_p.max()), max_T=float(state.T.max()))
 
@@ -183,7 +184,7 @@ def _metrics(hist, state, setup):
         end_time_s=float(t[-1]),
         plastic_work_whole_body=float(Wp[-1]) * setup.info["model_fraction_inverse"],
         kinetic_energy_final_over_initial=float(hist["E_kin"][-1]) / E0,
-        T_melt_K=setup.plasticity.T_melt,
+        T_melt_K=setup.strength.T_melt,
         model=setup.info["model"],
         reference=setup.info["reference"],
     )
@@ -221,10 +222,8 @@ def comparison_table(summaries: list) -> str:
     return "\n".join(lines)
 
 
-def make_scene():
-    from .scenes import Scene                               # late import: scenes imports this module
-    return Scene(
-        "taylor",
-        "Taylor impact: 4340 cylinder 37.97 x 7.595 mm at 181 m/s on a rigid frictionless wall (Section 3.1)",
-        _default_dp, _build, _record, _metrics, options=TAYLOR_OPTIONS, default_dim=3,
-        methods=("esph", "tlsph"), report=comparison_table)
+SCENE = Scene(
+    "taylor",
+    "Taylor impact: 4340 cylinder 37.97 x 7.595 mm at 181 m/s on a rigid frictionless wall (Section 3.1)",
+    _default_dp, _build, _record, _metrics, options=TAYLOR_OPTIONS, default_dim=3,
+    methods=("esph", "tlsph"), report=comparison_table)

@@ -27,8 +27,9 @@ Measurements (``summary.json`` metrics):
 * ``tool_force_history``: [t, F] with F the force of the block on the tool against its motion, per metre of
   thickness [N/m], time-averaged over 400 equal time bins (each step's value and size are in
   ``reaction_forces.csv``; the pinball contact force comes in impulses a step long, which the bins average);
-  also its peak and its time average over the second half of the run, and the same for the clamp (``clamp_force_mean_N_per_m``). The peak of
-  the binned TLSPH force depends on how many steps fall in a bin (so on dp and dt): compare mean forces.
+  also its peak and its time average over the second half of the run, and the same for the clamp
+  (``clamp_force_mean_N_per_m``). The peak of the binned TLSPH force depends on how many steps fall in a bin
+  (so on dp and dt): compare mean forces.
 * ``plastic_strain_line`` (Fig. 8): [x, eps_p] of the row of particles that starts nearest to mid-height
   (on it for an odd number of rows, as at the paper's spacing; half a spacing below it for an even number),
   sorted by their current x [mm, -] (a Lagrangian line: the same particles in both methods).
@@ -43,44 +44,19 @@ import math
 import numpy as np
 from scipy.spatial import cKDTree
 
-from .boundaries import Clamp, RigidBody
-from .material import ElasticMaterial
-from .plasticity import JohnsonCook
-from .reference import AISI4340_TABLE3, PRESSING_GEOMETRY, PRESSING_RESOLUTIONS_M, PRESSING_TABLE4
-from .state import concatenate_states, make_state
+from ..boundaries import Clamp, RigidBody
+from ..paper_data import PRESSING_GEOMETRY, PRESSING_RESOLUTIONS_M, PRESSING_TABLE4
+from ..state import concatenate_states, make_state
+from .base import Numerics, Scene, Setup
+from .measure import (N_FORCE_BINS, TOOL_BODY, aisi4340_johnson_cook, aisi4340_material, binned_mean,
+                      block_lattice, kinetic_energy, time_mean)
 
-__all__ = ["make_scene", "pressing_material", "pressing_johnson_cook", "pressing_particles", "pressing_table",
-           "TOOL_BODY"]
-
-TOOL_BODY = 1
-N_FORCE_BINS = 400
+__all__ = ["SCENE", "pressing_particles", "pressing_table"]
 
 PRESSING_OPTIONS = {
     "travel": (0.2e-3, "tool travel at the end of the run [m] (not printed in the paper); t_end = travel / 200 m/s"),
     "eps_dot_0": (1.0, "Johnson-Cook reference strain rate [1/s] (not printed in Table 3)"),
 }
-
-
-def pressing_material() -> ElasticMaterial:
-    """Table 3: rho = 7830 kg/m^3, E = 207 GPa, nu = 0.3."""
-    t = AISI4340_TABLE3
-    return ElasticMaterial(rho0=t["rho"], E=t["E_Pa"], nu=t["nu"])
-
-
-def pressing_johnson_cook(eps_dot_0: float) -> JohnsonCook:
-    """Table 3 Johnson-Cook constants, chi = 0.9 (Section 2.3), the given reference strain rate."""
-    t = AISI4340_TABLE3
-    return JohnsonCook(A=t["A_Pa"], B=t["B_Pa"], n=t["n"], C=t["C"], m=t["m"], eps_dot_0=float(eps_dot_0),
-                       T_room=t["T_room_K"], T_melt=t["T_melt_K"], cp=t["cp_J_kgK"], chi=t["taylor_quinney"],
-                       hardening_saturation_strain=None)
-
-
-def block_lattice(nx: int, ny: int, dx: float, dy: float):
-    """Cell centres ((i + 1/2) dx, (j + 1/2) dy) of an nx x ny block, particle k = i ny + j (column i, row j),
-    with the (i, j) of every particle: the layout of the pressing block and of the cutting workpiece."""
-    i, j = np.meshgrid(np.arange(nx), np.arange(ny), indexing="ij")
-    i, j = i.ravel(), j.ravel()
-    return np.stack([(i + 0.5) * dx, (j + 0.5) * dy], axis=1), i, j
 
 
 def pressing_particles(dp: float, n_tool_layers: int):
@@ -104,8 +80,7 @@ def _default_dp(dim, quick):
     return PRESSING_RESOLUTIONS_M[0] if quick else PRESSING_TABLE4["particle_spacing_m"]
 
 
-def _build(dim, dp, quick, travel=PRESSING_OPTIONS["travel"][0], eps_dot_0=1.0):
-    from .scenes import Numerics, Setup
+def _build(dim, dp, quick, *, travel, eps_dot_0):
     if dim != 2:
         raise ValueError("the pressing scene is 2D plane strain (the mid-plane of the paper's 0.1 mm slab)")
     if not (np.isfinite(travel) and 0 < travel < 0.9 * PRESSING_GEOMETRY["block_m"][0]):
@@ -116,8 +91,8 @@ def _build(dim, dp, quick, travel=PRESSING_OPTIONS["travel"][0], eps_dot_0=1.0):
                         skin_factor=0.3)
     layers = math.ceil(2.0 * numerics.h_over_dp - 1e-9)
     xb, xt, dx, dy, clamp, line = pressing_particles(dp, layers)
-    mat = pressing_material()
-    jc = pressing_johnson_cook(eps_dot_0)
+    mat = aisi4340_material()
+    jc = aisi4340_johnson_cook(eps_dot_0)
     T0 = jc.T_room
     speed = PRESSING_GEOMETRY["tool_speed_m_s"]
     block = make_state(xb, [0.0, 0.0], mat.rho0, dx * dy, T0=T0)
@@ -126,8 +101,8 @@ def _build(dim, dp, quick, travel=PRESSING_OPTIONS["travel"][0], eps_dot_0=1.0):
     t_end = float(travel) / speed
     return Setup(state=state, material=mat, dp=dx, numerics=numerics, t_end=t_end, n_snapshots=10,
                  info=dict(n_block=block.n, n_tool=tool.n, dx=dx, dy=dy, tool_layers=layers,
-                           line_index=line, travel_m=float(travel), tool_speed_m_s=speed),
-                 plasticity=jc, rigid=(RigidBody("tool", TOOL_BODY, (-speed, 0.0)),),
+                           travel_m=float(travel), tool_speed_m_s=speed),
+                 arrays=dict(line_index=line), strength=jc, rigid=(RigidBody("tool", TOOL_BODY, (-speed, 0.0)),),
                  clamps=(Clamp("left_side", clamp),), snapshot_times=tuple(t_end * np.array([0.25, 0.5, 0.75])))
 
 
@@ -137,25 +112,8 @@ def _record(state, setup):
     near = xb[:, 0] > xt[:, 0].min() - 3 * setup.dp
     gap = float(cKDTree(xt).query(xb[near])[0].min()) if near.any() else float("inf")
     return dict(t=state.t, max_eps_p=float(np.max(state.eps_p[:n])), max_T=float(np.max(state.T[:n])),
-                E_kin=float(0.5 * np.sum(state.m[:n] * np.einsum("ik,ik->i", state.v[:n], state.v[:n]))),
+                E_kin=kinetic_energy(state, slice(0, n)),
                 min_tool_gap_over_dp=gap / setup.dp)
-
-
-def _binned(t, dt, f, t_end, n_bins):
-    """Time average of a per-step force over equal time bins (each step weighted by its size dt, put in the
-    bin of its midpoint t): (bin centres, means) of the bins that hold a step."""
-    edges = np.linspace(0.0, t_end, n_bins + 1)
-    k = np.clip(np.searchsorted(edges, t, side="right") - 1, 0, n_bins - 1)
-    w = np.bincount(k, weights=dt, minlength=n_bins)
-    s = np.bincount(k, weights=f * dt, minlength=n_bins)
-    ok = w > 0
-    return 0.5 * (edges[1:] + edges[:-1])[ok], s[ok] / w[ok]
-
-
-def _time_mean(t, dt, f, t_from):
-    """(1 / duration) * integral of f dt over the steps whose midpoint lies after t_from."""
-    sel = t > t_from
-    return float(np.sum(f[sel] * dt[sel]) / np.sum(dt[sel])) if sel.any() else float("nan")
 
 
 def _metrics(hist, state, setup):
@@ -165,15 +123,15 @@ def _metrics(hist, state, setup):
     tool = np.asarray(rh["tool"])[:, 0]                # force of the block on the tool, +x: against its motion
     clamp = np.asarray(rh["left_side"])[:, 0]          # force of the block on the clamped column
     nb = min(N_FORCE_BINS, max(1, len(t)))
-    tb, fb = _binned(t, dt, tool, setup.t_end, nb)
-    _, cb = _binned(t, dt, clamp, setup.t_end, nb)
-    line = setup.info["line_index"]
+    tb, fb = binned_mean(t, dt, tool, setup.t_end, nb)
+    _, cb = binned_mean(t, dt, clamp, setup.t_end, nb)
+    line = setup.arrays["line_index"]
     order = np.argsort(state.x[line, 0])
     return dict(
         tool_force_history=np.stack([tb, fb], axis=1),
         tool_force_peak_N_per_m=float(np.max(fb)),
-        tool_force_mean_N_per_m=_time_mean(t, dt, tool, 0.5 * setup.t_end),
-        clamp_force_mean_N_per_m=_time_mean(t, dt, clamp, 0.5 * setup.t_end),
+        tool_force_mean_N_per_m=time_mean(t, dt, tool, 0.5 * setup.t_end),
+        clamp_force_mean_N_per_m=time_mean(t, dt, clamp, 0.5 * setup.t_end),
         clamp_force_history=np.stack([tb, cb], axis=1),
         max_plastic_strain=float(np.max(state.eps_p[:n])),
         max_temperature_K=float(np.max(state.T[:n])),
@@ -205,10 +163,8 @@ def pressing_table(summaries: list) -> str:
     return "\n".join(rows)
 
 
-def make_scene():
-    from .scenes import Scene                               # late import: scenes imports this module
-    return Scene(
-        "pressing",
-        "metal pressing: AISI 4340 block 1.0 x 0.5 mm, left side fixed, rigid tool at 200 m/s (Section 3.2)",
-        _default_dp, _build, _record, _metrics, options=PRESSING_OPTIONS, default_dim=2,
-        methods=("esph", "tlsph"), report=pressing_table)
+SCENE = Scene(
+    "pressing",
+    "metal pressing: AISI 4340 block 1.0 x 0.5 mm, left side fixed, rigid tool at 200 m/s (Section 3.2)",
+    _default_dp, _build, _record, _metrics, options=PRESSING_OPTIONS, default_dim=2,
+    methods=("esph", "tlsph"), report=pressing_table)

@@ -1,0 +1,162 @@
+"""What a scene is made of: the numerical parameters (:class:`Numerics`), everything a run needs
+(:class:`Setup`), a scene as data (:class:`Scene`) and the parsing of its options.
+
+A :class:`Setup` is all :func:`refsph.simulate.simulate` needs; a :class:`Scene` adds what the command line needs
+to make one (``build``, ``default_dp``, ``options``) and what to measure (``record``, ``metrics``, ``report``).
+A script that builds its own case makes a Setup and calls ``simulate`` (README, "Your own scene").
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field, fields
+from typing import Callable
+
+import numpy as np
+
+from ..boundaries import MirrorPlanes
+from ..material import ElasticMaterial
+from ..state import State
+from ..strength import Elastic, StrengthModel
+
+__all__ = ["Numerics", "Setup", "Scene", "parse_bool", "convert_options", "numerics_field_optional"]
+
+
+@dataclass(frozen=True)
+class Numerics:
+    """Numerical parameters of a run (not material constants, so defaults are allowed here).
+
+    h_over_dp: smoothing length / spacing; beta1, beta2: artificial viscosity (Eq. (12)); gamma: ESPH
+    artificial pressure (Eq. (14); 0 = off); n_ap: its exponent; eps: Eq. (13); kernel: 'cubic' | 'wendland';
+    courant: CFL number; corrected: TLSPH kernel-gradient correction; ref_update_strain: TLSPH reference
+    update trigger on max |E| (None = never); skin_factor: ESPH Verlet skin in units of h; contact_k: TLSPH
+    pinball radius R = contact_k h (Eq. (32); None = dp / (2h), pinballs of neighbouring bodies touch at one
+    spacing); contact_Kp: the pinball scaling factor K_p (Eq. (33)); threads: threads that share the pair sums
+    (0 = one per available core); integrator: the time stepper (:data:`refsph.integrate.STEPPERS`). The numbers
+    of a run do not depend on ``threads``, only its speed does.
+    """
+
+    h_over_dp: float = 1.5
+    beta1: float = 1.5
+    beta2: float = 1.5
+    gamma: float = 0.3
+    n_ap: float = 4.0
+    eps: float = 0.01
+    kernel: str = "cubic"
+    courant: float = 0.3
+    corrected: bool = True
+    ref_update_strain: float | None = 0.5
+    skin_factor: float = 0.1
+    contact_k: float | None = None
+    contact_Kp: float = 50.0
+    threads: int = 0
+    integrator: str = "predictor_corrector"
+
+
+def numerics_field_optional(name: str) -> bool:
+    """True if the Numerics field accepts None (read from its annotation)."""
+    return any(f.name == name and "None" in str(f.type) for f in fields(Numerics))
+
+
+@dataclass
+class Setup:
+    """Everything a run needs.
+
+    ``state``: the particles (:func:`refsph.state.make_state`); ``material``: elastic constants; ``dp``: spacing;
+    ``numerics``; ``t_end`` [s]; ``n_snapshots``: evenly spaced output times (plus ``snapshot_times`` [s]);
+    ``strength``: the strength model (:mod:`refsph.strength`; None: elastic); ``heating``: plastic work heats the
+    material (Eq. (28); False: isothermal); ``mirror``: symmetry planes (:class:`~refsph.boundaries.MirrorPlanes`);
+    ``walls``: rigid walls (:class:`~refsph.boundaries.RigidWall`); ``rigid``: tools
+    (:class:`~refsph.boundaries.RigidBody`, their particles the last rows of ``state``); ``clamps``: held
+    particles (:class:`~refsph.boundaries.Clamp`); ``friction``: a :class:`~refsph.contact.CoulombFriction` for
+    the TLSPH pinball contact (None: frictionless, as in the paper); ``info``: numbers that describe the scene
+    (written to ``summary.json`` as ``scene_info``: JSON scalars, strings and short lists only); ``arrays``:
+    per-particle arrays the scene's measurements need (index sets; not written to the summary).
+    """
+
+    state: State
+    material: ElasticMaterial
+    dp: float
+    numerics: Numerics
+    t_end: float
+    n_snapshots: int
+    info: dict = field(default_factory=dict)
+    strength: StrengthModel | None = None
+    heating: bool = True
+    mirror: MirrorPlanes | None = None
+    walls: tuple = ()
+    snapshot_times: tuple = ()
+    rigid: tuple = ()
+    clamps: tuple = ()
+    friction: object = None
+    arrays: dict = field(default_factory=dict)
+
+    def __post_init__(self):
+        if self.strength is None:
+            self.strength = Elastic()
+        bad = [k for k, v in self.info.items() if isinstance(v, np.ndarray)]
+        if bad:
+            raise ValueError(f"Setup.info goes into summary.json: put the arrays {', '.join(bad)} into Setup.arrays")
+
+    @property
+    def h(self) -> float:
+        return self.numerics.h_over_dp * self.dp
+
+
+@dataclass(frozen=True)
+class Scene:
+    """A scene as data. ``build(dim, dp, quick, **options) -> Setup`` (every option given; :meth:`setup` fills in
+    the defaults); ``default_dp(dim, quick)``; ``record(state, setup) -> dict`` of scalars stored in the history
+    every few steps; ``metrics(history, state, setup) -> dict``, the ``metrics`` of ``summary.json``;
+    ``options``: the scene's own settings, {name: (default, help)}; ``default_dim``, ``methods``: what a plain
+    ``refsph run SCENE`` runs; ``report(summaries) -> str``: a table of runs."""
+
+    name: str
+    description: str
+    default_dp: Callable[[int, bool], float]
+    build: Callable[..., Setup]
+    record: Callable[[State, Setup], dict]
+    metrics: Callable[[dict, State, Setup], dict]
+    options: dict = field(default_factory=dict)
+    default_dim: int = 2
+    methods: tuple = ("tlsph",)
+    report: Callable[[list], str] | None = None
+
+    def setup(self, dim: int | None = None, dp: float | None = None, quick: bool = False, **options) -> Setup:
+        """The scene's Setup: ``dim`` and ``dp`` default to the scene's, options to their defaults (strings
+        converted like the default, as from the command line)."""
+        dim = self.default_dim if dim is None else dim
+        dp = self.default_dp(dim, quick) if dp is None else dp
+        return self.build(dim, dp, quick, **convert_options(self, options))
+
+
+_TRUE, _FALSE = ("true", "1", "yes"), ("false", "0", "no")
+
+
+def parse_bool(value, what: str) -> bool:
+    """A boolean, or its spelling true/false/1/0/yes/no (any case); ``what`` names it in the error."""
+    if isinstance(value, str) and value.lower() in _TRUE + _FALSE:
+        return value.lower() in _TRUE
+    if isinstance(value, (bool, np.bool_)):
+        return bool(value)
+    raise ValueError(f"{what} must be true or false, got {value!r}")
+
+
+def convert_options(scene: Scene, options: dict) -> dict:
+    """Every option of the scene: the given ones checked and converted like their default (strings from the
+    command line included: booleans from true/false/1/0/yes/no, numbers with float()), the others at their
+    default. Unknown names are refused."""
+    out = {name: default for name, (default, _) in scene.options.items()}
+    for name, value in options.items():
+        if name not in scene.options:
+            known = ", ".join(sorted(scene.options)) or "none"
+            raise ValueError(f"unknown option {name!r} for scene {scene.name!r} (known: {known})")
+        default = scene.options[name][0]
+        if isinstance(default, bool):
+            out[name] = parse_bool(value, f"option {name}")
+        elif isinstance(default, (int, float)):
+            try:
+                out[name] = float(value)
+            except (TypeError, ValueError):
+                raise ValueError(f"option {name} must be a number, got {value!r}") from None
+        else:
+            out[name] = value
+    return out

@@ -1,0 +1,111 @@
+"""What the scenes share: lattices of particles, the materials of the paper's tables, time averages of force
+histories, energies and momentum. Every scene module imports what it needs from here (and nothing from another
+scene).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ..material import ElasticMaterial, eos_pressure
+from ..neighbours import find_pairs
+from ..paper_data import AISI4340_TABLE3
+from ..plasticity import JohnsonCook
+from ..state import State
+
+__all__ = ["TOOL_BODY", "N_FORCE_BINS", "lattice", "block_lattice", "aisi4340_material", "aisi4340_johnson_cook",
+           "binned_mean", "time_mean", "kinetic_energy", "elastic_energy", "linear_momentum", "min_pair_distance",
+           "zero_crossings"]
+
+TOOL_BODY = 1           # body id of the tool in the scenes with one (0 is the workpiece)
+N_FORCE_BINS = 400      # force histories in summary.json: time averages over this many equal bins
+
+
+# ----------------------------------------------------------------------------- particles and materials
+def lattice(lengths, dp: float) -> np.ndarray:
+    """Particle centres of a box [0, L_0] x ... on a square/cubic lattice of spacing dp (cell centres)."""
+    axes = []
+    for L in lengths:
+        n = int(round(L / dp))
+        if n < 1:
+            raise ValueError(f"spacing dp={dp!r} is larger than the body ({L!r} m)")
+        axes.append((np.arange(n) + 0.5) * dp)
+    grids = np.meshgrid(*axes, indexing="ij")
+    return np.stack([g.ravel() for g in grids], axis=1)
+
+
+def block_lattice(nx: int, ny: int, dx: float, dy: float):
+    """Cell centres ((i + 1/2) dx, (j + 1/2) dy) of an nx x ny block, particle k = i ny + j (column i, row j),
+    with the (i, j) of every particle: the layout of the pressing block and of the cutting workpiece."""
+    i, j = np.meshgrid(np.arange(nx), np.arange(ny), indexing="ij")
+    i, j = i.ravel(), j.ravel()
+    return np.stack([(i + 0.5) * dx, (j + 0.5) * dy], axis=1), i, j
+
+
+def aisi4340_material() -> ElasticMaterial:
+    """Table 3: rho = 7830 kg/m^3, E = 207 GPa, nu = 0.3 (the workpiece of the pressing and the cutting, and the
+    elastic test scenes)."""
+    t = AISI4340_TABLE3
+    return ElasticMaterial(rho0=t["rho"], E=t["E_Pa"], nu=t["nu"])
+
+
+def aisi4340_johnson_cook(eps_dot_0: float) -> JohnsonCook:
+    """Table 3 Johnson-Cook constants, chi = 0.9 (Section 2.3), the given reference strain rate (not printed)."""
+    t = AISI4340_TABLE3
+    return JohnsonCook(A=t["A_Pa"], B=t["B_Pa"], n=t["n"], C=t["C"], m=t["m"], eps_dot_0=float(eps_dot_0),
+                       T_room=t["T_room_K"], T_melt=t["T_melt_K"], cp=t["cp_J_kgK"], chi=t["taylor_quinney"])
+
+
+# ----------------------------------------------------------------------------- time averages
+def binned_mean(t, dt, f, t_end, n_bins):
+    """Time average of a per-step force over equal time bins (each step weighted by its size dt, put in the
+    bin of its midpoint t): (bin centres, means) of the bins that hold a step."""
+    edges = np.linspace(0.0, t_end, n_bins + 1)
+    k = np.clip(np.searchsorted(edges, t, side="right") - 1, 0, n_bins - 1)
+    w = np.bincount(k, weights=dt, minlength=n_bins)
+    s = np.bincount(k, weights=f * dt, minlength=n_bins)
+    ok = w > 0
+    return 0.5 * (edges[1:] + edges[:-1])[ok], s[ok] / w[ok]
+
+
+def time_mean(t, dt, f, t_from):
+    """(1 / duration) * integral of f dt over the steps whose midpoint lies after t_from."""
+    sel = t > t_from
+    return float(np.sum(f[sel] * dt[sel]) / np.sum(dt[sel])) if sel.any() else float("nan")
+
+
+def zero_crossings(t: np.ndarray, a: np.ndarray) -> np.ndarray:
+    """Times where a(t) changes sign (linear interpolation between samples)."""
+    s = np.sign(a)
+    k = np.flatnonzero((s[1:] != s[:-1]) & (s[1:] != 0))
+    return t[k] - a[k] * (t[k + 1] - t[k]) / (a[k + 1] - a[k])
+
+
+# ----------------------------------------------------------------------------- energies and momentum
+def kinetic_energy(state: State, rows=slice(None)) -> float:
+    """sum_i m_i |v_i|^2 / 2 over ``rows`` (default: every particle)."""
+    m, v = state.m[rows], state.v[rows]
+    return float(0.5 * np.sum(m * np.einsum("ik,ik->i", v, v)))
+
+
+def elastic_energy(state: State, mat: ElasticMaterial) -> float:
+    """sum_i V_i (p_i^2 / (2K) + s_i:s_i / (4G)), V = m / rho; small-strain energy of the stress state."""
+    p = eos_pressure(state.rho, mat.rho0, mat.K)
+    ss = np.einsum("nab,nab->n", state.S, state.S)
+    if state.dim == 2:
+        ss = ss + state.S_zz**2
+    V = state.m / state.rho
+    return float(np.sum(V * (p * p / (2.0 * mat.K) + ss / (4.0 * mat.G))))
+
+
+def linear_momentum(state: State) -> np.ndarray:
+    """sum_i m_i v_i."""
+    return np.sum(state.m[:, None] * state.v, axis=0)
+
+
+def min_pair_distance(x: np.ndarray, radius: float) -> float:
+    """The smallest distance between two particles closer than ``radius`` (inf if none)."""
+    I, J = find_pairs(x, radius)
+    if len(I) == 0:
+        return float("inf")
+    d = x[I] - x[J]
+    return float(np.sqrt(np.min(np.einsum("pk,pk->p", d, d))))

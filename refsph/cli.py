@@ -1,4 +1,4 @@
-"""Command line: ``refsph list`` and ``refsph run SCENE [--method {esph,tlsph,both}] ...``."""
+"""Command line: ``refsph list``, ``refsph run SCENE [--method {esph,tlsph,both}] ...`` and ``refsph book``."""
 from __future__ import annotations
 
 import argparse
@@ -20,10 +20,15 @@ def _fmt(v):
     return str(v)
 
 
-def main(argv=None) -> int:
+def _parser() -> argparse.ArgumentParser:
     ap = argparse.ArgumentParser(prog="refsph", description="Reference ESPH/TLSPH for metal machining")
     sub = ap.add_subparsers(dest="cmd", required=True)
     sub.add_parser("list", help="list the scenes")
+    b = sub.add_parser("book", help="execute the chapters and render them as a book (build/book/index.html)")
+    b.add_argument("--full", action="store_true", help="full resolution (default: quick mode, REFSPH_QUICK=1)")
+    b.add_argument("--rerun", action="store_true", help="execute every chapter again (default: reuse the "
+                   "executed notebooks in build/executed/ that are newer than their chapter)")
+    b.add_argument("--jobs", type=int, default=2, help="chapters executed at a time (default 2)")
     r = sub.add_parser("run", help="run a scene")
     r.add_argument("scene")
     r.add_argument("--method", choices=METHODS + ("both",), default=None,
@@ -41,10 +46,16 @@ def main(argv=None) -> int:
     r.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
                    help="a numerical parameter (a field of refsph.scenes.Numerics), e.g. --set contact_Kp=10, "
                         "--set ref_update_strain=none; repeatable")
+    return ap
+
+
+def main(argv=None) -> int:
+    ap = _parser()
     args, extra = ap.parse_known_args(argv)
     if extra and args.cmd != "run":
         ap.error(f"unrecognized arguments: {' '.join(extra)}")
-
+    if args.cmd == "book":
+        return _book(args)
     if args.cmd == "list":
         for name, sc in SCENES.items():
             print(f"{name:10s} {sc.description}")
@@ -52,7 +63,22 @@ def main(argv=None) -> int:
             for opt, (default, help_) in sc.options.items():
                 print(f"{'':10s} --option {opt}=VALUE  {help_} (default {default})")
         return 0
+    return _run(args, extra)
 
+
+def _book(args) -> int:
+    from .book import build_book
+    try:
+        index = build_book(quick=not args.full, reuse=not args.rerun, jobs=args.jobs)
+    except (RuntimeError, ImportError) as e:
+        print(f"refsph: {e}", file=sys.stderr)
+        return 1
+    print(f"book: {index}")
+    return 0
+
+
+def _run(args, extra) -> int:
+    """``refsph run``: each method of the scene in turn, its metrics printed, then the scene's report."""
     if args.scene not in SCENES:
         print(f"refsph: unknown scene {args.scene!r}; available: {', '.join(sorted(SCENES))}", file=sys.stderr)
         return 2

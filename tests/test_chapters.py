@@ -1,29 +1,24 @@
-"""Every chapter runs as a notebook in quick mode in under a minute, and its own checks pass.
+"""Every chapter runs as a notebook in quick mode in under a minute, its own checks pass, it is a lesson of a
+teachable size, and it ends with exercises whose answer key runs (tests/test_exercises.py).
 
 Chapters are jupytext percent-format .py files; each one compares the package's fast code with its plain
-pair-by-pair version in ``assert`` cells, so a failing comparison fails this test.
-"""
-import time
+pair-by-pair version in ``assert`` cells, so a failing comparison fails this test. The executed notebooks are
+kept in build/executed/ for the book (``refsph book``)."""
 from pathlib import Path
 
 import pytest
 
-CHAPTERS = sorted((Path(__file__).resolve().parent.parent / "chapters").glob("[0-9][0-9]_*.py"))
+from refsph.book import chapter_files, execute_chapter
+
+CHAPTERS = chapter_files()
+ROOT = Path(__file__).resolve().parent.parent
 
 
 @pytest.mark.parametrize("path", CHAPTERS, ids=[p.stem for p in CHAPTERS])
-def test_chapter_runs_quick(path, tmp_path, monkeypatch):
-    jupytext = pytest.importorskip("jupytext")
-    nbclient = pytest.importorskip("nbclient")
-    monkeypatch.setenv("REFSPH_QUICK", "1")
-    monkeypatch.setenv("MPLBACKEND", "Agg")
-    monkeypatch.setenv("REFSPH_FIGURES", str(tmp_path))      # quick-mode figures must not replace figures/
-    nb = jupytext.read(path)
-    client = nbclient.NotebookClient(nb, timeout=120, kernel_name="python3",
-                                     resources={"metadata": {"path": str(path.parent)}})
-    t0 = time.perf_counter()
-    client.execute()
-    wall = time.perf_counter() - t0
+def test_chapter_runs_quick(path, tmp_path):
+    pytest.importorskip("jupytext")
+    pytest.importorskip("nbclient")
+    _, wall = execute_chapter(path, quick=True, timeout=120, figures=tmp_path)
     assert wall < 60.0, f"{path.name} took {wall:.1f} s in quick mode (limit 60 s)"
 
 

@@ -11,7 +11,7 @@ from refsph.state import concatenate_states, make_state
 dp, R, V = 25e-6, 0.2e-3, 50.0                       # spacing, roller radius [m], rolling speed [m/s]
 mat, jc = aisi4340_material(), aisi4340_johnson_cook(eps_dot_0=1.0)
 plate = make_state(lattice([1.5e-3, 0.3e-3], dp), [0.0, 0.0], mat.rho0, dp * dp, T0=jc.T_room)
-centre = np.array([0.3e-3, 0.3e-3 + R + 0.5 * dp])    # the roller's surface touches the plate's
+centre = np.array([0.3e-3, 0.3e-3 + R + 0.5 * dp])    # the roller starts half a spacing above the plate
 phi = np.linspace(0.0, 2 * np.pi, round(2 * np.pi * R / dp), endpoint=False)
 ring = centre + (R - 0.5 * dp) * np.stack([np.cos(phi), np.sin(phi)], axis=1)
 roller = RigidBody("roller", 1, velocity=(V, -0.05 * V), angular_velocity=-V / R, centre=tuple(centre))
@@ -29,7 +29,8 @@ def record(state, setup):                             # called every few steps: 
 
 def metrics(history, state, setup):                   # once at the end: summary.json's "metrics"
     F = history["reaction"]["roller"]                 # force of the plate on the roller [N/m], every step
-    groove = 0.3e-3 - state.x[:n][np.abs(state.x[:n, 0] - 0.8e-3) < dp, 1].max()
+    top = np.abs(state.x[:n, 0] - 0.8e-3) < dp           # the column at x = 0.8 mm; its top started at 0.3 mm - dp/2
+    groove = 0.3e-3 - 0.5 * dp - state.x[:n][top, 1].max()
     return dict(groove_depth_um=float(1e6 * groove), max_plastic_strain=max(history["eps_p"]),
                 mean_force_N_per_m=np.mean(F, axis=0).tolist(), max_T_K=float(state.T[:n].max()))
 

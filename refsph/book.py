@@ -35,8 +35,12 @@ suppress_warnings = ["mystnb.unknown_mime_type"]
 
 
 def chapter_files() -> list[Path]:
-    """chapters/NN_name.py, in order."""
-    return sorted((repository_root() / "chapters").glob("[0-9][0-9]_*.py"))
+    """chapters/NN_name.py, in order (FileNotFoundError outside a source checkout, which has no chapters)."""
+    folder = repository_root() / "chapters"
+    if not folder.is_dir():
+        raise FileNotFoundError(f"no chapters/ at {folder}: the chapters and the book need a source checkout of "
+                                "refsph (pip install -e . in a clone)")
+    return sorted(folder.glob("[0-9][0-9]_*.py"))
 
 
 def executed_path(chapter: Path) -> Path:
@@ -51,24 +55,15 @@ def execute_chapter(chapter: Path, quick: bool = True, timeout: int = 600, figur
     import nbclient
     import nbformat
 
-    env = {"REFSPH_QUICK": "1" if quick else "0", "MPLBACKEND": "module://matplotlib_inline.backend_inline"}
+    env = dict(os.environ, REFSPH_QUICK="1" if quick else "0", MPLBACKEND="module://matplotlib_inline.backend_inline")
     if figures is not None:
         env["REFSPH_FIGURES"] = str(figures)
-    old = {k: os.environ.get(k) for k in env}
-    os.environ.update(env)
-    try:
-        nb = jupytext.read(chapter)
-        client = nbclient.NotebookClient(nb, timeout=timeout, kernel_name="python3",
-                                         resources={"metadata": {"path": str(chapter.parent)}})
-        t0 = time.perf_counter()
-        client.execute()
-        seconds = time.perf_counter() - t0
-    finally:
-        for k, v in old.items():
-            if v is None:
-                os.environ.pop(k, None)
-            else:
-                os.environ[k] = v
+    nb = jupytext.read(chapter)
+    client = nbclient.NotebookClient(nb, timeout=timeout, kernel_name="python3",
+                                     resources={"metadata": {"path": str(chapter.parent)}})
+    t0 = time.perf_counter()
+    client.execute(env=env)                      # the kernel's own environment: nothing of this process changes
+    seconds = time.perf_counter() - t0
     nb.metadata["refsph"] = {"quick": quick, "seconds": seconds}
     out = executed_path(chapter)
     out.parent.mkdir(parents=True, exist_ok=True)

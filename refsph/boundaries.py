@@ -424,6 +424,30 @@ class Constraints:
                 self.reaction_impulse[k] = self.reaction_impulse[k] + f * dt
         return new
 
+    def checkpoint(self) -> dict:
+        """What a restart needs besides the state: the reaction log and impulses, the start of turning bodies."""
+        d = self.dim or 1
+        ck = dict(reaction_log=np.asarray(self.reaction_log, dtype=float).reshape(-1, 2 + d * len(self.reaction_names)),
+                  wall_impulse=self.wall_impulse.copy(),
+                  reaction_impulse=np.array([np.atleast_1d(i) * np.ones(d) for i in self.reaction_impulse],
+                                            dtype=float).reshape(len(self.reaction_impulse), d))
+        for k, start in enumerate(self._start):
+            if start is not None:
+                ck[f"turning_{k}"] = np.concatenate([[start[0]], start[1], start[2].ravel()])
+        return ck
+
+    def restore(self, ck: dict) -> None:
+        """The inverse of :meth:`checkpoint`, after :meth:`bind` on the restart state."""
+        self.reaction_log = [list(row) for row in np.asarray(ck["reaction_log"], dtype=float)]
+        self.wall_impulse = np.array(ck["wall_impulse"], dtype=float)
+        self.reaction_impulse = [np.array(row) for row in ck["reaction_impulse"]]
+        if not self.reaction_log:                               # before the first step: the scalar start value
+            self.reaction_impulse = [0.0 for _ in self.reaction_impulse]
+        for k, start in enumerate(self._start):
+            if start is not None:
+                a, d = ck[f"turning_{k}"], self.dim
+                self._start[k] = (float(a[0]), a[1:1 + d], a[1 + d:].reshape(-1, d))
+
     def reaction_history(self) -> dict:
         """{'t': (n_steps,), 'dt': (n_steps,), name: (n_steps, d) force on that rigid body / clamp} (N; 2D: N per
         metre of thickness), one row per step at the step's midpoint t (the time of the rates that moved it);

@@ -1,4 +1,5 @@
-"""Command line: ``refsph list``, ``refsph run SCENE [--method {esph,tlsph,both}] ...`` and ``refsph book``."""
+"""Command line: ``refsph list``, ``refsph run SCENE [--method {esph,tlsph,both}] ...``, ``refsph book``,
+``refsph oracle DIR``, ``refsph compare REF TEST`` and ``refsph export RUN_DIR --vtk``."""
 from __future__ import annotations
 
 import argparse
@@ -29,8 +30,25 @@ def _parser() -> argparse.ArgumentParser:
     b.add_argument("--rerun", action="store_true", help="execute every chapter again (default: reuse the "
                    "executed notebooks in build/executed/ that are newer than their chapter)")
     b.add_argument("--jobs", type=int, default=2, help="chapters executed at a time (default 2)")
+    o = sub.add_parser("oracle", help="write the golden cases (inputs, refsph's outputs, tolerances) into DIR")
+    o.add_argument("dir")
+    c = sub.add_parser("compare", help="compare golden-case or run folders: TEST against REF (exit 1 if any "
+                                       "quantity is outside its tolerance)")
+    c.add_argument("ref")
+    c.add_argument("test")
+    c.add_argument("--tolerances", default=None, metavar="FILE",
+                   help='JSON: {"fields": {NAME: rtol}, "metrics": {NAME: rtol}, "field": rtol, "metric": rtol}')
+    e = sub.add_parser("export", help="export a run folder's snapshots (--vtk: VTU files and a ParaView .pvd)")
+    e.add_argument("run_dir")
+    e.add_argument("--vtk", action="store_true", required=True, help="VTK (ParaView) via meshio")
     r = sub.add_parser("run", help="run a scene")
-    r.add_argument("scene")
+    r.add_argument("scene", nargs="?", help="the scene (see 'refsph list'); not with --restart")
+    r.add_argument("--from", dest="particles", default=None, metavar="FILE.npz",
+                   help="start the scene's physics from external particles (x, v, m; optional body, rho, S, S_zz, "
+                        "X, V0, T, clamp_<name>; see refsph.io.state_from_particles)")
+    r.add_argument("--restart", default=None, metavar="RUN_DIR",
+                   help="continue the run in RUN_DIR from its last snapshot, with the arguments it was started with "
+                        "(bit for bit the same as the uninterrupted run)")
     r.add_argument("--method", choices=METHODS + ("both",), default=None,
                    help="formulation (default: the scene's; 'both' runs ESPH then TLSPH)")
     r.add_argument("--dim", type=int, choices=(2, 3), default=None, help="dimension (default: the scene's)")
@@ -56,6 +74,21 @@ def main(argv=None) -> int:
         ap.error(f"unrecognized arguments: {' '.join(extra)}")
     if args.cmd == "book":
         return _book(args)
+    if args.cmd == "oracle":
+        from .golden import write_golden_cases
+        names = write_golden_cases(args.dir)
+        print(f"{len(names)} golden cases in {args.dir}: {', '.join(names)}")
+        return 0
+    if args.cmd == "compare":
+        return _compare(args)
+    if args.cmd == "export":
+        from .export import export_vtk
+        try:
+            print(f"ParaView: {export_vtk(args.run_dir)}")
+        except (ImportError, OSError) as e:
+            print(f"refsph: {e}", file=sys.stderr)
+            return 2
+        return 0
     if args.cmd == "list":
         for name, sc in SCENES.items():
             print(f"{name:10s} {sc.description}")
@@ -66,12 +99,45 @@ def main(argv=None) -> int:
     return _run(args, extra)
 
 
+def _restart(args) -> int:
+    from .simulate import restart_run
+    if args.scene is not None:
+        print("refsph: --restart takes its scene and settings from RUN_DIR/summary.json; give no scene",
+              file=sys.stderr)
+        return 2
+    try:
+        s = restart_run(args.restart, progress=not args.quiet).summary
+    except SimulationError as e:
+        print(f"refsph: run failed: {e}", file=sys.stderr)
+        return 3
+    except (ValueError, OSError) as e:
+        print(f"refsph: {e}", file=sys.stderr)
+        return 2
+    print(f"{s['scene']} {s['method']} {s['dim']}D: continued to t = {s['t_final']:.6g} s, {s['n_steps']} steps "
+          f"in all; output: {args.restart}/summary.json")
+    return 0
+
+
+def _compare(args) -> int:
+    import json
+
+    from .compare import compare, format_table
+    try:
+        tol = json.loads(open(args.tolerances).read()) if args.tolerances else None
+        rows = compare(args.ref, args.test, tol)
+    except (OSError, ValueError, KeyError) as e:
+        print(f"refsph: {e}", file=sys.stderr)
+        return 2
+    print(format_table(rows))
+    return 0 if all(r.passed for r in rows) else 1
+
+
 def _book(args) -> int:
     from .book import build_book
     try:
         index = build_book(quick=not args.full, reuse=not args.rerun, jobs=args.jobs)
-    except (RuntimeError, ImportError) as e:
-        print(f"refsph: {e}", file=sys.stderr)
+    except Exception as e:                                  # a chapter's failing cell, a timeout, no sphinx ...
+        print(f"refsph: the book was not built: {type(e).__name__}: {e}", file=sys.stderr)
         return 1
     print(f"book: {index}")
     return 0
@@ -79,6 +145,8 @@ def _book(args) -> int:
 
 def _run(args, extra) -> int:
     """``refsph run``: each method of the scene in turn, its metrics printed, then the scene's report."""
+    if args.restart is not None:
+        return _restart(args)
     if args.scene not in SCENES:
         print(f"refsph: unknown scene {args.scene!r}; available: {', '.join(sorted(SCENES))}", file=sys.stderr)
         return 2
@@ -99,11 +167,12 @@ def _run(args, extra) -> int:
             out = f"{args.out}/{method}"
         try:
             res = run(args.scene, method, dim=dim, dp=args.dp, t_end=args.t_end, out=out, quick=args.quick,
-                      dt=args.dt, progress=not args.quiet, options=options, numerics=numerics)
+                      dt=args.dt, progress=not args.quiet, options=options, numerics=numerics,
+                      particles=args.particles)
         except SimulationError as e:
             print(f"refsph: run failed: {e}", file=sys.stderr)
             return 3
-        except ValueError as e:
+        except (ValueError, OSError) as e:
             print(f"refsph: {e}", file=sys.stderr)
             return 2
         s = res.summary

@@ -5,6 +5,7 @@ A run directory holds
     summary.json              scene, method, dim, dp, h, n_particles, n_steps, wall_time_s, status, metrics, ...
     snapshots/snap_00000.npz  one file per output time (NumPy .npz, arrays below, SI units)
     snapshots/last_good.npz   only after a failure: the last state that was finite
+    snapshots/restart.npz     the checkpoint of the last snapshot (solver state, history) for refsph run --restart
     reaction_forces.csv       scenes with rigid bodies or clamps: the force on each, every step (below)
 
 Snapshot arrays (N particles, d dimensions):
@@ -12,6 +13,7 @@ Snapshot arrays (N particles, d dimensions):
 | key       | shape     | unit          | meaning                                              |
 |-----------|-----------|---------------|------------------------------------------------------|
 | t         | ()        | s             | time                                                 |
+| id        | (N,)      | -             | particle id: its row in the initial state (never reordered) |
 | x, v      | (N, d)    | m, m/s        | position, velocity                                   |
 | m         | (N,)      | kg (2D: kg/m) | mass                                                 |
 | rho       | (N,)      | kg/m^3        | density                                              |
@@ -42,12 +44,12 @@ from pathlib import Path
 import numpy as np
 
 from .material import eos_pressure, von_mises
-from .state import FIELD_UNITS, State
+from .state import FIELD_UNITS, PLASTIC_FIELDS, State
 
-__all__ = ["save_snapshot", "load_snapshot", "load_run", "write_json", "json_ready", "save_reactions", "load_reactions",
-           "SNAPSHOT_UNITS"]
+__all__ = ["save_snapshot", "load_snapshot", "state_from_snapshot", "state_from_particles", "load_run",
+           "write_json", "json_ready", "save_reactions", "load_reactions", "SNAPSHOT_UNITS"]
 
-SNAPSHOT_UNITS = dict(FIELD_UNITS, p="Pa", sigma_vm="Pa", F="1")
+SNAPSHOT_UNITS = dict(FIELD_UNITS, p="Pa", sigma_vm="Pa", F="1", id="1 (particle id)")
 
 
 def save_snapshot(path, state: State, material, F: np.ndarray | None = None) -> None:
@@ -58,6 +60,7 @@ def save_snapshot(path, state: State, material, F: np.ndarray | None = None) -> 
         t=np.float64(state.t), x=state.x, v=state.v, m=state.m, rho=state.rho,
         p=eos_pressure(state.rho, material.rho0, material.K), S=state.S, S_zz=state.S_zz,
         sigma_vm=von_mises(state.S, state.S_zz), X=state.X, V0=state.V0,
+        id=np.arange(state.n, dtype=np.int64),          # refsph never reorders particles: the id is the row
     )
     if F is not None:
         arrays["F"] = F
@@ -78,6 +81,56 @@ def load_snapshot(path) -> dict:
     out["units"] = json.loads(str(out["units"]))
     out["t"] = float(out["t"])
     return out
+
+
+def state_from_snapshot(snap) -> State:
+    """A :class:`~refsph.state.State` from a snapshot (a path, or the dict :func:`load_snapshot` gives)."""
+    z = load_snapshot(snap) if isinstance(snap, (str, Path)) else snap
+    extra = {k: np.array(z[k]) for k in PLASTIC_FIELDS + ("body",) if k in z}
+    return State(x=np.array(z["x"]), v=np.array(z["v"]), m=np.array(z["m"]), rho=np.array(z["rho"]),
+                 S=np.array(z["S"]), S_zz=np.array(z["S_zz"]), X=np.array(z["X"]), V0=np.array(z["V0"]),
+                 t=float(z["t"]), **extra)
+
+
+def state_from_particles(path, rho0: float, T0: float | None, clamp_names=()) -> tuple[State, dict]:
+    """An external particle set (``.npz``) as a State, and the clamps' index arrays it gives.
+
+    Required arrays: ``x`` (N, d) [m], ``v`` (N, d) [m/s], ``m`` (N,) [kg; 2D: kg/m]. Optional: ``body`` (N,)
+    (ids of rigid bodies, their rows last; needed where the scene has tools), ``rho`` (default rho0), ``S``
+    (N, d, d) and ``S_zz`` (N,) [Pa] (default 0), ``X`` (default x), ``V0`` (default m / rho0), ``T`` (default
+    ``T0``) and ``eps_p``, ``eps_dot_p``, ``W_p`` (default 0) for a plasticity law, and ``clamp_<name>`` index
+    arrays for every clamp of the scene. Errors name the missing or inconsistent array."""
+    with np.load(path, allow_pickle=False) as z:
+        a = {k: z[k] for k in z.files}
+    missing = [k for k in ("x", "v", "m") if k not in a]
+    if missing:
+        raise ValueError(f"{path}: missing array(s) {', '.join(missing)} (x (N, d), v (N, d), m (N,) are needed)")
+    x = np.asarray(a["x"], dtype=float)
+    if x.ndim != 2 or x.shape[1] not in (2, 3):
+        raise ValueError(f"{path}: x must have shape (N, 2) or (N, 3), got {x.shape}")
+    n, d = x.shape
+    shapes = dict(v=(n, d), m=(n,), body=(n,), rho=(n,), S=(n, d, d), S_zz=(n,), X=(n, d), V0=(n,), T=(n,),
+                  eps_p=(n,), eps_dot_p=(n,), W_p=(n,))
+    for k, shape in shapes.items():
+        if k in a and np.shape(a[k]) != shape:
+            raise ValueError(f"{path}: array {k} has shape {np.shape(a[k])}, expected {shape} (N = {n} from x)")
+    m = np.asarray(a["m"], dtype=float)
+    plastic = T0 is not None
+    state = State(x=x, v=np.asarray(a["v"], dtype=float), m=m, rho=np.asarray(a.get("rho", np.full(n, rho0)), float),
+                  S=np.asarray(a.get("S", np.zeros((n, d, d))), float), S_zz=np.asarray(a.get("S_zz", np.zeros(n)),
+                                                                                         float),
+                  X=np.asarray(a.get("X", x), float), V0=np.asarray(a.get("V0", m / rho0), float),
+                  body=np.asarray(a["body"], dtype=np.int32) if "body" in a else None,
+                  **({k: np.asarray(a.get(k, np.zeros(n) if k != "T" else np.full(n, T0)), float)
+                      for k in PLASTIC_FIELDS} if plastic else {}))
+    state.check()
+    clamps = {}
+    for name in clamp_names:
+        if f"clamp_{name}" not in a:
+            raise ValueError(f"{path}: the scene holds particles by the clamp {name!r}: give their indices as "
+                             f"clamp_{name}")
+        clamps[name] = np.asarray(a[f"clamp_{name}"])
+    return state, clamps
 
 
 def load_run(directory) -> tuple[dict, list[Path]]:

@@ -34,7 +34,7 @@ import scipy.sparse as sp
 from scipy.spatial import cKDTree
 
 __all__ = ["find_pairs", "VerletList", "scatter_add", "pair_count_per_particle", "PairSum", "PairBlocks",
-           "PAIR_BLOCK", "available_cores", "threads_per_job", "check_threads"]
+           "PAIR_BLOCK", "available_cores", "threads_per_job", "check_threads", "check_half_pairs"]
 
 PAIR_BLOCK = 2**17        # pairs per block of a PairBlocks: 1 MB per float array (benchmarks/pair_blocks.py)
 
@@ -53,6 +53,30 @@ def find_pairs(x: np.ndarray, radius: float) -> tuple[np.ndarray, np.ndarray]:
     key.sort()
     I, J = np.divmod(key, len(x))
     return I.astype(np.intp, copy=False), J.astype(np.intp, copy=False)
+
+
+def check_half_pairs(I: np.ndarray, J: np.ndarray, n: int) -> None:
+    """Refuse a pair list that is not refsph's convention: *half pairs*, each interacting pair once with I < J
+    (so no self-pair i = i and not both (i, j) and (j, i)), no pair twice, indices in [0, n). A full
+    (both-direction) list, the usual GPU layout, would double every sum; this says so instead."""
+    I, J = np.asarray(I), np.asarray(J)
+    if I.shape != J.shape or I.ndim != 1:
+        raise ValueError(f"pair lists I and J must be 1-D arrays of one length, got shapes {I.shape}, {J.shape}")
+    if not len(I):
+        return
+    if min(I.min(), J.min()) < 0 or max(I.max(), J.max()) >= n:
+        raise ValueError(f"pair indices must lie in [0, {n})")
+    if np.any(I == J):
+        k = int(np.flatnonzero(I == J)[0])
+        raise ValueError(f"pair {k} is a self-pair ({I[k]}, {J[k]}); refsph expects half pairs: each interacting "
+                         "pair once with I < J and no self-pairs")
+    if np.any(I > J):
+        k = int(np.flatnonzero(I > J)[0])
+        raise ValueError(f"pair {k} is ({I[k]}, {J[k]}) with I > J: refsph expects half pairs (each interacting "
+                         "pair once, I < J); a full (both-direction) neighbour list would count every pair twice")
+    key = I.astype(np.int64) * n + J
+    if len(key) > 1 and not np.all(key[1:] > key[:-1]) and len(np.unique(key)) != len(key):
+        raise ValueError("a pair appears twice: refsph expects half pairs, each interacting pair once (I < J)")
 
 
 def scatter_add(index: np.ndarray, values: np.ndarray, n: int) -> np.ndarray:
@@ -153,8 +177,7 @@ class PairBlocks:
             raise ValueError(f"block size must be a positive number of pairs, got {size!r}")
         threads = check_threads(threads)
         I, J = np.asarray(I), np.asarray(J)
-        if len(I) and (min(I.min(), J.min()) < 0 or max(I.max(), J.max()) >= n):
-            raise ValueError(f"pair indices must lie in [0, {n})")
+        check_half_pairs(I, J, n)
         self.n, self.n_pairs, self.size = int(n), len(I), int(size)
         self.blocks = [self.Block(I[a:a + self.size], J[a:a + self.size], slice(a, a + self.size))
                        for a in range(0, max(len(I), 1), self.size)]

@@ -61,6 +61,8 @@ def chapter(name: str) -> Chapter:
     """Set up a chapter: quick mode from ``REFSPH_QUICK``, its figure folder, a scratch folder, the plot style."""
     quick = os.environ.get("REFSPH_QUICK", "0") == "1"
     root = repository_root()
+    if not (root / "chapters").is_dir():                    # an installed package: work where the notebook runs
+        root = Path.cwd()
     if os.environ.get("REFSPH_FIGURES"):
         figures = Path(os.environ["REFSPH_FIGURES"])
     elif os.environ.get("REFSPH_WRITE_FIGURES", "0") == "1":

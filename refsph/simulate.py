@@ -12,6 +12,8 @@ state.
 from __future__ import annotations
 
 import dataclasses
+import json
+import os
 import sys
 import time
 from dataclasses import dataclass
@@ -24,7 +26,8 @@ from . import __version__
 from .contact import PinballContact
 from .esph import ESPHParams
 from .integrate import Solver, cfl_time_step, get_stepper
-from .io import save_reactions, save_snapshot, write_json
+from .boundaries import Clamp
+from .io import json_ready, save_reactions, save_snapshot, state_from_particles, state_from_snapshot, write_json
 from .kernels import get_kernel
 from .neighbours import check_threads
 from .scenes import Scene, Setup, get_scene
@@ -33,9 +36,10 @@ from .state import State
 from .tlsph import TLSPHParams
 
 __all__ = ["SimulationError", "RunResult", "RunRecord", "make_solver", "run", "simulate", "snapshot_times",
-           "step_or_fail", "METHODS"]
+           "step_or_fail", "provenance", "restart_run", "METHODS"]
 
 METHODS = ("esph", "tlsph")
+CHECKPOINT = "restart.npz"          # snapshots/restart.npz: how to continue from the last snapshot (see simulate)
 
 
 class SimulationError(RuntimeError):
@@ -101,9 +105,34 @@ def snapshot_times(setup: Setup) -> np.ndarray:
     return np.unique(np.concatenate([times, extra]))
 
 
+def provenance(threads: int) -> dict:
+    """Where a run's numbers come from: refsph version and git commit (when the package is a git checkout; with
+    ``dirty`` if it has uncommitted changes), Python, NumPy and SciPy versions, platform, thread count, command line."""
+    import platform
+    import subprocess
+
+    import scipy
+    root = Path(__file__).resolve().parent.parent
+    commit = None
+    if (root / ".git").exists():
+        try:
+            git = ["git", "-C", str(root)]
+            commit = subprocess.run(git + ["rev-parse", "HEAD"], capture_output=True, text=True, timeout=10,
+                                    check=True).stdout.strip()
+            dirty = subprocess.run(git + ["status", "--porcelain", "--untracked-files=no"], capture_output=True,
+                                   text=True, timeout=10, check=True).stdout.strip()
+            commit += " (dirty)" if dirty else ""
+        except (OSError, subprocess.SubprocessError):
+            commit = None
+    return dict(refsph=__version__, git_commit=commit, python=platform.python_version(), numpy=np.__version__,
+                scipy=scipy.__version__, platform=platform.platform(), threads=threads, command=list(sys.argv))
+
+
 def _as_dict(obj) -> dict:
     """A strength model, wall, body ... as {'model': its class, its fields}."""
     fields = dataclasses.asdict(obj) if dataclasses.is_dataclass(obj) else {}
+    if "model" in fields:
+        return dict(model=type(obj).__name__, fields=fields)
     return dict(model=type(obj).__name__, **fields)
 
 
@@ -111,19 +140,50 @@ class RunRecord:
     """What a run leaves: ``summary`` (summary.json), ``history`` (the recorded scalars), snapshots and the
     reaction-force CSV in ``out`` (None: nothing is written)."""
 
-    def __init__(self, setup: Setup, solver: Solver, out, dt, name: str, record: Callable | None, times):
+    def __init__(self, setup: Setup, solver: Solver, out, dt, name: str, record: Callable | None, times,
+                 resume: dict | None = None):
         self.setup, self.solver, self.record_fn = setup, solver, record
         self.out = Path(out) if out is not None else None
-        if self.out is not None:
-            (self.out / "snapshots").mkdir(parents=True, exist_ok=True)
-            for old in (self.out / "snapshots").glob("*.npz"):
-                old.unlink()
         self.history: dict[str, list] = {}
         self.snapshots: list[str] = []
         self.times, self.next_snap = times, 0
-        self.n_steps, self.dts = 0, []
+        self.n_steps, self.dts, self.record_every = 0, [], 1
         self.t0, self.c0 = time.perf_counter(), time.process_time()
+        if resume is not None:
+            self._resume(resume)
+        if self.out is not None:
+            (self.out / "snapshots").mkdir(parents=True, exist_ok=True)
+            for old in (self.out / "snapshots").glob("*.npz"):
+                if old.name not in self.snapshots and old.name != CHECKPOINT:
+                    old.unlink()
         self.summary = self._initial_summary(setup, solver, dt, name)
+        if resume is not None:
+            self.summary["restarts"] = int(resume["run"]["restarts"]) + 1
+
+    def _resume(self, ck: dict) -> None:
+        """Continue the record of an interrupted run from its checkpoint."""
+        r = ck["run"]
+        self.history = {k: list(v) for k, v in r["history"].items()}
+        self.snapshots, self.next_snap = list(r["snapshots"]), int(r["next_snap"])
+        self.n_steps, self.record_every = int(r["n_steps"]), int(r["record_every"])
+        self.dts = list(np.asarray(ck["dts"], dtype=float))
+        self.t0 -= float(r["wall_time_s"])
+        self.c0 -= float(r["cpu_time_s"])
+
+    def checkpoint(self, snapshot: str) -> None:
+        """``snapshots/restart.npz``: what :func:`simulate` needs to continue from snapshot ``snapshot`` exactly as
+        the uninterrupted run (the solver's own state, the history, the counters), written atomically."""
+        if self.out is None or not hasattr(self.solver, "checkpoint"):
+            return
+        run = dict(snapshot=snapshot, history={k: v for k, v in self.history.items() if k != "reaction"},
+                   snapshots=self.snapshots, next_snap=self.next_snap, n_steps=self.n_steps,
+                   record_every=self.record_every, wall_time_s=time.perf_counter() - self.t0,
+                   cpu_time_s=time.process_time() - self.c0, restarts=self.summary.get("restarts", 0))
+        arrays = {f"solver/{k}": v for k, v in self.solver.checkpoint().items()}
+        path = self.out / "snapshots" / CHECKPOINT
+        tmp = path.with_name("restart.tmp.npz")
+        np.savez(tmp, run=json.dumps(json_ready(run)), dts=np.asarray(self.dts, dtype=float), **arrays)
+        os.replace(tmp, path)
 
     def _initial_summary(self, setup: Setup, solver: Solver, dt, name: str) -> dict:
         state = setup.state
@@ -138,7 +198,7 @@ class RunRecord:
                             clamps=[c.to_dict() for c in setup.clamps],
                             friction=(dataclasses.asdict(setup.friction) if setup.friction is not None else None)),
             scene_info=setup.info, snapshot_times=[float(t) for t in self.times], refsph_version=__version__,
-            status="running", metrics={})
+            provenance=provenance(solver.threads), status="running", metrics={})
 
     def record(self, state: State) -> None:
         if self.record_fn is not None:
@@ -149,6 +209,10 @@ class RunRecord:
         path = self.out / "snapshots" / name
         save_snapshot(path, state, self.setup.material, self.solver.deformation_gradient(state))
         return path
+
+    def next_output_time(self) -> float:
+        """The next snapshot time not yet written (t_end, the last one, once all are)."""
+        return float(self.times[min(self.next_snap, len(self.times) - 1)])
 
     def snapshot_if_due(self, state: State) -> None:
         """Write every snapshot whose time has come (a killed run keeps its summary up to the last of them)."""
@@ -161,6 +225,8 @@ class RunRecord:
                     self.update(state)
                     write_json(self.out / "summary.json", self.summary)
             self.next_snap += 1
+            if self.out is not None:
+                self.checkpoint(name)
             if state.t < self.setup.t_end * (1 - 1e-12):
                 break
 
@@ -242,45 +308,78 @@ class _Progress:
             self.last = now
 
 
+def _begin(setup: Setup, solver: Solver, out, dt, name: str, record, record_every, restart: bool):
+    """The initial record: a fresh start (the setup's state, recorded and written at t = 0), or with ``restart``
+    the checkpoint of the run folder ``out`` (its snapshot, the history and counters, the solver's own state)."""
+    if restart:
+        if out is None:
+            raise ValueError("restart needs the run folder (out=...)")
+        path = Path(out) / "snapshots" / CHECKPOINT
+        if not path.exists():
+            raise FileNotFoundError(f"{path} does not exist: nothing to restart from (a run writes it at every "
+                                    "snapshot)")
+        with np.load(path) as z:
+            ck = {k: z[k] for k in z.files}
+        run_ck = json.loads(str(ck["run"]))
+        state = state_from_snapshot(Path(out) / "snapshots" / run_ck["snapshot"])
+        solver.restore({k[len("solver/"):]: v for k, v in ck.items() if k.startswith("solver/")}, state)
+        rec = RunRecord(setup, solver, out, dt, name, record, snapshot_times(setup),
+                        resume=dict(run=run_ck, dts=ck["dts"]))
+        return state, rec
+    state = setup.state.copy()
+    state.check()
+    solver.check_state(state)
+    rec = RunRecord(setup, solver, out, dt, name, record, snapshot_times(setup))
+    rec.record_every = record_every or max(1, int(setup.t_end / _time_step(setup, dt, state) / 400))
+    _warn_fixed_dt(setup, dt, state)
+    rec.record(state)
+    rec.snapshot_if_due(state)
+    return state, rec
+
+
 def simulate(setup: Setup, method: str | None = None, *, scene: Scene | None = None,
              record: Callable[[State, Setup], dict] | None = None,
              metrics: Callable[[dict, State, Setup], dict] | None = None, solver: Solver | None = None,
              hook: Callable[[State, Solver], State | None] | None = None, out=None, dt: float | None = None,
-             progress: bool = True, label: str = "", record_every: int | None = None) -> RunResult:
+             progress: bool = True, label: str = "", record_every: int | None = None, restart: bool = False,
+             meta: dict | None = None) -> RunResult:
     """Run a prepared setup with ``method`` ('esph' | 'tlsph'), or with a ``solver`` of one's own (any
     :class:`~refsph.integrate.Solver`, e.g. one that wraps ``make_solver(method, setup)`` to add a force).
 
     ``record(state, setup) -> dict`` of scalars is called on the initial state, every ``record_every`` steps
     (default: about 400 records per run) and on the final state; the lists it builds are the ``history``, which
     ``metrics(history, state, setup) -> dict`` turns into ``summary['metrics']``. ``scene``: take both (and the
-    name) from a :class:`~refsph.scenes.Scene`. ``hook(state, solver)`` is called after every step and may return
-    a changed state (prescribed kinematics). ``dt=None``: the CFL step every step; else a fixed ``dt``.
-    ``out``: the run folder (summary.json, snapshots/, reaction_forces.csv), None: nothing written."""
+    name) from a :class:`~refsph.scenes.Scene`. ``hook(state, solver)`` is called after every step (after the
+    solver's after-step work: TLSPH's density is that of the positions before the hook) and may return a changed
+    state (prescribed kinematics). ``dt=None``: the CFL step every step; else a fixed ``dt``.
+    ``out``: the run folder (summary.json, snapshots/, reaction_forces.csv), None: nothing written. The step before
+    each snapshot time is shortened to land on it, so snapshots are at their nominal times (to round-off).
+    With ``out``, every snapshot also writes ``snapshots/restart.npz``; ``restart=True`` continues the run in
+    ``out`` from there (same setup, solver and callbacks), and gives the same bits as the uninterrupted run.
+    ``meta``: extra entries for summary.json."""
+    if solver is not None and method is not None and method != solver.method:
+        raise ValueError(f"method {method!r} does not match the solver's ({solver.method!r}); give one of them")
     method = method if solver is None else solver.method
     _validate(method, setup.state.dim, setup.dp, setup.numerics, setup.t_end, dt)
     record = record or (scene.record if scene is not None else None)
     metrics = metrics or (scene.metrics if scene is not None else None)
-    state = setup.state.copy()
-    state.check()
     solver = solver if solver is not None else make_solver(method, setup)
     stepper = get_stepper(setup.numerics.integrator)
-    solver.check_state(state)
     name = scene.name if scene is not None else label
-    rec = RunRecord(setup, solver, out, dt, name, record, snapshot_times(setup))
-    if record_every is None:
-        record_every = max(1, int(setup.t_end / _time_step(setup, dt, state) / 400))
-    _warn_fixed_dt(setup, dt, state)
+    state, rec = _begin(setup, solver, out, dt, name, record, record_every, restart)
+    rec.summary.update(meta or {})
+    record_every = rec.record_every
     show = _Progress(label or f"{name} {method} {state.dim}D", setup.t_end, progress)
-    rec.record(state)
-    rec.snapshot_if_due(state)
     try:
         while state.t < setup.t_end * (1 - 1e-12):
             step_dt = _time_step(setup, dt, state)
-            rec.dts.append(step_dt)                         # the step size chosen (before any cut to land on t_end)
-            step_dt = min(step_dt, setup.t_end - state.t)
-            state = step_or_fail(state, solver, step_dt, rec, stepper)
+            rec.dts.append(step_dt)                         # the step size chosen (before any cut to land on time)
+            step_dt = min(step_dt, rec.next_output_time() - state.t)   # snapshots land on their nominal times
+            prev, state = state, step_or_fail(state, solver, step_dt, rec, stepper)
             if hook is not None:
                 state = hook(state, solver) or state
+                if not (np.isfinite(state.v).all() and np.isfinite(state.x).all()):
+                    raise rec.fail("nan", f"the hook made the state non-finite after step {rec.n_steps}", prev)
             if rec.n_steps % record_every == 0:
                 with np.errstate(over="ignore", invalid="ignore"):  # near-blow-up states are caught above
                     rec.record(state)
@@ -303,9 +402,14 @@ def simulate(setup: Setup, method: str | None = None, *, scene: Scene | None = N
 
 def run(scene_name: str, method: str, *, dim: int | None = None, dp: float | None = None,
         t_end: float | None = None, out=None, quick: bool = False, dt: float | None = None, progress: bool = True,
-        numerics: dict | None = None, options: dict | None = None) -> RunResult:
+        numerics: dict | None = None, options: dict | None = None, restart: bool = False,
+        particles=None) -> RunResult:
     """Build scene ``scene_name`` and run it. ``dim``: None = the scene's default; ``numerics`` overrides
-    fields of the scene's Numerics; ``options`` sets the scene's own options (``Scene.options``)."""
+    fields of the scene's Numerics; ``options`` sets the scene's own options (``Scene.options``); ``restart``:
+    continue the run in ``out`` from its last checkpoint (:func:`restart_run` takes the arguments from it);
+    ``particles``: an ``.npz`` of external particles that replace the scene's own (the scene keeps its material,
+    numerics, boundaries and end time; :func:`refsph.io.state_from_particles` says what the file holds). Metrics
+    that need the scene's own particle layout are then reported as ``metrics_error``."""
     scene = get_scene(scene_name)
     dim = scene.default_dim if dim is None else dim
     _validate(method, dim, dp, None, t_end, dt)
@@ -317,4 +421,44 @@ def run(scene_name: str, method: str, *, dim: int | None = None, dp: float | Non
         setup.numerics = dataclasses.replace(setup.numerics, **numerics)
     if t_end is not None:
         setup.t_end = t_end
-    return simulate(setup, method, scene=scene, out=out, dt=dt, progress=progress)
+    args = dict(scene_name=scene_name, method=method, dim=dim, dp=dp, t_end=t_end, quick=quick, dt=dt,
+                numerics=numerics or {}, options=options or {})
+    metrics = scene.metrics
+    if particles is not None:
+        args["particles"] = str(Path(particles).resolve())
+        _use_particles(setup, particles)
+        metrics = _tolerant(scene.metrics)
+    return simulate(setup, method, scene=scene, out=out, dt=dt, progress=progress, restart=restart,
+                    meta=dict(run_args=args), metrics=metrics)
+
+
+def _use_particles(setup: Setup, path) -> None:
+    """Replace the setup's particles by those of ``path`` (its clamps re-indexed from the file)."""
+    T0 = setup.state.T[0] if setup.state.T is not None else None
+    state, clamps = state_from_particles(path, setup.material.rho0, T0, [c.name for c in setup.clamps])
+    if state.dim != setup.state.dim:
+        raise ValueError(f"{path}: the particles are {state.dim}D, the scene is {setup.state.dim}D")
+    if setup.rigid and state.body is None:
+        raise ValueError(f"{path}: the scene has rigid bodies ({', '.join(b.name for b in setup.rigid)}): give "
+                         "the body id of every particle as body")
+    setup.state = state
+    setup.clamps = tuple(Clamp(c.name, clamps[c.name]) for c in setup.clamps)
+    setup.arrays = {}
+
+
+def _tolerant(metrics):
+    def measured(history, state, setup):
+        try:
+            return metrics(history, state, setup)
+        except (KeyError, IndexError, ValueError) as e:       # a measure made for the scene's own particles
+            return dict(metrics_error=f"{type(e).__name__}: {e}")
+    return measured
+
+
+def restart_run(run_dir, progress: bool = True) -> RunResult:
+    """Continue the run in ``run_dir`` (made by :func:`run` / ``refsph run``) from its last checkpoint, with the
+    arguments it was started with (``summary.json``'s ``run_args``)."""
+    summary = json.loads((Path(run_dir) / "summary.json").read_text())
+    if "run_args" not in summary:
+        raise ValueError(f"{run_dir}/summary.json has no run_args: only runs made by refsph run can be restarted")
+    return run(**summary["run_args"], out=run_dir, progress=progress, restart=True)

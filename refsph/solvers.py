@@ -21,7 +21,7 @@ from . import contact as _contact
 from .boundaries import Constraints, Ghosts, MirrorPlanes
 from .contact import PinballContact
 from .esph import ESPHParams, esph_rates
-from .material import ElasticMaterial
+from .material import ElasticMaterial, eos_pressure
 from .neighbours import PairBlocks, VerletList, check_threads
 from .state import Rates, State
 from .strength import Elastic, StrengthModel, check_strength_fields, strength_stage
@@ -94,8 +94,9 @@ class ESPHSolver:
             self.pairs.I, self.pairs.J = I[keep], J[keep]
         return (self.pairs.I, self.pairs.J), self._ghosts.extend_state(state, self._ghost_constant)
 
-    def rates(self, state: State, dt: float | None = None) -> Rates:
-        """Eqs. (10)-(14), (23) over all particles, rigid ones included; constrained (``dt`` is not used)."""
+    def rates(self, state: State, dt: float | None = None, out: dict | None = None) -> Rates:
+        """Eqs. (10)-(14), (23) over all particles, rigid ones included; constrained (``dt`` is not used).
+        ``out``: a dict that receives the pair list (I, J) and the pressure p (Eq. (24)) of ``state``'s rows."""
         if self.constraints.dim is None:
             self.constraints.bind(state)
         (I, J), ext = self._pairs_and_state(state)
@@ -106,6 +107,8 @@ class ESPHSolver:
             self._pair_sum_build = self.pairs.n_builds
         r = esph_rates(ext, self.material, self.params, I, J, pairs=self._pair_sum)
         r = r if ext is state else r.rows(state.n)
+        if out is not None:
+            out.update(I=I, J=J, p=eos_pressure(state.rho, self.material.rho0, self.material.K))
         return self.constraints.constrain(state, r)
 
     def finish_stage(self, old: State, new: State, rates: Rates, dt: float, final: bool) -> State:
@@ -117,6 +120,32 @@ class ESPHSolver:
     def deformation_gradient(self, state: State) -> None:
         """ESPH has no deformation gradient."""
         return None
+
+    def checkpoint(self) -> dict:
+        """What a restart needs besides the state: the positions the Verlet list was built at (the list and its
+        ghosts follow from them), the counters, the constraints' log."""
+        ck = {f"constraints/{k}": v for k, v in self.constraints.checkpoint().items()}
+        ck["n_builds"] = np.int64(self.pairs.n_builds)
+        if self.pairs._x_build is not None:
+            ck["x_build"] = self.pairs._x_build
+        return ck
+
+    def restore(self, ck: dict, state: State) -> None:
+        """Continue from a :meth:`checkpoint` at ``state`` exactly as the uninterrupted run would."""
+        self.check_state(state)
+        self.constraints.restore({k.split("/", 1)[1]: v for k, v in ck.items() if k.startswith("constraints/")})
+        if "x_build" in ck:
+            x_build = np.array(ck["x_build"])
+            if self.mirror is None:
+                self.pairs.build(x_build)
+            else:
+                self._ghosts = self.mirror.ghosts(x_build, self.pairs.cutoff + self.pairs.skin)
+                self._ghost_constant = self._ghosts.extend_constant(state)
+                I, J = self.pairs.build(self._ghosts.extend_vectors(x_build), track=x_build)
+                keep = I < state.n
+                self.pairs.I, self.pairs.J = I[keep], J[keep]
+        self.pairs.n_builds = int(ck["n_builds"])
+        self._pair_sum_build = -1
 
     def reaction_history(self) -> dict:
         return self.constraints.reaction_history()
@@ -193,17 +222,16 @@ class TLSPHSolver:
 
     def check_state(self, state: State) -> None:
         """The state fits the solver (ValueError naming what does not); TLSPH computes rho = m / (J V0)
-        (Eq. (2)) and refuses a state whose rho says otherwise (an initial pressure it would silently drop; J = 1
-        for a particle at its reference position, x = X)."""
+        (Eq. (2)) and refuses a state whose rho says otherwise (an initial pressure it would silently drop). J is
+        1 in the reference configuration (every x = X) and det F of the operator otherwise."""
         _check_common(self.strength, self.mirror, self.constraints, state)
         if self.contact is not None and self.contact.friction is not None and state.T is None:
             raise ValueError("friction with mu(T) needs a state with temperatures (make_state(..., T0=...))")
         body = self._deformable(state)
-        J = np.ones(body.n)                     # J = 1 where the particles sit at their reference positions
-        moved = np.flatnonzero(np.any(body.x != body.X, axis=1))
-        if len(moved):
+        J = np.ones(body.n)                     # the reference configuration itself: J = 1 (by definition)
+        if np.any(body.x != body.X):            # a deformed start: the J the operator gives (Eq. (18))
             op = self.operator(body)
-            J[moved] = det(self._F(self._extended(body, op), op)[moved])
+            J = det(self._F(self._extended(body, op), op)[:body.n])
         rho = body.m / (J * body.V0)
         if not np.allclose(body.rho, rho, rtol=1e-8, atol=0.0):
             k = int(np.argmax(np.abs(body.rho - rho)))
@@ -239,17 +267,20 @@ class TLSPHSolver:
                  ("body", state.body))}
         return State(m=m, X=X, V0=V0, t=state.t, **part)
 
-    def rates(self, state: State, dt: float) -> Rates:
+    def rates(self, state: State, dt: float, out: dict | None = None) -> Rates:
         """Eqs. (16)-(23) on the deformable body; with rigid bodies, the pinball contact (Eqs. (32)-(36)) for a
-        step of size ``dt`` (Eq. (34))."""
+        step of size ``dt`` (Eq. (34)). ``out``: a dict that receives F, J, P, l, rho, p of the deformable rows
+        (:func:`~refsph.tlsph.tlsph_rates`) and the operator's half pairs (I, J)."""
         body = self._deformable(state)
         op = self.operator(body)
         ext = self._extended(body, op)
         F = self._F_from_after_step(body, op)
         if F is None:
             F = self._F(ext, op)
-        r = tlsph_rates(ext, self.material, self.params, op, F=F)
+        r = tlsph_rates(ext, self.material, self.params, op, F=F, out=out)
         r = r if ext is body else r.rows(body.n)
+        if out is not None:
+            out.update({k: out[k][:body.n] for k in ("F", "J", "P", "l", "rho", "p")}, I=op.I, J=op.J)
         if body is not state:
             r = self._with_rigid(state, r, dt)
         return self.constraints.constrain(state, r)
@@ -310,6 +341,22 @@ class TLSPHSolver:
         else:
             self._F_after_step = (op, body.x.copy(), F_ext)
         return state
+
+    def checkpoint(self) -> dict:
+        """What a restart needs besides the state (the operator follows from X and V0): counters, the log."""
+        ck = {f"constraints/{k}": v for k, v in self.constraints.checkpoint().items()}
+        ck.update(n_reference_updates=np.int64(self.n_reference_updates),
+                  cache_counts=np.array(self._cache_counts, dtype=np.int64),
+                  max_penetration=np.float64(self.max_penetration), n_contacts=np.int64(self.n_contacts))
+        return ck
+
+    def restore(self, ck: dict, state: State) -> None:
+        """Continue from a :meth:`checkpoint` at ``state`` exactly as the uninterrupted run would."""
+        self.check_state(state)
+        self.constraints.restore({k.split("/", 1)[1]: v for k, v in ck.items() if k.startswith("constraints/")})
+        self.n_reference_updates = int(ck["n_reference_updates"])
+        self._cache_counts = [int(c) for c in ck["cache_counts"]]
+        self.max_penetration, self.n_contacts = float(ck["max_penetration"]), int(ck["n_contacts"])
 
     def _drop_operator(self) -> None:
         self._cache_counts[0] += self.op.momentum_cache_hits

@@ -121,8 +121,11 @@ class State:
             raise ValueError(f"state field body must be an integer array of shape {(n,)}, "
                              f"got {self.body.dtype} {self.body.shape}")
         for name in ("m", "rho", "V0"):
-            if np.any(getattr(self, name) <= 0):
+            if not np.all(getattr(self, name) > 0):
                 raise ValueError(f"state field {name} must be positive everywhere")
+        for name in ("x", "v", "rho", "S", "S_zz", "X"):
+            if not np.all(np.isfinite(getattr(self, name))):
+                raise ValueError(f"state field {name} must be finite")
 
     def first_nonfinite(self) -> tuple[str, int] | None:
         """(field, particle index) of the first NaN/inf in an evolving field, or None."""
@@ -155,7 +158,8 @@ class Rates:
 
 def make_state(x: np.ndarray, v: np.ndarray, rho0: float, volume: np.ndarray | float,
                T0: float | None = None, body: np.ndarray | None = None, *, S: np.ndarray | None = None,
-               S_zz: np.ndarray | float | None = None, rho: np.ndarray | float | None = None) -> State:
+               S_zz: np.ndarray | float | None = None, rho: np.ndarray | float | None = None,
+               X: np.ndarray | None = None) -> State:
     """A state at rest density ``rho0`` unless told otherwise: m = rho0 V, X = x, V0 = V.
 
     ``T0`` (kelvin): give it for a plasticity law; the state then carries eps_p = eps_dot_p = W_p = 0 and T = T0.
@@ -169,7 +173,9 @@ def make_state(x: np.ndarray, v: np.ndarray, rho0: float, volume: np.ndarray | f
     * ESPH reads ``S``, ``S_zz`` and ``rho`` (it integrates rho by Eq. (10)): both parts of the stress are used;
     * TLSPH reads ``S`` and ``S_zz``, and computes rho and p from m, V0 and J = det F (Eq. (2)), so it cannot
       start from a pressure that the configuration does not carry: its solver refuses a state whose rho is not
-      m / (J V0) (start from a deformed configuration, x != X, instead).
+      m / (J V0). To start TLSPH deformed, give the reference positions ``X`` (default: x) and rho = m / (J V0).
+
+    ``S`` must be symmetric and traceless, ``rho`` finite and positive (ValueError naming the field otherwise).
     """
     x = np.array(x, dtype=float)
     n, d = x.shape
@@ -185,12 +191,20 @@ def make_state(x: np.ndarray, v: np.ndarray, rho0: float, volume: np.ndarray | f
     S = np.zeros((n, d, d)) if S is None else np.broadcast_to(np.asarray(S, dtype=float), (n, d, d)).copy()
     S_zz = np.zeros(n) if S_zz is None else np.broadcast_to(np.asarray(S_zz, dtype=float), (n,)).copy()
     trace = np.trace(S, axis1=1, axis2=2) + (S_zz if d == 2 else 0.0)
+    if not np.all(np.isfinite(S)) or not np.allclose(S, S.transpose(0, 2, 1), rtol=0,
+                                                     atol=1e-12 * np.max(np.abs(S), initial=1.0)):
+        raise ValueError("initial deviatoric stress S must be finite and symmetric")
     if not np.all(np.abs(trace) <= 1e-12 * np.max(np.abs(S), initial=1.0)):
         raise ValueError("initial deviatoric stress S must be traceless (in 2D: S_xx + S_yy + S_zz = 0); put the "
                          "mean stress into the density rho")
     if d == 3 and np.any(S_zz != 0):
         raise ValueError("S_zz is the 2D plane-strain component; in 3D it is S[:, 2, 2]")
     rho = np.full(n, float(rho0)) if rho is None else np.broadcast_to(np.asarray(rho, dtype=float), (n,)).copy()
+    if not np.all(np.isfinite(rho) & (rho > 0)):
+        raise ValueError("initial density rho must be finite and positive")
+    X = x.copy() if X is None else np.array(X, dtype=float)
+    if X.shape != x.shape:
+        raise ValueError(f"reference positions X must have the shape of x {x.shape}, got {X.shape}")
     return State(
         x=x,
         v=np.broadcast_to(np.asarray(v, dtype=float), (n, d)).copy(),
@@ -198,7 +212,7 @@ def make_state(x: np.ndarray, v: np.ndarray, rho0: float, volume: np.ndarray | f
         rho=rho,
         S=S,
         S_zz=S_zz,
-        X=x.copy(),
+        X=X,
         V0=V,
         body=None if body is None else np.asarray(body, dtype=np.int32).copy(),
         **thermal,

@@ -89,13 +89,13 @@ def strength_stage(model: StrengthModel, old: State, new: State, l: np.ndarray, 
     gradient ``l`` (its equivalent strain rate enters the flow stress) and the start-of-step plastic fields of
     ``old``. Only the final stage accumulates eps_p, W_p and T; an intermediate stage (the predictor's half
     state) is only returned to the yield surface, so that the midpoint rates see an admissible stress."""
-    if not model.state_fields:
+    if isinstance(model, Elastic):
         return new
     check_strength_fields(model, old)
     eps_dot = equivalent_strain_rate(l)
     S, S_zz, deps, dw, dT = plastic_update(new.S, new.S_zz, old.eps_p, old.T, rho, eps_dot, model, G, heating)
     new.S, new.S_zz = S, S_zz
-    if final:
+    if final and old.plastic:                  # a law without plastic fields (state_fields = ()) keeps none
         new.eps_p = old.eps_p + deps
         new.W_p = old.W_p + dw
         new.T = old.T + dT

@@ -298,6 +298,11 @@ def reference_update(state: State, F: np.ndarray) -> State:
     other field kept. ``F``: the deformation gradient of ``state.x`` on the old reference configuration (Eq. (18)).
     A new state; the operator of the new configuration is ``ReferenceOperator(new.X, new.V0, ...)``."""
     J = det(F)
+    bad = np.flatnonzero(~(J > 0))
+    if len(bad):
+        raise ValueError(f"reference update: J = det F = {J[bad[0]]!r} at particle {bad[0]} (and {len(bad) - 1} "
+                         "more); the new reference volume J V0 would not be positive (a particle whose neighbours "
+                         "lie in one line, or an inverted one)")
     new = state.copy()
     new.X = state.x.copy()
     new.V0 = J * state.V0

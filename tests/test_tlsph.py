@@ -266,3 +266,12 @@ def test_blocks_and_threads_give_the_same_rates(block):
     a, b = (tlsph_rates(block, MAT, params(True), op).v for op in (one, many))
     assert len(many.pairs.blocks) > 5
     assert np.allclose(a, b, rtol=1e-12, atol=1e-13 * np.abs(a).max())
+
+
+def test_reference_update_refuses_a_singular_F():
+    X, V = _square()
+    st = make_state(X, 0.0, MAT.rho0, V)
+    F = np.broadcast_to(np.eye(2), (len(X), 2, 2)).copy()
+    F[3] = [[1.0, 0.0], [0.0, 0.0]]                        # collapsed: J = 0
+    with pytest.raises(ValueError, match="particle 3"):
+        reference_update(st, F)

@@ -99,20 +99,28 @@ def main(argv=None) -> int:
     return _run(args, extra)
 
 
+def _attempt(fn):
+    """(fn(), 0), or (None, exit code) with the message on stderr: 3 for a run that failed, 2 for bad input."""
+    try:
+        return fn(), 0
+    except SimulationError as e:
+        print(f"refsph: run failed: {e}", file=sys.stderr)
+        return None, 3
+    except (ValueError, OSError) as e:
+        print(f"refsph: {e}", file=sys.stderr)
+        return None, 2
+
+
 def _restart(args) -> int:
     from .simulate import restart_run
     if args.scene is not None:
         print("refsph: --restart takes its scene and settings from RUN_DIR/summary.json; give no scene",
               file=sys.stderr)
         return 2
-    try:
-        s = restart_run(args.restart, progress=not args.quiet).summary
-    except SimulationError as e:
-        print(f"refsph: run failed: {e}", file=sys.stderr)
-        return 3
-    except (ValueError, OSError) as e:
-        print(f"refsph: {e}", file=sys.stderr)
-        return 2
+    res, code = _attempt(lambda: restart_run(args.restart, progress=not args.quiet))
+    if code:
+        return code
+    s = res.summary
     print(f"{s['scene']} {s['method']} {s['dim']}D: continued to t = {s['t_final']:.6g} s, {s['n_steps']} steps "
           f"in all; output: {args.restart}/summary.json")
     return 0
@@ -165,16 +173,11 @@ def _run(args, extra) -> int:
         out = args.out or f"runs/{args.scene}-{method}-{dim}d"
         if args.out and len(methods) > 1:
             out = f"{args.out}/{method}"
-        try:
-            res = run(args.scene, method, dim=dim, dp=args.dp, t_end=args.t_end, out=out, quick=args.quick,
-                      dt=args.dt, progress=not args.quiet, options=options, numerics=numerics,
-                      particles=args.particles)
-        except SimulationError as e:
-            print(f"refsph: run failed: {e}", file=sys.stderr)
-            return 3
-        except (ValueError, OSError) as e:
-            print(f"refsph: {e}", file=sys.stderr)
-            return 2
+        res, code = _attempt(lambda: run(args.scene, method, dim=dim, dp=args.dp, t_end=args.t_end, out=out,
+                                         quick=args.quick, dt=args.dt, progress=not args.quiet, options=options,
+                                         numerics=numerics, particles=args.particles))
+        if code:
+            return code
         s = res.summary
         summaries.append(s)
         print(f"{s['scene']} {s['method']} {s['dim']}D: {s['n_particles']} particles, {s['n_steps']} steps, "

@@ -42,6 +42,17 @@ def finish_stage(constraints: Constraints, strength: StrengthModel, material: El
     return strength_stage(strength, old, new, rates.l, rho, dt, final, material.G, heating)
 
 
+def _compose(solver, material: ElasticMaterial, params, strength: StrengthModel | None, heating: bool,
+             mirror: MirrorPlanes | None, constraints: Constraints, threads: int) -> None:
+    """The parts every solver is made of: material and parameters, strength model (None: elastic), heating switch,
+    symmetry planes, constraints, threads."""
+    solver.material, solver.params = material, params
+    solver.strength = strength if strength is not None else Elastic()
+    solver.heating = bool(heating)
+    solver.mirror, solver.constraints = mirror, constraints
+    solver.threads = check_threads(threads)
+
+
 def _check_common(strength: StrengthModel, mirror: MirrorPlanes | None, constraints: Constraints,
                   state: State) -> None:
     check_strength_fields(strength, state)
@@ -62,12 +73,8 @@ class ESPHSolver:
     def __init__(self, material: ElasticMaterial, params: ESPHParams, skin_factor: float, *,
                  strength: StrengthModel | None = None, heating: bool = True, mirror: MirrorPlanes | None = None,
                  walls=(), rigid=(), clamps=(), threads: int = 1):
-        self.material, self.params = material, params
-        self.strength = strength if strength is not None else Elastic()
-        self.heating = bool(heating)
-        self.mirror = mirror
-        self.constraints = Constraints(walls, rigid, clamps, mirror)
-        self.threads = check_threads(threads)
+        _compose(self, material, params, strength, heating, mirror, Constraints(walls, rigid, clamps, mirror),
+                 threads)
         self.pairs = VerletList(params.kernel.support * params.h, skin_factor * params.h)
         self._pair_sum: PairBlocks | None = None           # blocks and sparse patterns of the current pair list
         self._pair_sum_build = -1
@@ -171,12 +178,8 @@ class TLSPHSolver:
     def __init__(self, material: ElasticMaterial, params: TLSPHParams, *, strength: StrengthModel | None = None,
                  heating: bool = True, mirror: MirrorPlanes | None = None, walls=(), rigid=(), clamps=(),
                  contact: PinballContact | None = None, dp: float | None = None, threads: int = 1):
-        self.material, self.params = material, params
-        self.strength = strength if strength is not None else Elastic()
-        self.heating = bool(heating)
-        self.mirror = mirror
-        self.constraints = Constraints(walls, rigid, clamps, mirror)
-        self.threads = check_threads(threads)
+        _compose(self, material, params, strength, heating, mirror, Constraints(walls, rigid, clamps, mirror),
+                 threads)
         if self.constraints.rigid and contact is None:
             raise ValueError("TLSPH with rigid bodies needs a contact model (PinballContact)")
         if contact is not None and not (dp is not None and dp > 0):

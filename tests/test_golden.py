@@ -87,3 +87,15 @@ def test_half_pair_convention_is_enforced():
 def test_rates_input_errors():
     with pytest.raises(TypeError, match="Setup"):
         rates(get_scene("bar").setup(quick=True).state, 42, "esph")
+
+
+def test_export_vtk(tmp_path):
+    """refsph export RUN_DIR --vtk: one VTU per snapshot with every field, and a .pvd with the times."""
+    meshio = pytest.importorskip("meshio")
+    run("bar", "tlsph", quick=True, t_end=1e-6, progress=False, out=tmp_path)
+    assert main(["export", str(tmp_path), "--vtk"]) == 0
+    pvd = (tmp_path / "vtk" / "run.pvd").read_text()
+    assert pvd.count("<DataSet") == len(list((tmp_path / "snapshots").glob("snap_*.npz")))
+    m = meshio.read(tmp_path / "vtk" / "snap_00010.vtu")
+    assert m.points.shape[1] == 3 and {"x", "v", "S", "F", "id", "p"} <= set(m.point_data)
+    assert m.point_data["S"].shape[1] == 9

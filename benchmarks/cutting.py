@@ -247,7 +247,7 @@ def _picture(ax, z, dp, field, vmax, cmap="jet", vmin=0.0, xlim=(1.3, 3.6), ylim
     # the committed figures were drawn with jet and squares 1.15 spacings wide; the next rerun of the paper-resolution
     # runs (about 2 CPU-hours each pair) should draw them with the defaults (viridis, 1.5: no gaps)
     return particle_field(ax, z["x"], z[field], dp, body=z["body"], xlim=xlim, ylim=ylim, cmap=cmap, vmin=vmin,
-                          vmax=vmax, spread=1.15)
+                          vmax=vmax, spread=1.15, fill=None)
 
 
 def strain_figure(by: dict, feed: float) -> None:

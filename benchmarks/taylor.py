@@ -84,7 +84,8 @@ def record(name):
                 diagnostics=s["diagnostics"])
 
 
-def plots(records):
+def plots(records, json_only: bool = False):
+    """The benchmark's figures; ``json_only``: only those drawn from the records alone (the work-precision plot)."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -120,6 +121,8 @@ def plots(records):
     fig.tight_layout()
     fig.savefig(FIG / "06_taylor_work_precision.png", dpi=120)
     plt.close(fig)
+    if json_only:                                       # the rest needs the run folders
+        return
 
     # length against time (Fig. 3)
     fig, ax = plt.subplots(figsize=(6, 4))
@@ -348,9 +351,15 @@ def main(argv=None):
     ap.add_argument("--plot-only", action="store_true", help="no runs: figures and table from earlier runs")
     ap.add_argument("--only", default=None, help="run only the jobs whose name contains this string")
     ap.add_argument("--finest", type=float, default=None, help="an extra, finer spacing [m] for the convergence study")
+    ap.add_argument("--json-figures", action="store_true",
+                    help="only redraw the figures made from the committed JSON alone "
+                         "(figures/06_taylor_work_precision.png)")
     ap.add_argument("--report", action="store_true",
                     help="no runs: write benchmarks/taylor_report.md from the committed benchmarks/taylor.json only")
     args = ap.parse_args(argv)
+    if args.json_figures:
+        plots(json.loads(OUT_JSON.read_text()), json_only=True)
+        return 0
     if args.report:
         REPORT.write_text(report(json.loads(OUT_JSON.read_text())))
         print(f"report written to {REPORT.relative_to(ROOT)}")

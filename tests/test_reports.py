@@ -1,18 +1,35 @@
 """The benchmark reports (benchmarks/*_report.md) are what the benchmark scripts write from the committed JSON:
-regenerating one gives the committed file byte for byte (so a report cannot drift from its data)."""
+regenerating one gives the committed file byte for byte (so a report cannot drift from its data); and the
+README's work-precision figures are redrawn from the JSON by the code as it is."""
 import importlib.util
 import json
 from pathlib import Path
 
+import matplotlib.image
+import numpy as np
 import pytest
 
 ROOT = Path(__file__).resolve().parent.parent
 
 
-@pytest.mark.parametrize("name", ["taylor", "pressing", "cutting"])
-def test_report_is_generated_from_the_json(name):
+def _script(name):
     spec = importlib.util.spec_from_file_location(f"bench_{name}", ROOT / "benchmarks" / f"{name}.py")
     mod = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(mod)
+    return mod
+
+
+@pytest.mark.parametrize("name", ["taylor", "pressing", "cutting"])
+def test_report_is_generated_from_the_json(name):
     records = json.loads((ROOT / "benchmarks" / f"{name}.json").read_text())
-    assert mod.report(records) == (ROOT / "benchmarks" / f"{name}_report.md").read_text()
+    assert _script(name).report(records) == (ROOT / "benchmarks" / f"{name}_report.md").read_text()
+
+
+@pytest.mark.parametrize("name, figure", [("taylor", "06_taylor_work_precision.png"),
+                                          ("pressing", "07_pressing_work_precision.png")])
+def test_readme_figures_are_what_the_code_draws(name, figure, tmp_path):
+    mod = _script(name)
+    mod.FIG = tmp_path
+    mod.plots(json.loads((ROOT / "benchmarks" / f"{name}.json").read_text()), json_only=True)
+    new, old = matplotlib.image.imread(tmp_path / figure), matplotlib.image.imread(ROOT / "figures" / figure)
+    assert new.shape == old.shape and np.abs(new - old).max() < 0.05     # the same picture (fonts may vary)

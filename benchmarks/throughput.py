@@ -16,7 +16,15 @@ list is not rebuilt and the reference configuration is not updated inside the ti
     particle-steps/s = particles x steps / wall time
     ns/pair/step     = wall time / (steps x half pairs), half pair = (i < j) with |x_i - x_j| < 2h
 
-Usage:  python benchmarks/throughput.py [--sizes 100 200] [--steps N] [--repeats R] [--json PATH]
+Both steppers are timed (``--integrators``): the predictor-corrector (two rate evaluations per step) and the
+leapfrog (one force and one deformation-rate evaluation per step, ``refsph.integrate.leapfrog_step``).
+
+Error per unit of work (``--study``): the 2D quick elastic bar of ``refsph run bar`` (TLSPH, the default
+artificial viscosity, two periods) with each stepper at Courant 0.1 ... 0.6; the error is the largest
+difference of the modal amplitude history from a reference run (leapfrog, Courant 0.025), relative to the initial
+amplitude; the work is the wall time of the run. Written to the same JSON (``integrator_study``).
+
+Usage:  python benchmarks/throughput.py [--sizes 100 200] [--steps N] [--repeats R] [--json PATH] [--study]
 """
 from __future__ import annotations
 
@@ -37,7 +45,7 @@ import numpy as np  # noqa: E402
 import scipy  # noqa: E402
 
 import refsph  # noqa: E402
-from refsph.integrate import cfl_time_step, predictor_corrector_step  # noqa: E402
+from refsph.integrate import STEPPERS, cfl_time_step  # noqa: E402
 from refsph.neighbours import find_pairs  # noqa: E402
 from refsph.scenes import Numerics, Setup, aisi4340_material, lattice  # noqa: E402
 from refsph.simulate import make_solver  # noqa: E402
@@ -63,25 +71,26 @@ def half_pairs_within_support(setup: Setup) -> int:
     return int(np.count_nonzero(r2 < (2.0 * setup.h) ** 2))
 
 
-def time_method(method: str, setup: Setup, steps: int, repeats: int) -> dict:
-    """Best-of-``repeats`` wall (and CPU) time of ``steps`` predictor-corrector steps, after one warm-up step."""
+def time_method(method: str, setup: Setup, steps: int, repeats: int, integrator: str = "predictor_corrector") -> dict:
+    """Best-of-``repeats`` wall (and CPU) time of ``steps`` steps of ``integrator``, after one warm-up step."""
+    step = STEPPERS[integrator]
     solver = make_solver(method, setup)
     state = setup.state.copy()
     dt = cfl_time_step(state, setup.material, setup.h, setup.numerics.courant)
     t0 = time.perf_counter()
-    state = predictor_corrector_step(state, solver, dt)        # warm-up: builds the pairs / the operator
+    state = step(state, solver, dt)                            # warm-up: builds the pairs / the operator
     t_setup = time.perf_counter() - t0
     wall, cpu = np.inf, np.inf
     for _ in range(repeats):
         t0, c0 = time.perf_counter(), time.process_time()
         for _ in range(steps):
-            state = predictor_corrector_step(state, solver, dt)
+            state = step(state, solver, dt)
         wall = min(wall, time.perf_counter() - t0)
         cpu = min(cpu, time.process_time() - c0)
     if not (np.isfinite(state.v).all() and np.isfinite(state.x).all()):
         raise RuntimeError(f"{method}: non-finite state in the benchmark run")
     n, n_half = state.n, half_pairs_within_support(setup)
-    return dict(method=method, n_particles=n, half_pairs=n_half, pairs_per_particle=n_half / n,
+    return dict(method=method, integrator=integrator, n_particles=n, half_pairs=n_half, pairs_per_particle=n_half / n,
                 steps=steps, repeats=repeats, wall_s=wall, cpu_s=cpu, s_per_step=wall / steps,
                 particle_steps_per_s=n * steps / wall, ns_per_pair_step=1e9 * wall / (steps * n_half),
                 setup_s=t_setup, diagnostics=solver.diagnostics())
@@ -95,6 +104,8 @@ def main(argv=None) -> list[dict]:
                     help="timed steps per repetition (default: about 4e5 particle-steps, at least 2)")
     ap.add_argument("--repeats", type=int, default=5, help="repetitions, the best is reported (default 5)")
     ap.add_argument("--methods", nargs="+", default=list(METHODS), choices=METHODS)
+    ap.add_argument("--integrators", nargs="+", default=list(STEPPERS), choices=list(STEPPERS))
+    ap.add_argument("--study", action="store_true", help="also the error-per-work study of both steppers")
     ap.add_argument("--json", type=Path, default=Path(__file__).with_name("throughput.json"),
                     help="where to write the results (default: benchmarks/throughput.json)")
     args = ap.parse_args(argv)
@@ -103,10 +114,11 @@ def main(argv=None) -> list[dict]:
           f"Python {platform.python_version()} on {platform.machine()}, single core "
           f"(BLAS/OpenMP pools pinned to 1 thread; scipy.sparse is single-threaded);")
     print("2D AISI 4340 block, h = 1.5 dp, cubic kernel, artificial viscosity 1.5/1.5, ESPH artificial "
-          "pressure 0.3, TLSPH corrected; one step = predictor-corrector (2 rate evaluations + after-step)")
+          "pressure 0.3, TLSPH corrected; one step of predictor_corrector = 2 rate evaluations, of leapfrog = "
+          "1 force + 1 deformation-rate evaluation")
     print("pair = half pair (i < j) with |x_i - x_j| < 2h; best of the repetitions\n")
-    header = (f"{'method':6s} {'particles':>9s} {'pairs/part':>10s} {'steps':>5s} {'particle-steps/s':>16s} "
-              f"{'ns/pair/step':>12s} {'wall s':>7s} {'cpu s':>7s} {'setup s':>7s}")
+    header = (f"{'method':6s} {'integrator':19s} {'particles':>9s} {'pairs/part':>10s} {'steps':>5s} "
+              f"{'particle-steps/s':>16s} {'ns/pair/step':>12s} {'wall s':>7s} {'cpu s':>7s} {'setup s':>7s}")
     print(header)
     print("-" * len(header))
     results = []
@@ -114,17 +126,42 @@ def main(argv=None) -> list[dict]:
         setup = block_setup(side)
         n = setup.state.n
         steps = args.steps or max(2, int(round(4e5 / n)))
-        for method in args.methods:
-            r = time_method(method, setup, steps, args.repeats)
+        for method, integrator in [(m, i) for m in args.methods for i in args.integrators]:
+            r = time_method(method, setup, steps, args.repeats, integrator)
             results.append(r)
-            print(f"{method:6s} {n:9d} {r['pairs_per_particle']:10.2f} {steps:5d} "
+            print(f"{method:6s} {integrator:19s} {n:9d} {r['pairs_per_particle']:10.2f} {steps:5d} "
                   f"{r['particle_steps_per_s']:16.3e} {r['ns_per_pair_step']:12.1f} {r['wall_s']:7.3f} "
                   f"{r['cpu_s']:7.3f} {r['setup_s']:7.3f}", flush=True)
+    study = integrator_study() if args.study else None
     write_results(args.json, results, threads=1,
                   pair_definition="half pair (i < j) with |x_i - x_j| < 2h in the initial lattice",
-                  timing="best of `repeats` repetitions of `steps` predictor-corrector steps, after one warm-up "
-                         "step; particle_steps_per_s and ns_per_pair_step from the wall time")
+                  timing="best of `repeats` repetitions of `steps` steps of each integrator, after one warm-up "
+                         "step; particle_steps_per_s and ns_per_pair_step from the wall time",
+                  **({"integrator_study": study} if study else {}))
     return results
+
+
+def integrator_study(courants=(0.1, 0.2, 0.3, 0.45, 0.6)) -> list[dict]:
+    """Error against work of both steppers on the quick 2D TLSPH bar (module text)."""
+    from refsph.simulate import run
+
+    def amplitude(integrator, courant):
+        t0 = time.perf_counter()
+        res = run("bar", "tlsph", dim=2, quick=True, progress=False,
+                  numerics=dict(threads=1, integrator=integrator, courant=courant))
+        h = np.asarray(res.summary["metrics"]["amplitude_history"])
+        return h, time.perf_counter() - t0, res.summary["n_steps"]
+
+    ref, _, _ = amplitude("leapfrog", 0.025)
+    print(f"\n{'integrator':19s} {'courant':>7s} {'steps':>6s} {'wall s':>7s} {'amplitude error':>15s}")
+    out = []
+    for integrator in STEPPERS:
+        for c in courants:
+            h, wall, steps = amplitude(integrator, c)
+            err = float(np.max(np.abs(np.interp(ref[:, 0], h[:, 0], h[:, 1]) - ref[:, 1])) / abs(ref[0, 1]))
+            out.append(dict(integrator=integrator, courant=c, steps=steps, wall_s=wall, amplitude_error=err))
+            print(f"{integrator:19s} {c:7.3f} {steps:6d} {wall:7.2f} {err:15.3e}", flush=True)
+    return out
 
 
 def software() -> dict:

@@ -527,10 +527,14 @@ print(f"shear gamma = {gamma_big}: reference neighbours now up to {stretch:.1f} 
 # **(b) Zero-energy (hourglass) modes.** $\mathbf F$ at $i$ is built from differences $\mathbf x_j - \mathbf x_i$
 # weighted by an odd function of $\mathbf X_{ij}$. A displacement that is *even* about every particle of a regular
 # lattice — every second row up, or a checkerboard — therefore has zero gradient in the interior: $\mathbf F =
-# \mathbf I$, no stress, no restoring force. Such modes can grow unopposed (Ganzenmüller, CMAME 286 (2015) 87,
-# adds a penalty force against them; the paper and `refsph` rely on the artificial viscosity).
+# \mathbf I$, no stress, no restoring force. Such modes can grow unopposed. The paper relies on the artificial
+# viscosity; `refsph` also has Ganzenmüller's (CMAME 286 (2015) 87) penalty force, `--set hourglass=1`
+# (`tlsph.hourglass_acceleration`, off by default), which pushes back on the part of $\mathbf x_j - \mathbf x_i$
+# that $\mathbf F$ does not explain.
 
 # %%
+from refsph.tlsph import hourglass_acceleration
+
 ij_fs = np.round(X_fs / dp_fs - 0.5).astype(int)
 zero = np.zeros(len(X_fs))
 modes = {"every second row up/down": np.stack([zero, 0.2 * dp_fs * (-1.0) ** ij_fs[:, 1]], 1),
@@ -541,6 +545,10 @@ for ax, (name, u) in zip(axes, modes.items()):
     print(f"{name}: every particle moved by 0.2 dp; max |F - I| interior {e[interior].max():.0e}, "
           f"surface {e[surface].max():.2f}")
     assert e[interior].max() < 1e-12
+    a_hg = hourglass_acceleration(X_fs + u, op_cor.deformation_gradient(X_fs + u), np.full(len(X_fs), 1.0),
+                                  op_cor, 1.0, 1.0)
+    print(f"   hourglass force against it: {-np.sum(a_hg * u) / np.sum(u * u):.2e} (> 0: restoring)")
+    assert np.sum(a_hg * u) < 0
     sc = particle_field(ax, X_fs + u, np.log10(np.maximum(e, 1e-17)), dp_fs, vmin=-17, vmax=0, spread=0.8)
     ax.set(xlabel="x [mm]", ylabel="y [mm]", title=name)
 colorbar(fig, sc, axes, "log10 of |F - I| [-]")

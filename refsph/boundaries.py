@@ -320,6 +320,7 @@ class Constraints:
                              "body of particles)")
         self.wall_impulse = np.zeros(len(self.walls))
         self.n_deformable: int | None = None   # rows [0, n_deformable) are deformable, the rest rigid
+        self.deformable_bodies: list[int] = [0]  # the body ids of those rows (several: they meet by contact)
         self.dim: int | None = None
         self.rows: list[slice] = []            # the rows of each rigid body
         self._start: list[tuple | None] = []   # per turning body: (t0, c0, x0 - c0)
@@ -347,10 +348,7 @@ class Constraints:
         if sum(r.stop - r.start for r in self.rows) != n - n_def:
             raise ValueError("rigid body particles must come after every deformable particle in the state")
         self.n_deformable = n_def
-        if state.body is not None and np.any(state.body[:n_def] != 0):
-            other = sorted(set(np.unique(state.body[:n_def]).tolist()) - {0})
-            raise ValueError(f"body ids {other} are not declared as rigid bodies; the deformable workpiece is "
-                             "body 0 (a second deformable body is not implemented)")
+        self.deformable_bodies = [0] if state.body is None else sorted(np.unique(state.body[:n_def]).tolist())
         for c in self.clamps:
             if c.index[-1] >= n_def:
                 raise ValueError(f"clamp {c.name!r} holds particle {c.index[-1]}, which is not a deformable one")
@@ -378,8 +376,9 @@ class Constraints:
                                                 "RigidBody.velocity_at(x))" if b.rotates else ""))
         return rows
 
-    def constrain(self, state: State, r: Rates) -> Rates:
-        """Prescribed motion on the rates (in place), after keeping the force on each body and clamp."""
+    def constrain(self, state: State, r: Rates, record: bool = True) -> Rates:
+        """Prescribed motion on the rates (in place), after keeping the force on each body and clamp (``record``:
+        False for rates without forces, the deformation half of a leapfrog step, which keep the last forces)."""
         if not self.rigid and not self.clamps:
             return r
         forces = []
@@ -393,7 +392,8 @@ class Constraints:
             forces.append(np.sum(state.m[c.index, None] * r.v[c.index], axis=0))
             r.v[c.index] = 0.0
             r.x[c.index] = 0.0
-        self._reaction = forces
+        if record:
+            self._reaction = forces
         return r
 
     def apply(self, old: State, new: State, dt: float, final: bool, rho_floor: float | None = None) -> State:

@@ -36,6 +36,8 @@ def _parser() -> argparse.ArgumentParser:
                                        "quantity is outside its tolerance)")
     c.add_argument("ref")
     c.add_argument("test")
+    c.add_argument("--only", nargs="+", default=None, metavar="CASE",
+                   help="golden cases to compare (names or patterns such as 'kernel_*'; default: every case)")
     c.add_argument("--tolerances", default=None, metavar="FILE",
                    help='JSON: {"fields": {NAME: rtol}, "metrics": {NAME: rtol}, "field": rtol, "metric": rtol}')
     e = sub.add_parser("export", help="export a run folder's snapshots (--vtk: VTU files and a ParaView .pvd)")
@@ -132,7 +134,7 @@ def _compare(args) -> int:
     from .compare import compare, format_table
     try:
         tol = json.loads(open(args.tolerances).read()) if args.tolerances else None
-        rows = compare(args.ref, args.test, tol)
+        rows = compare(args.ref, args.test, tol, only=args.only)
     except (OSError, ValueError, KeyError) as e:
         print(f"refsph: {e}", file=sys.stderr)
         return 2

@@ -15,7 +15,16 @@ once per half pair and added to both particles: linear momentum is conserved to 
 done by :class:`~refsph.neighbours.PairSum` (two sparse products per sum, the pair values as matrix entries),
 block by block (:class:`~refsph.neighbours.PairBlocks`: arrays that fit in the cache, optionally on threads).
 The velocity gradient (Eq. (23)) is exact for a linear velocity field only where the kernel support is
-full; at a free surface it is not (no correction is applied in ESPH, as in the paper).
+full; at a free surface it is not, and a rigid rotation there reads as a strain rate (the paper applies no
+correction). ``ESPHParams.correction`` (``Numerics.esph_correction``, off by default) normalises it
+(Randles & Libersky 1996; Bonet & Lok 1999):
+
+    M_i  = - sum_j V_j x_ij (x) grad_i W_ij        (the moment matrix; the identity inside a full support)
+    l_i  = [- sum_j V_j v_ij (x) grad_i W_ij] M_i^-1
+
+so that every linear velocity field, a rigid rotation included, has its exact gradient at every particle. The
+momentum equation (Eq. (11)) keeps the uncorrected, antisymmetric kernel gradient: it conserves linear momentum
+exactly, and with no spurious stress there is nothing for it to misplace.
 """
 from __future__ import annotations
 
@@ -23,11 +32,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .kernels import Kernel
+from .kernels import Kernel, correction_matrix
 from .material import ElasticMaterial, cauchy_stress, eos_pressure, jaumann_deviatoric_rate
 from .neighbours import PairBlocks, PairSum
 from .state import Rates, State
-from .tensor import empty
+from .tensor import empty, matmul, transpose
 
 __all__ = ["ESPHParams", "esph_rates", "artificial_viscosity", "artificial_pressure",
            "velocity_gradient", "continuity_rate"]
@@ -37,7 +46,8 @@ __all__ = ["ESPHParams", "esph_rates", "artificial_viscosity", "artificial_press
 class ESPHParams:
     """Numerical parameters of ESPH. h: smoothing length [m]; dp: initial spacing [m] (Eq. (14));
     beta1, beta2: artificial viscosity (Eq. (12)); gamma: artificial pressure coefficient (Eq. (14), 0 = off);
-    n_ap: artificial pressure exponent (paper: 4); eps: Eq. (13) regulariser (paper: 0.01)."""
+    n_ap: artificial pressure exponent (paper: 4); eps: Eq. (13) regulariser (paper: 0.01); correction: the
+    normalised velocity gradient (module text; False: Eq. (23) as printed)."""
 
     h: float
     dp: float
@@ -47,6 +57,7 @@ class ESPHParams:
     n_ap: float
     eps: float
     kernel: Kernel
+    correction: bool = False
 
 
 def artificial_viscosity(vr, r2, rho_bar, c_bar, h, beta1, beta2, eps):
@@ -105,14 +116,22 @@ def velocity_gradient(pairs: PairSum, V: np.ndarray, dv, gW, out: np.ndarray | N
     return out.transpose(2, 0, 1)
 
 
+PARTS = ("all", "deformation", "forces")
+
+
 def esph_rates(state: State, mat: ElasticMaterial, prm: ESPHParams, I: np.ndarray, J: np.ndarray,
-               pairs: PairBlocks | None = None) -> Rates:
+               pairs: PairBlocks | None = None, part: str = "all") -> Rates:
     """All ESPH time derivatives for half pairs (I, J) (pairs beyond 2h contribute zero).
 
     ``pairs``: a :class:`~refsph.neighbours.PairBlocks` of (I, J), if the caller keeps one (it depends only on
     the pair list, and says how many threads run its blocks); otherwise one is built here. Every pair term
     is computed block by block (:func:`_block_sums`) and the per-particle sums are added up in block order.
+    ``part``: 'all'; 'deformation' (Eqs. (10), (23), (20): the rates of rho, S, S_zz and l, dv/dt zero) or
+    'forces' (Eq. (11): dv/dt only, the other rates zero), the two halves a staggered stepper (the leapfrog)
+    evaluates at different states; 'all' computes both in one pass over the pairs, with the same numbers.
     """
+    if part not in PARTS:
+        raise ValueError(f"part must be one of {', '.join(PARTS)}, got {part!r}")
     n, d = state.x.shape
     m, rho = state.m, state.rho
     blocks = pairs if pairs is not None else PairBlocks(I, J, n)
@@ -128,38 +147,67 @@ def esph_rates(state: State, mat: ElasticMaterial, prm: ESPHParams, I: np.ndarra
                     v=[np.ascontiguousarray(state.v[:, k]) for k in range(d)],
                     m=m, V=m / rho, rho=rho, m_s=[[m * s[:, c, b] for b in range(d)] for c in range(d)],
                     a_p=np.abs(p) / (rho * rho), compressed=p > 0)
-    sums = blocks.reduce(lambda blk: _block_sums(blk, particle, mat, prm, d))
+    sums = blocks.reduce(lambda blk: _block_sums(blk, particle, mat, prm, d, part))
+    rows = _row_layout(d, prm.correction, part)
 
-    drho = sums[0]                                                      # Eq. (10)
-    l = empty(n, d)                                                     # Eq. (23)
-    for a in range(d):
-        for b in range(d):
-            l[:, a, b] = sums[1 + a * d + b]
-    # Eq. (11) with s = sigma / rho^2, the stress term split in an i-side and a j-side sum (as in TLSPH's
-    # ReferenceOperator.momentum_sum), so that no pair array of d x d stresses is gathered:
-    #   a_i = sum_j m_j (s_i + s_j) gW_ij - sum_j m_j (pi_ij + p^a_ij) gW_ij
-    #       = s_i . (sum_j m_j gW_ij)  +  sum_j m_j s_j gW_ij  -  sum_j m_j (pi_ij + p^a_ij) gW_ij
-    # Every term is antisymmetric in (i, j): momentum is conserved to round-off.
-    k = 1 + d * d
-    mgW, s_j, visc = sums[k:k + d], sums[k + d:k + d + d * d], sums[k + d + d * d:]
-    acc = np.empty((d, n))
-    for c in range(d):
-        acc[c] = -visc[c]
-        for b in range(d):
-            acc[c] += s[:, c, b] * mgW[b] + s_j[c * d + b]
-
-    dS, dS_zz = jaumann_deviatoric_rate(state.S, state.S_zz, l, mat.G)
+    zero = np.zeros((n, d, d))
+    drho, l, dS, dS_zz = np.zeros(n), None, zero, np.zeros(n)
+    if part != "forces":
+        drho = sums[rows["drho"]]                                       # Eq. (10)
+        l = empty(n, d)                                                 # Eq. (23)
+        for a in range(d):
+            for b in range(d):
+                l[:, a, b] = sums[rows["l"] + a * d + b]
+        if prm.correction:                                              # l M^-1 (module text)
+            M = empty(n, d)
+            for a in range(d):
+                for b in range(d):
+                    M[:, a, b] = sums[rows["M"] + a * d + b]
+            l = matmul(l, transpose(correction_matrix(M)[0]))
+        dS, dS_zz = jaumann_deviatoric_rate(state.S, state.S_zz, l, mat.G)
+    acc = np.zeros((d, n))
+    if part != "deformation":
+        # Eq. (11) with s = sigma / rho^2, the stress term split in an i-side and a j-side sum (as in TLSPH's
+        # ReferenceOperator.momentum_sum), so that no pair array of d x d stresses is gathered:
+        #   a_i = sum_j m_j (s_i + s_j) gW_ij - sum_j m_j (pi_ij + p^a_ij) gW_ij
+        #       = s_i . (sum_j m_j gW_ij)  +  sum_j m_j s_j gW_ij  -  sum_j m_j (pi_ij + p^a_ij) gW_ij
+        # Every term is antisymmetric in (i, j): momentum is conserved to round-off.
+        k = rows["mgW"]
+        mgW, s_j, visc = sums[k:k + d], sums[k + d:k + d + d * d], sums[k + d + d * d:k + 2 * d + d * d]
+        for c in range(d):
+            acc[c] = -visc[c]
+            for b in range(d):
+                acc[c] += s[:, c, b] * mgW[b] + s_j[c * d + b]
     return Rates(x=state.v.copy(), v=acc.T, rho=drho, S=dS, S_zz=dS_zz, l=l)
 
 
-def _block_sums(blk, particle: dict, mat: ElasticMaterial, prm: ESPHParams, d: int) -> np.ndarray:
-    """The pair sums of one block of pairs, one row per sum (each row: the block's window of particles):
+def _row_layout(d: int, correction: bool, part: str) -> dict:
+    """Where each sum of :func:`_block_sums` starts, for the part computed: the deformation rows (drho: 1, l: d^2,
+    M: d^2 with the correction) first, then the force rows (mgW: d, s_j: d^2, visc: d), 'total' rows in all."""
+    rows, k = {}, 0
+    if part != "forces":
+        rows.update(drho=0, l=1)
+        k = 1 + d * d
+        if correction:
+            rows["M"] = k
+            k += d * d
+    if part != "deformation":
+        rows["mgW"] = k
+        k += 2 * d + d * d
+    rows["total"] = k
+    return rows
 
-        [0]                    sum_j m_j v_ij . grad_i W_ij                          (Eq. (10))
-        [1 + a d + b]          -sum_j V_j (v_ij)_a (grad_i W_ij)_b                  (Eq. (23))
-        [1 + d^2 + b]          sum_j m_j (grad_i W_ij)_b                             (Eq. (11), i-side)
-        [1 + d^2 + d + c d + b] sum_j m_j (s_j)_cb (grad_i W_ij)_b                   (Eq. (11), j-side)
-        [1 + 2 d^2 + d + c]    sum_j m_j (pi_ij + p^a_ij) (grad_i W_ij)_c            (Eqs. (11)-(14))
+
+def _block_sums(blk, particle: dict, mat: ElasticMaterial, prm: ESPHParams, d: int, part: str = "all") -> np.ndarray:
+    """The pair sums of one block of pairs, one row per sum (each row: the block's window of particles), laid out
+    by :func:`_row_layout`:
+
+        drho                   sum_j m_j v_ij . grad_i W_ij                          (Eq. (10))
+        l + a d + b            -sum_j V_j (v_ij)_a (grad_i W_ij)_b                  (Eq. (23))
+        M + a d + b            -sum_j V_j (x_ij)_a (grad_i W_ij)_b                  (the moment matrix; correction)
+        mgW + b                sum_j m_j (grad_i W_ij)_b                             (Eq. (11), i-side)
+        mgW + d + c d + b      sum_j m_j (s_j)_cb (grad_i W_ij)_b                   (Eq. (11), j-side)
+        mgW + d + d^2 + c      sum_j m_j (pi_ij + p^a_ij) (grad_i W_ij)_c            (Eqs. (11)-(14))
 
     Per-particle inputs come as one contiguous array per component (gathering from a 1-D array is about 2.5x
     faster than gathering rows of an (N, d) array)."""
@@ -175,9 +223,15 @@ def _block_sums(blk, particle: dict, mat: ElasticMaterial, prm: ESPHParams, d: i
     gW = [fr * dxk for dxk in dx]                                       # grad_i W_ij
 
     m, V = local(particle["m"]), local(particle["V"])
-    out = np.empty((1 + 2 * d * d + 2 * d, sums.n))
-    out[0] = continuity_rate(sums, m, fr * vr)                          # Eq. (10)
-    velocity_gradient(sums, V, dv, gW, out=out[1:1 + d * d].reshape(d, d, sums.n))     # Eq. (23)
+    rows = _row_layout(d, prm.correction, part)
+    out = np.empty((rows["total"], sums.n))
+    if part != "forces":
+        out[rows["drho"]] = continuity_rate(sums, m, fr * vr)           # Eq. (10)
+        velocity_gradient(sums, V, dv, gW, out=out[rows["l"]:rows["l"] + d * d].reshape(d, d, sums.n))  # Eq. (23)
+        if prm.correction:
+            velocity_gradient(sums, V, dx, gW, out=out[rows["M"]:rows["M"] + d * d].reshape(d, d, sums.n))
+    if part == "deformation":
+        return out
 
     # pair scalar: artificial viscosity (Eqs. (12)-(13)) + artificial pressure (Eq. (14))
     rho = particle["rho"]
@@ -189,7 +243,7 @@ def _block_sums(blk, particle: dict, mat: ElasticMaterial, prm: ESPHParams, d: i
         pi += _artificial_pressure(np.take(a_p, I), np.take(a_p, J), np.take(compressed, I) & np.take(compressed, J),
                                    w, prm.gamma, prm.n_ap)
 
-    k = 1 + d * d
+    k = rows["mgW"]
     for b in range(d):
         out[k + b] = sums.antisymmetric(gW[b], m)
         for c in range(d):

@@ -22,7 +22,9 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["Kernel", "CubicSpline", "WendlandC2", "KERNELS", "get_kernel"]
+from .tensor import det, inv
+
+__all__ = ["Kernel", "CubicSpline", "WendlandC2", "KERNELS", "get_kernel", "correction_matrix"]
 
 
 def _check_dim(dim: int) -> None:
@@ -182,3 +184,21 @@ def get_kernel(name: str) -> Kernel:
         return KERNELS[name]
     except KeyError:
         raise ValueError(f"unknown kernel {name!r}; choose one of {sorted(KERNELS)}") from None
+
+
+def correction_matrix(M: np.ndarray, tol: float = 1e-6) -> tuple[np.ndarray, np.ndarray]:
+    """L_i = M_i^-T (Bonet & Lok 1999). Where M_i is (nearly) singular -- a particle whose neighbours do not
+    span every direction (no neighbours, a single row of particles) -- the Moore-Penrose pseudo-inverse is used
+    instead (Bonet & Lok's correction restricted to the directions the neighbours span), so the operator stays
+    finite. Returns (L, indices of those degenerate particles); F of such a particle is singular in the
+    missing direction, so a run that depends on it stops with a non-finite-state error that names it."""
+    d = M.shape[1]
+    detM = det(M)
+    scale = np.maximum(np.abs(np.trace(M, axis1=1, axis2=2)) / d, np.finfo(float).tiny) ** d
+    bad = np.flatnonzero(~(np.abs(detM) > tol * scale))
+    safe = M.copy()
+    safe[bad] = np.eye(d)
+    L = np.swapaxes(inv(safe), 1, 2)
+    if len(bad):
+        L[bad] = np.swapaxes(np.linalg.pinv(M[bad]), 1, 2)
+    return L, bad

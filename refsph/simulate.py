@@ -16,6 +16,7 @@ import json
 import os
 import sys
 import time
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable
@@ -26,6 +27,7 @@ from . import __version__
 from .contact import PinballContact
 from .esph import ESPHParams
 from .integrate import Solver, cfl_time_step, get_stepper
+from .stability import warnings_for
 from .boundaries import Clamp
 from .io import json_ready, save_reactions, save_snapshot, state_from_particles, state_from_snapshot, write_json
 from .kernels import get_kernel
@@ -66,20 +68,34 @@ def make_solver(method: str, setup: Setup) -> Solver:
         if setup.friction is not None:
             raise ValueError("friction is a law of the TLSPH pinball contact; ESPH tools act through the SPH "
                              "sums and have no friction model (run TLSPH, or set friction=None)")
+        if nm.hourglass:
+            raise ValueError("hourglass control is a TLSPH option (ESPH's neighbours change every step, its zig-zag "
+                             "modes are the tensile instability's, see gamma)")
         prm = ESPHParams(h=h, dp=setup.dp, beta1=nm.beta1, beta2=nm.beta2, gamma=nm.gamma, n_ap=nm.n_ap,
-                         eps=nm.eps, kernel=kernel)
+                         eps=nm.eps, kernel=kernel, correction=bool(nm.esph_correction))
         return ESPHSolver(setup.material, prm, skin_factor=nm.skin_factor, **common)
     if method == "tlsph":
+        if nm.esph_correction:
+            raise ValueError("esph_correction is an ESPH option; TLSPH's kernel-gradient correction is 'corrected'")
         prm = TLSPHParams(h=h, beta1=nm.beta1, beta2=nm.beta2, eps=nm.eps, kernel=kernel,
-                          corrected=nm.corrected, ref_update_strain=nm.ref_update_strain)
+                          corrected=nm.corrected, ref_update_strain=nm.ref_update_strain,
+                          hourglass=float(nm.hourglass))
         contact = None
         if setup.friction is not None and not setup.rigid:
             raise ValueError("friction acts in the contact with rigid bodies, and this setup has none")
-        if setup.rigid:
+        if setup.rigid or len(_deformable_bodies(setup)) > 1:
             k = nm.contact_k if nm.contact_k is not None else setup.dp / (2.0 * h)
             contact = PinballContact(k=k, K_p=nm.contact_Kp, friction=setup.friction)
         return TLSPHSolver(setup.material, prm, contact=contact, dp=setup.dp, **common)
     raise ValueError(f"unknown method {method!r}; choose one of {', '.join(METHODS)}")
+
+
+def _deformable_bodies(setup: Setup) -> list:
+    """The body ids of the setup's deformable particles (those of no rigid body)."""
+    if setup.state.body is None:
+        return [0]
+    rigid = {b.body for b in setup.rigid}
+    return sorted(set(np.unique(setup.state.body).tolist()) - rigid)
 
 
 def _validate(method, dim, dp, setup_numerics=None, t_end=None, dt=None):
@@ -180,6 +196,7 @@ class RunRecord:
                    record_every=self.record_every, wall_time_s=time.perf_counter() - self.t0,
                    cpu_time_s=time.process_time() - self.c0, restarts=self.summary.get("restarts", 0))
         arrays = {f"solver/{k}": v for k, v in self.solver.checkpoint().items()}
+        arrays.update({f"stepper/{k}": v for k, v in (getattr(self.solver, "stepper_state", None) or {}).items()})
         path = self.out / "snapshots" / CHECKPOINT
         tmp = path.with_name("restart.tmp.npz")
         np.savez(tmp, run=json.dumps(json_ready(run)), dts=np.asarray(self.dts, dtype=float), **arrays)
@@ -323,6 +340,9 @@ def _begin(setup: Setup, solver: Solver, out, dt, name: str, record, record_ever
         run_ck = json.loads(str(ck["run"]))
         state = state_from_snapshot(Path(out) / "snapshots" / run_ck["snapshot"])
         solver.restore({k[len("solver/"):]: v for k, v in ck.items() if k.startswith("solver/")}, state)
+        kept = {k[len("stepper/"):]: v for k, v in ck.items() if k.startswith("stepper/")}
+        if kept:                                            # the leapfrog's last force (refsph.integrate)
+            solver.stepper_state = kept
         rec = RunRecord(setup, solver, out, dt, name, record, snapshot_times(setup),
                         resume=dict(run=run_ck, dts=ck["dts"]))
         return state, rec
@@ -366,6 +386,8 @@ def simulate(setup: Setup, method: str | None = None, *, scene: Scene | None = N
     solver = solver if solver is not None else make_solver(method, setup)
     stepper = get_stepper(setup.numerics.integrator)
     name = scene.name if scene is not None else label
+    for message in warnings_for(scene.name if scene is not None else None, method, setup.numerics):
+        warnings.warn(message, UserWarning, stacklevel=2)
     state, rec = _begin(setup, solver, out, dt, name, record, record_every, restart)
     rec.summary.update(meta or {})
     record_every = rec.record_every

@@ -15,6 +15,8 @@ constraint), then the strength model's return map with the stage's strain rate. 
 """
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 
 from . import contact as _contact
@@ -86,8 +88,14 @@ class ESPHSolver:
         return self.params.h
 
     def check_state(self, state: State) -> None:
-        """The state fits the solver (ValueError naming what does not)."""
+        """The state fits the solver (ValueError naming what does not). Several deformable bodies are accepted
+        with a warning: ESPH has no contact law between them, they are one continuum to the SPH sums."""
         _check_common(self.strength, self.mirror, self.constraints, state)
+        if len(self.constraints.deformable_bodies) > 1:
+            warnings.warn(f"ESPH has no contact between deformable bodies {self.constraints.deformable_bodies}: "
+                          "within 2h they are one continuum to the SPH sums (pressure pushes them apart, tension "
+                          "glues them and particles can change sides). TLSPH has the pinball contact.",
+                          stacklevel=2)
 
     def _pairs_and_state(self, state: State):
         if self.mirror is None:
@@ -101,9 +109,10 @@ class ESPHSolver:
             self.pairs.I, self.pairs.J = I[keep], J[keep]
         return (self.pairs.I, self.pairs.J), self._ghosts.extend_state(state, self._ghost_constant)
 
-    def rates(self, state: State, dt: float | None = None, out: dict | None = None) -> Rates:
+    def rates(self, state: State, dt: float | None = None, out: dict | None = None, part: str = "all") -> Rates:
         """Eqs. (10)-(14), (23) over all particles, rigid ones included; constrained (``dt`` is not used).
-        ``out``: a dict that receives the pair list (I, J) and the pressure p (Eq. (24)) of ``state``'s rows."""
+        ``out``: a dict that receives the pair list (I, J) and the pressure p (Eq. (24)) of ``state``'s rows.
+        ``part``: 'all', 'deformation' or 'forces' (:func:`~refsph.esph.esph_rates`; the leapfrog's halves)."""
         if self.constraints.dim is None:
             self.constraints.bind(state)
         (I, J), ext = self._pairs_and_state(state)
@@ -112,11 +121,11 @@ class ESPHSolver:
                 self._pair_sum.close()
             self._pair_sum = PairBlocks(I, J, ext.n, threads=self.threads)
             self._pair_sum_build = self.pairs.n_builds
-        r = esph_rates(ext, self.material, self.params, I, J, pairs=self._pair_sum)
+        r = esph_rates(ext, self.material, self.params, I, J, pairs=self._pair_sum, part=part)
         r = r if ext is state else r.rows(state.n)
         if out is not None:
             out.update(I=I, J=J, p=eos_pressure(state.rho, self.material.rho0, self.material.K))
-        return self.constraints.constrain(state, r)
+        return self.constraints.constrain(state, r, record=part != "deformation")
 
     def finish_stage(self, old: State, new: State, rates: Rates, dt: float, final: bool) -> State:
         return finish_stage(self.constraints, self.strength, self.material, self.heating, old, new, rates, dt, final)
@@ -182,6 +191,7 @@ class TLSPHSolver:
                  threads)
         if self.constraints.rigid and contact is None:
             raise ValueError("TLSPH with rigid bodies needs a contact model (PinballContact)")
+        self.n_body_contacts = 0
         if contact is not None and not (dp is not None and dp > 0):
             raise ValueError("the pinball contact needs the particle spacing dp (2D: force per unit thickness)")
         self.dp, self.contact = dp, contact
@@ -202,13 +212,16 @@ class TLSPHSolver:
         """The sparse operator of the current reference configuration of the deformable rows ``body``."""
         if self.op is None:
             p = self.params
+            ids = body.body if len(self.constraints.deformable_bodies) > 1 else None
             if self.mirror is None:
-                self.op = ReferenceOperator(body.X, body.V0, p.h, p.kernel, p.corrected, threads=self.threads)
+                self.op = ReferenceOperator(body.X, body.V0, p.h, p.kernel, p.corrected, threads=self.threads,
+                                            body=ids)
             else:
                 g = self.mirror.ghosts(body.X, p.kernel.support * p.h)
                 self._ghost_constant = g.extend_constant(body)   # m, X, V0: fixed with the operator
                 _, X, V0 = self._ghost_constant
-                self.op = ReferenceOperator(X, V0, p.h, p.kernel, p.corrected, ghosts=g, threads=self.threads)
+                self.op = ReferenceOperator(X, V0, p.h, p.kernel, p.corrected, ghosts=g, threads=self.threads,
+                                            body=ids)
         return self.op
 
     def _extended(self, body: State, op: ReferenceOperator) -> State:
@@ -228,6 +241,9 @@ class TLSPHSolver:
         (Eq. (2)) and refuses a state whose rho says otherwise (an initial pressure it would silently drop). J is
         1 in the reference configuration (every x = X) and det F of the operator otherwise."""
         _check_common(self.strength, self.mirror, self.constraints, state)
+        if len(self.constraints.deformable_bodies) > 1 and self.contact is None:
+            raise ValueError(f"deformable bodies {self.constraints.deformable_bodies} meet only through the pinball "
+                             "contact: give the solver a PinballContact (refsph.simulate.make_solver does)")
         if self.contact is not None and self.contact.friction is not None and state.T is None:
             raise ValueError("friction with mu(T) needs a state with temperatures (make_state(..., T0=...))")
         body = self._deformable(state)
@@ -270,47 +286,83 @@ class TLSPHSolver:
                  ("body", state.body))}
         return State(m=m, X=X, V0=V0, t=state.t, **part)
 
-    def rates(self, state: State, dt: float, out: dict | None = None) -> Rates:
+    def rates(self, state: State, dt: float, out: dict | None = None, part: str = "all") -> Rates:
         """Eqs. (16)-(23) on the deformable body; with rigid bodies, the pinball contact (Eqs. (32)-(36)) for a
         step of size ``dt`` (Eq. (34)). ``out``: a dict that receives F, J, P, l, rho, p of the deformable rows
-        (:func:`~refsph.tlsph.tlsph_rates`) and the operator's half pairs (I, J)."""
+        (:func:`~refsph.tlsph.tlsph_rates`) and the operator's half pairs (I, J). ``part``: 'all', 'deformation'
+        (stress rates) or 'forces' (dv/dt, contact included): the leapfrog's halves."""
         body = self._deformable(state)
         op = self.operator(body)
         ext = self._extended(body, op)
         F = self._F_from_after_step(body, op)
         if F is None:
             F = self._F(ext, op)
-        r = tlsph_rates(ext, self.material, self.params, op, F=F, out=out)
+        r = tlsph_rates(ext, self.material, self.params, op, F=F, out=out, part=part)
         r = r if ext is body else r.rows(body.n)
         if out is not None:
-            out.update({k: out[k][:body.n] for k in ("F", "J", "P", "l", "rho", "p")}, I=op.I, J=op.J)
+            out.update({k: (None if out[k] is None else out[k][:body.n]) for k in ("F", "J", "P", "l", "rho", "p")},
+                       I=op.I, J=op.J)
+        if part != "deformation" and len(self.constraints.deformable_bodies) > 1:
+            r.v = r.v + self._body_contact(body, dt)
         if body is not state:
-            r = self._with_rigid(state, r, dt)
-        return self.constraints.constrain(state, r)
+            r = self._with_rigid(state, r, dt, contact=part != "deformation")
+        return self.constraints.constrain(state, r, record=part != "deformation")
 
-    def _with_rigid(self, state: State, r: Rates, dt: float) -> Rates:
-        """Rates of all rows: the deformable ones plus the pinball contact, the rigid ones carrying the reaction
-        (dv/dt = contact force / m, turned into the recorded force and then zeroed by the constraints)."""
-        if not (dt is not None and dt > 0):
-            raise ValueError(f"the pinball contact needs the step size dt > 0 (Eq. (34)), got {dt!r}")
+    def _with_rigid(self, state: State, r: Rates, dt: float, contact: bool = True) -> Rates:
+        """Rates of all rows: the deformable ones plus the pinball contact (``contact``), the rigid ones carrying
+        the reaction (dv/dt = contact force / m, turned into the recorded force and then zeroed by the
+        constraints)."""
         n, N, d = self.constraints.n_deformable, state.n, state.dim
-        R = self.contact.k * self.params.h
-        c = _contact.pinball_contact(state.x[:n], state.v[:n], state.m[:n], state.x[n:], state.v[n:], np.inf, R,
-                                     self.material.G, np.inf, dt, self.contact,
-                                     thickness=self.dp if d == 2 else 1.0,
-                                     T_a=None if state.T is None else state.T[:n])
-        self.max_penetration = max(self.max_penetration, c.max_penetration)
-        self.n_contacts = c.n_contacts
-        v = np.empty((N, d))
-        v[:n] = r.v + c.a
-        v[n:] = c.force_on_b / state.m[n:, None]
+        v = np.zeros((N, d))
+        v[:n] = r.v
+        if contact:
+            c = self._contact(state, dt)
+            v[:n] += c.a
+            v[n:] = c.force_on_b / state.m[n:, None]
         S = np.zeros((N, d, d))
         S[:n] = r.S
         S_zz = np.zeros(N)
         S_zz[:n] = r.S_zz
-        l = np.zeros((N, d, d))
-        l[:n] = r.l
+        l = None
+        if r.l is not None:
+            l = np.zeros((N, d, d))
+            l[:n] = r.l
         return Rates(x=state.v.copy(), v=v, rho=None, S=S, S_zz=S_zz, l=l)
+
+    def _body_contact(self, body: State, dt: float) -> np.ndarray:
+        """dv/dt of the deformable rows from the pinball contact (Eqs. (32)-(36)) between every two of their
+        bodies (each pair of bodies once; equal and opposite forces, both sides deformable)."""
+        if not (dt is not None and dt > 0):
+            raise ValueError(f"the pinball contact needs the step size dt > 0 (Eq. (34)), got {dt!r}")
+        acc = np.zeros_like(body.x)
+        ids = self.constraints.deformable_bodies
+        rows = [np.flatnonzero(body.body == b) for b in ids]
+        G, R = self.material.G, self.contact.k * self.params.h
+        n_contacts, thickness = 0, self.dp if body.dim == 2 else 1.0
+        for k, ra in enumerate(rows):
+            for rb in rows[k + 1:]:
+                c = _contact.pinball_contact(body.x[ra], body.v[ra], body.m[ra], body.x[rb], body.v[rb], body.m[rb],
+                                             R, G, G, dt, self.contact, thickness=thickness,
+                                             T_a=None if body.T is None else body.T[ra])
+                acc[ra] += c.a
+                acc[rb] += c.force_on_b / body.m[rb, None]
+                self.max_penetration = max(self.max_penetration, c.max_penetration)
+                n_contacts += c.n_contacts
+        self.n_body_contacts = n_contacts
+        return acc
+
+    def _contact(self, state: State, dt: float):
+        """The pinball contact (Eqs. (32)-(36)) of the deformable rows with the rigid ones, for a step dt."""
+        if not (dt is not None and dt > 0):
+            raise ValueError(f"the pinball contact needs the step size dt > 0 (Eq. (34)), got {dt!r}")
+        n, d = self.constraints.n_deformable, state.dim
+        c = _contact.pinball_contact(state.x[:n], state.v[:n], state.m[:n], state.x[n:], state.v[n:], np.inf,
+                                     self.contact.k * self.params.h, self.material.G, np.inf, dt, self.contact,
+                                     thickness=self.dp if d == 2 else 1.0,
+                                     T_a=None if state.T is None else state.T[:n])
+        self.max_penetration = max(self.max_penetration, c.max_penetration)
+        self.n_contacts = c.n_contacts
+        return c
 
     def finish_stage(self, old: State, new: State, rates: Rates, dt: float, final: bool) -> State:
         return finish_stage(self.constraints, self.strength, self.material, self.heating, old, new, rates, dt, final)
@@ -391,5 +443,7 @@ class TLSPHSolver:
         if self.contact is not None:
             out["max_pinball_penetration_m"] = self.max_penetration
             out["pinball_contacts_last_step"] = self.n_contacts
+            if len(self.constraints.deformable_bodies) > 1:
+                out["pinball_contacts_between_bodies_last_step"] = self.n_body_contacts
         out.update(self.constraints.diagnostics())
         return out

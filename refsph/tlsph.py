@@ -41,14 +41,14 @@ import numpy as np
 import scipy.sparse as sp
 
 from .esph import artificial_viscosity
-from .kernels import Kernel
+from .kernels import Kernel, correction_matrix
 from .material import ElasticMaterial, cauchy_stress, eos_pressure, jaumann_deviatoric_rate
 from .neighbours import PairBlocks, find_pairs, scatter_add
 from .state import Rates, State
 from .tensor import component_major, det, identity, inv, matmul, rowdot, transpose
 
 __all__ = ["TLSPHParams", "ReferenceOperator", "tlsph_rates", "first_piola", "green_lagrange_norm",
-           "reference_update", "reference_viscosity", "correction_matrix"]
+           "reference_update", "reference_viscosity", "correction_matrix", "hourglass_acceleration"]
 
 
 @dataclass(frozen=True)
@@ -56,7 +56,8 @@ class TLSPHParams:
     """Numerical parameters of TLSPH. h: smoothing length in the reference configuration [m];
     beta1, beta2, eps: artificial viscosity (Eqs. (12)-(13)); corrected: kernel-gradient correction;
     ref_update_strain: update the reference configuration when max_i |E_i| exceeds it, with
-    E = (F^T F - I)/2 the Green-Lagrange strain (None: never)."""
+    E = (F^T F - I)/2 the Green-Lagrange strain (None: never); hourglass: the coefficient alpha of
+    :func:`hourglass_acceleration` (0: off, as in the paper)."""
 
     h: float
     beta1: float
@@ -65,6 +66,7 @@ class TLSPHParams:
     kernel: Kernel
     corrected: bool
     ref_update_strain: float | None
+    hourglass: float = 0.0
 
 
 class ReferenceOperator:
@@ -86,7 +88,7 @@ class ReferenceOperator:
     """
 
     def __init__(self, X: np.ndarray, V: np.ndarray, h: float, kernel: Kernel, corrected: bool,
-                 ghosts=None, threads: int = 1, block_size: int | None = None):
+                 ghosts=None, threads: int = 1, block_size: int | None = None, body: np.ndarray | None = None):
         X = np.asarray(X, dtype=float)
         n, d = X.shape
         self.n, self.dim, self.h, self.kernel, self.corrected = n, d, float(h), kernel, bool(corrected)
@@ -97,6 +99,12 @@ class ReferenceOperator:
         if ghosts is not None:
             # X = [real; mirror ghosts] (refsph.boundaries): ghost-ghost pairs act on ghosts only; dropped
             keep = self.I < ghosts.n_real
+            self.I, self.J = self.I[keep], self.J[keep]
+        if body is not None:
+            # several deformable bodies: a particle's neighbours are those of its own body (the bodies meet
+            # through the pinball contact, refsph.contact); ``body`` covers the real rows, ghosts take their source's
+            b = np.asarray(body) if ghosts is None else ghosts.extend_scalars(np.asarray(body))
+            keep = b[self.I] == b[self.J]
             self.I, self.J = self.I[keep], self.J[keep]
         I, J = self.I, self.J
         self.n_pairs = len(I)
@@ -126,7 +134,18 @@ class ReferenceOperator:
         for blk in self.pairs.blocks:                          # its reference gradients, per component
             blk.gW = [np.ascontiguousarray(self.gW[blk.sl, k]) for k in range(d)]
         self._sm, self._sm_m = None, None
+        self._W: tuple | None = None                          # hourglass constants, made on first use
         self.momentum_cache_hits = self.momentum_cache_misses = 0
+
+    def hourglass_constants(self) -> tuple[list, np.ndarray]:
+        """What :func:`hourglass_acceleration` needs of the reference configuration, made once: X_j - X_i on the
+        half pairs (one array per component) and V_i V_j W(|X_ij|) / |X_ij|^2."""
+        if self._W is None:
+            Xij = [np.ascontiguousarray(self.X[self.J, a] - self.X[self.I, a]) for a in range(self.dim)]
+            R2 = sum(c * c for c in Xij)
+            W = self.kernel.w(np.sqrt(R2), self.h, self.dim)
+            self._W = (Xij, self.V[self.I] * self.V[self.J] * W / R2)
+        return self._W
 
     def gradient(self, f: np.ndarray) -> np.ndarray:
         """Eq. (16) with the corrected gradient: sum_j V_j (f_j - f_i) (x) grad~_i W_ij, (N, c) -> (N, c, d).
@@ -176,24 +195,6 @@ class ReferenceOperator:
                 js += jside[a * d + k]
             out[a] = iside - js / self.V
         return out.T
-
-
-def correction_matrix(M: np.ndarray, tol: float = 1e-6) -> tuple[np.ndarray, np.ndarray]:
-    """L_i = M_i^-T (Bonet & Lok 1999). Where M_i is (nearly) singular -- a particle whose neighbours do not
-    span every direction (no neighbours, a single row of particles) -- the Moore-Penrose pseudo-inverse is used
-    instead (Bonet & Lok's correction restricted to the directions the neighbours span), so the operator stays
-    finite. Returns (L, indices of those degenerate particles); F of such a particle is singular in the
-    missing direction, so a run that depends on it stops with a non-finite-state error that names it."""
-    d = M.shape[1]
-    detM = det(M)
-    scale = np.maximum(np.abs(np.trace(M, axis1=1, axis2=2)) / d, np.finfo(float).tiny) ** d
-    bad = np.flatnonzero(~(np.abs(detM) > tol * scale))
-    safe = M.copy()
-    safe[bad] = np.eye(d)
-    L = np.swapaxes(inv(safe), 1, 2)
-    if len(bad):
-        L[bad] = np.swapaxes(np.linalg.pinv(M[bad]), 1, 2)
-    return L, bad
 
 
 def first_piola(sigma: np.ndarray, J: np.ndarray, Finv: np.ndarray) -> np.ndarray:
@@ -259,38 +260,81 @@ def _viscosity_block(blk, particle: dict, c0: float, prm: TLSPHParams, d: int) -
 
 
 def tlsph_rates(state: State, mat: ElasticMaterial, prm: TLSPHParams, op: ReferenceOperator,
-                out: dict | None = None, F: np.ndarray | None = None) -> Rates:
+                out: dict | None = None, F: np.ndarray | None = None, part: str = "all") -> Rates:
     """All TLSPH time derivatives. If ``out`` is a dict, F, J, P and l are stored in it (diagnostics).
 
-    ``F``: the deformation gradient of ``state.x`` on ``op`` (Eq. (18)), if the caller already has it."""
+    ``F``: the deformation gradient of ``state.x`` on ``op`` (Eq. (18)), if the caller already has it. ``part``:
+    'all'; 'deformation' (Eqs. (19), (20): the stress rates and l, dv/dt zero; P is not computed) or 'forces'
+    (Eq. (17): dv/dt only, the stress rates zero), the halves a staggered stepper evaluates apart."""
+    if part not in ("all", "deformation", "forces"):
+        raise ValueError(f"part must be 'all', 'deformation' or 'forces', got {part!r}")
     n, d = state.x.shape
     x, v, m = state.x, state.v, state.m
 
     if F is None:
         F = op.deformation_gradient(x)                      # Eq. (18)
-    Fdot = op.gradient(v)                                   # Eq. (19)
     J = det(F)
     Finv = inv(F, J)
-    l = matmul(Fdot, Finv)
-
     rho_ref = m / op.V                                      # reference density rho_0 = m / V
     rho = rho_ref / J                                       # Eq. (2)
     p = eos_pressure(rho, mat.rho0, mat.K)                  # Eq. (24)
-    sigma = cauchy_stress(state.S, p)
-    P = first_piola(sigma, J, Finv)
-
-    # Eq. (17), stress part: a_i = sum_j m_j (P_i / rho_0i^2 grad~_i W_ij - P_j / rho_0j^2 grad~_j W_ji)
-    a = op.momentum_sum(P / (rho_ref**2)[:, None, None], m)
-
-    # Eq. (17), artificial viscosity: a_i -= sum_j m_j pi_ij (B_i + B_j)/2 grad_i W_ij,  B = J F^-T
-    if prm.beta1 > 0 or prm.beta2 > 0:
-        B = J[:, None, None] * transpose(Finv)
-        a += reference_viscosity(x, v, m, rho, B, op, mat.c0, prm)
-
-    dS, dS_zz = jaumann_deviatoric_rate(state.S, state.S_zz, l, mat.G)
+    l, P = None, None
+    dS, dS_zz = np.zeros((n, d, d)), np.zeros(n)
+    if part != "forces":
+        Fdot = op.gradient(v)                               # Eq. (19)
+        l = matmul(Fdot, Finv)
+        dS, dS_zz = jaumann_deviatoric_rate(state.S, state.S_zz, l, mat.G)
+    a = np.zeros((n, d))
+    if part != "deformation":
+        sigma = cauchy_stress(state.S, p)
+        P = first_piola(sigma, J, Finv)
+        # Eq. (17), stress part: a_i = sum_j m_j (P_i / rho_0i^2 grad~_i W_ij - P_j / rho_0j^2 grad~_j W_ji)
+        a = op.momentum_sum(P / (rho_ref**2)[:, None, None], m)
+        # Eq. (17), artificial viscosity: a_i -= sum_j m_j pi_ij (B_i + B_j)/2 grad_i W_ij,  B = J F^-T
+        if prm.beta1 > 0 or prm.beta2 > 0:
+            B = J[:, None, None] * transpose(Finv)
+            a += reference_viscosity(x, v, m, rho, B, op, mat.c0, prm)
+        if prm.hourglass > 0:
+            a += hourglass_acceleration(x, F, m, op, mat.E, prm.hourglass)
     if out is not None:
         out.update(F=F, J=J, P=P, l=l, rho=rho, p=p)
     return Rates(x=v.copy(), v=a, rho=None, S=dS, S_zz=dS_zz, l=l)
+
+
+def hourglass_acceleration(x: np.ndarray, F: np.ndarray, m: np.ndarray, op: ReferenceOperator, E: float,
+                           alpha: float) -> np.ndarray:
+    """Hourglass control (Ganzenmueller 2015, CMAME 286, 87; the scheme of LAMMPS's SMD package): a penalty on the
+    part of the pair separation that F does not explain. With X_ij = X_j - X_i, x_ij = x_j - x_i, r = |x_ij|:
+
+        eps_ij  = (F_i + F_j)/2 X_ij - x_ij          (the error of the linear prediction, both sides averaged)
+        delta   = eps_ij . x_ij / r                   (its part along the pair)
+        f_i     = -alpha E V_i V_j W(X_ij) / |X_ij|^2 delta x_ij / r,   f_j = -f_i
+
+    so dv_i/dt = sum_j f_i / m_i. It vanishes for every linear (affine) deformation, where F X_ij = x_ij exactly,
+    and pushes back the zig-zag (zero-energy) modes that F, a sum over the neighbours, cannot see. Linear and
+    angular momentum are conserved (the pair force is along x_ij). alpha ~ 0.1-10 (LAMMPS's default 10); it
+    stiffens the particle-scale modes and so lowers the stable time step a little at large alpha."""
+    I, J = op.I, op.J
+    n, d = x.shape
+    real = op.ghosts.n_real if op.ghosts is not None else op.n
+    Xij, coef = op.hourglass_constants()                    # X_j - X_i per component; V_i V_j W(X_ij) / |X_ij|^2
+    xij = [np.take(x[:, a], J) - np.take(x[:, a], I) for a in range(d)]
+    err = []
+    for a in range(d):                                      # (F_i + F_j)/2 X_ij - x_ij, one component at a time
+        Fa = [np.ascontiguousarray(F[:, a, b]) for b in range(d)]
+        e = -xij[a]
+        for b in range(d):
+            e = e + 0.5 * (np.take(Fa[b], I) + np.take(Fa[b], J)) * Xij[b]
+        err.append(e)
+    r2 = sum(c * c for c in xij)
+    mag = (-alpha * E) * coef * sum(e * c for e, c in zip(err, xij)) / r2     # delta / r folded in
+    acc = np.empty((n, d))
+    for a in range(d):
+        f = mag * xij[a]                                    # on i; -f on j
+        acc[:, a] = np.bincount(I, f, minlength=n) - np.bincount(J, f, minlength=n)
+    acc[:real] /= m[:real, None]
+    acc[real:] = 0.0                                        # ghosts: their own rows are not used
+    return acc
 
 
 def reference_update(state: State, F: np.ndarray) -> State:

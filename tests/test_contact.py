@@ -225,8 +225,11 @@ def test_bodies_input_errors():
     setup, n = _disc_on_wall()
     with pytest.raises(ValueError, match="non-negative"):
         Clamp("c", np.array([-1, 0, 1]))
-    with pytest.raises(ValueError, match="not declared"):                 # tool ids without a RigidBody
-        simulate(dataclasses.replace(setup, rigid=()), "tlsph", progress=False)
+    # body ids without a RigidBody are deformable bodies: TLSPH meets them by the pinball, ESPH warns
+    two = dataclasses.replace(setup, rigid=(), t_end=2 * setup.t_end / 100)
+    assert simulate(two, "tlsph", progress=False).summary["status"] == "ok"
+    with pytest.warns(UserWarning, match="no contact between deformable bodies"):
+        simulate(two, "esph", progress=False)
     with pytest.raises(ValueError, match="start with its velocity"):
         simulate(dataclasses.replace(setup, rigid=(RigidBody("wall", 1, (-5.0, 0.0)),)), "esph", progress=False)
     with pytest.raises(ValueError, match="distinct body ids"):

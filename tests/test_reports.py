@@ -33,3 +33,12 @@ def test_readme_figures_are_what_the_code_draws(name, figure, tmp_path):
     mod.plots(json.loads((ROOT / "benchmarks" / f"{name}.json").read_text()), json_only=True)
     new, old = matplotlib.image.imread(tmp_path / figure), matplotlib.image.imread(ROOT / "figures" / figure)
     assert new.shape == old.shape and np.abs(new - old).max() < 0.05     # the same picture (fonts may vary)
+
+
+@pytest.mark.parametrize("name, page", [("lammps_crosscheck", "lammps_crosscheck.md"),
+                                        ("stability_map", "stability_map.md")])
+def test_study_page_is_generated_from_the_json(name, page):
+    """The LAMMPS cross-check and the stability map: their pages are what the scripts write from their JSON."""
+    mod = _script(name)
+    assert mod.report(json.loads((ROOT / "benchmarks" / f"{name}.json").read_text())) == \
+        (ROOT / "benchmarks" / page).read_text()

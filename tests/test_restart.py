@@ -12,7 +12,9 @@ from refsph.simulate import run
 
 CASES = [("taylor", "tlsph", dict(dim=2, quick=True, t_end=6e-6)),
          ("pressing", "esph", dict(quick=True, t_end=0.2e-6)),
-         ("pressing", "tlsph", dict(quick=True, t_end=0.2e-6))]
+         ("pressing", "tlsph", dict(quick=True, t_end=0.2e-6)),
+         ("pressing", "tlsph", dict(quick=True, t_end=0.2e-6, numerics=dict(integrator="leapfrog"))),  # kept force
+         ("taylor", "esph", dict(dim=2, quick=True, t_end=6e-6, numerics=dict(integrator="leapfrog")))]
 
 
 def _killed(monkeypatch, scene, method, out, kw):
@@ -31,7 +33,8 @@ def _killed(monkeypatch, scene, method, out, kw):
     monkeypatch.setattr(sim, "simulate", original)
 
 
-@pytest.mark.parametrize("scene, method, kw", CASES, ids=[f"{c[0]}-{c[1]}" for c in CASES])
+@pytest.mark.parametrize("scene, method, kw", CASES,
+                         ids=[f"{c[0]}-{c[1]}" + ("-leapfrog" if "numerics" in c[2] else "") for c in CASES])
 def test_restart_is_bit_for_bit(tmp_path, monkeypatch, scene, method, kw):
     whole = run(scene, method, out=tmp_path / "whole", progress=False, **kw)
     _killed(monkeypatch, scene, method, tmp_path / "cut", kw)

@@ -4,12 +4,13 @@ report. The registry :data:`SCENES` is what ``refsph list`` prints.
 
 * :mod:`.base` -- :class:`Numerics`, :class:`Setup`, :class:`Scene` and option parsing;
 * :mod:`.measure` -- what the scenes share: lattices, the Table 3 material, time averages, energies, momentum;
-* :mod:`.bar`, :mod:`.tension` -- elastic test cases; :mod:`.taylor`, :mod:`.pressing`, :mod:`.cutting` -- the
+* :mod:`.bar`, :mod:`.tension` -- elastic test cases; :mod:`.spinning_disc`, :mod:`.rings` -- hard cases
+  (objectivity; contact and fracture); :mod:`.taylor`, :mod:`.pressing`, :mod:`.cutting` -- the
   paper's three benchmarks (Sections 3.1-3.3).
 """
 from __future__ import annotations
 
-from . import bar, cutting, pressing, taylor, tension
+from . import bar, cutting, pressing, rings, spinning_disc, taylor, tension
 from .base import Numerics, Scene, Setup, convert_options, parse_bool
 from .measure import (aisi4340_johnson_cook, aisi4340_material, block_lattice, elastic_energy, kinetic_energy,
                       lattice, linear_momentum, min_pair_distance)
@@ -18,7 +19,8 @@ __all__ = ["Numerics", "Setup", "Scene", "SCENES", "get_scene", "convert_options
            "block_lattice", "aisi4340_material", "aisi4340_johnson_cook", "kinetic_energy", "elastic_energy",
            "linear_momentum", "min_pair_distance"]
 
-SCENES: dict[str, Scene] = {m.SCENE.name: m.SCENE for m in (bar, tension, taylor, pressing, cutting)}
+SCENES: dict[str, Scene] = {m.SCENE.name: m.SCENE for m in (bar, tension, spinning_disc, rings, taylor,
+                                                              pressing, cutting)}
 
 
 def get_scene(name: str) -> Scene:

@@ -10,7 +10,7 @@ from .base import Numerics, Scene, Setup
 from .measure import (aisi4340_material, elastic_energy, kinetic_energy, lattice, linear_momentum,
                       zero_crossings)
 
-__all__ = ["SCENE"]
+__all__ = ["SCENE", "period_and_wave_speed"]
 
 
 def _geometry(dim):
@@ -48,16 +48,21 @@ def _record(state, setup):
                 E_el=elastic_energy(state, setup.material), Px=float(P[0]), Py=float(P[1]))
 
 
+def period_and_wave_speed(t: np.ndarray, amplitude: np.ndarray, L: float) -> tuple[float, float]:
+    """The period T of the first axial mode, twice the mean spacing of the amplitude's zero crossings, and the
+    wave speed c = 2 L / T (NaN without two crossings). Used for refsph's runs and for other codes' output."""
+    tz = zero_crossings(np.asarray(t, dtype=float), np.asarray(amplitude, dtype=float))
+    if len(tz) < 2:
+        return float("nan"), float("nan")
+    period = 2.0 * float(np.mean(np.diff(tz)))
+    return period, 2.0 * L / period
+
+
 def _metrics(hist, state, setup):
     t, a = np.asarray(hist["t"]), np.asarray(hist["amplitude"])
-    tz = zero_crossings(t, a)
     L = setup.info["L"]
     c_th = setup.material.c_bar(state.dim)
-    if len(tz) >= 2:
-        period = 2.0 * float(np.mean(np.diff(tz)))
-        c = 2.0 * L / period
-    else:
-        period, c = float("nan"), float("nan")
+    period, c = period_and_wave_speed(t, a, L)
     E = np.asarray(hist["E_kin"]) + np.asarray(hist["E_el"])
     P = np.stack([hist["Px"], hist["Py"]], axis=1)
     p_scale = float(np.sum(state.m)) * setup.info["v0"]
@@ -67,6 +72,7 @@ def _metrics(hist, state, setup):
         wave_speed_theory_m_s=c_th,
         wave_speed_rel_error=(c - c_th) / c_th,
         energy_history=np.stack([t, hist["E_kin"], hist["E_el"]], axis=1),
+        amplitude_history=np.stack([t, a], axis=1),
         energy_final_over_initial=float(E[-1] / E[0]),
         momentum_drift_rel=float(np.max(np.abs(P - P[0])) / p_scale),
     )

@@ -30,8 +30,10 @@ class Numerics:
     update trigger on max |E| (None = never); skin_factor: ESPH Verlet skin in units of h; contact_k: TLSPH
     pinball radius R = contact_k h (Eq. (32); None = dp / (2h), pinballs of neighbouring bodies touch at one
     spacing); contact_Kp: the pinball scaling factor K_p (Eq. (33)); threads: threads that share the pair sums
-    (0 = one per available core); integrator: the time stepper (:data:`refsph.integrate.STEPPERS`). The numbers
-    of a run do not depend on ``threads``, only its speed does.
+    (0 = one per available core); integrator: the time stepper (:data:`refsph.integrate.STEPPERS`); esph_correction:
+    ESPH's normalised velocity gradient (:mod:`refsph.esph`; off: Eq. (23) as printed); hourglass: TLSPH hourglass
+    control coefficient (Ganzenmueller 2015, :mod:`refsph.tlsph`; 0 = off, as in the paper). The numbers of a run
+    do not depend on ``threads``, only its speed does.
     """
 
     h_over_dp: float = 1.5
@@ -49,6 +51,8 @@ class Numerics:
     contact_Kp: float = 50.0
     threads: int = 0
     integrator: str = "predictor_corrector"
+    esph_correction: bool = False
+    hourglass: float = 0.0
 
 
 def numerics_field_optional(name: str) -> bool:

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..material import ElasticMaterial, eos_pressure
+from ..material import ElasticMaterial, eos_pressure, von_mises
 from ..neighbours import find_pairs
 from ..paper_data import AISI4340_TABLE3
 from ..plasticity import JohnsonCook
@@ -14,7 +14,7 @@ from ..state import State
 
 __all__ = ["TOOL_BODY", "N_FORCE_BINS", "lattice", "block_lattice", "aisi4340_material", "aisi4340_johnson_cook",
            "binned_mean", "time_mean", "kinetic_energy", "elastic_energy", "linear_momentum", "min_pair_distance",
-           "zero_crossings"]
+           "zero_crossings", "disc", "annulus", "angular_momentum", "n_fragments", "von_mises_max"]
 
 TOOL_BODY = 1           # body id of the tool in the scenes with one (0 is the workpiece)
 N_FORCE_BINS = 400      # force histories in summary.json: time averages over this many equal bins
@@ -109,3 +109,58 @@ def min_pair_distance(x: np.ndarray, radius: float) -> float:
         return float("inf")
     d = x[I] - x[J]
     return float(np.sqrt(np.min(np.einsum("pk,pk->p", d, d))))
+
+
+# ----------------------------------------------------------------------------- shapes and survival measures
+def disc(radius: float, dp: float, centre=(0.0, 0.0)) -> np.ndarray:
+    """Particle centres of a 2D disc: the square lattice of spacing dp (a node at the centre) cut to r <= radius
+    - dp/2, so that the cells (dp x dp) fill it and its edge is half a spacing outside the outer centres."""
+    return annulus(0.0, radius, dp, centre)
+
+
+def annulus(r_inner: float, r_outer: float, dp: float, centre=(0.0, 0.0)) -> np.ndarray:
+    """Particle centres of a 2D ring r_inner <= r <= r_outer on the square lattice of spacing dp centred at
+    ``centre`` (Gray, Monaghan & Swift 2001 build their rings this way): centres with r_inner + dp/2 <= r <=
+    r_outer - dp/2 (r_inner = 0: every centre from the middle out)."""
+    if not (0 <= r_inner < r_outer and dp > 0):
+        raise ValueError(f"need 0 <= r_inner < r_outer and dp > 0, got {r_inner!r}, {r_outer!r}, {dp!r}")
+    n = int(np.ceil(r_outer / dp)) + 1
+    a = np.arange(-n, n + 1) * dp
+    X, Y = np.meshgrid(a, a, indexing="ij")
+    pts = np.stack([X.ravel(), Y.ravel()], axis=1)
+    r = np.hypot(pts[:, 0], pts[:, 1])
+    lo = r_inner + 0.5 * dp if r_inner > 0 else -1.0
+    keep = (r >= lo) & (r <= r_outer - 0.5 * dp + 1e-12 * dp)
+    return pts[keep] + np.asarray(centre, dtype=float)
+
+
+def angular_momentum(state: State, rows=slice(None), about=None) -> np.ndarray | float:
+    """sum_i m_i (x_i - c) x v_i about ``about`` (default: the rows' centre of mass): a scalar in 2D (the z
+    component), a vector in 3D."""
+    m, x, v = state.m[rows], state.x[rows], state.v[rows]
+    c = np.sum(m[:, None] * x, axis=0) / np.sum(m) if about is None else np.asarray(about, dtype=float)
+    r = x - c
+    if state.dim == 2:
+        return float(np.sum(m * (r[:, 0] * v[:, 1] - r[:, 1] * v[:, 0])))
+    return np.sum(m[:, None] * np.cross(r, v), axis=0)
+
+
+def n_fragments(x: np.ndarray, bond: float, min_size: int = 1) -> int:
+    """The number of connected pieces: particles closer than ``bond`` (e.g. 1.5 dp) belong to one piece; pieces of
+    fewer than ``min_size`` particles are not counted (1: every loose particle is a fragment)."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    n = len(x)
+    if n == 0:
+        return 0
+    I, J = find_pairs(x, bond)
+    graph = coo_matrix((np.ones(len(I)), (I, J)), shape=(n, n))
+    _, labels = connected_components(graph, directed=False)
+    sizes = np.bincount(labels)
+    return int(np.sum(sizes >= min_size))
+
+
+def von_mises_max(state: State) -> float:
+    """The largest von Mises stress sqrt(3 J2) of the state (pressure from the linear EOS does not enter)."""
+    return float(np.max(von_mises(state.S, state.S_zz))) if state.n else 0.0

@@ -54,8 +54,9 @@ from .measure import (N_FORCE_BINS, TOOL_BODY, aisi4340_johnson_cook, aisi4340_m
 __all__ = ["SCENE", "pressing_particles", "pressing_table"]
 
 PRESSING_OPTIONS = {
-    "travel": (0.2e-3, "tool travel at the end of the run [m] (not printed in the paper); t_end = travel / 200 m/s"),
+    "travel": (0.2e-3, "tool travel at the end of the run [m] (not printed in the paper); t_end = travel / tool speed"),
     "eps_dot_0": (1.0, "Johnson-Cook reference strain rate [1/s] (not printed in Table 3)"),
+    "speed_factor": (1.0, "tool speed / the paper's 200 m/s (0.1: the same travel in ten times the time, chapter 10)"),
 }
 
 
@@ -80,7 +81,7 @@ def _default_dp(dim, quick):
     return PRESSING_RESOLUTIONS_M[0] if quick else PRESSING_TABLE4["particle_spacing_m"]
 
 
-def _build(dim, dp, quick, *, travel, eps_dot_0):
+def _build(dim, dp, quick, *, travel, eps_dot_0, speed_factor):
     if dim != 2:
         raise ValueError("the pressing scene is 2D plane strain (the mid-plane of the paper's 0.1 mm slab)")
     if not (np.isfinite(travel) and 0 < travel < 0.9 * PRESSING_GEOMETRY["block_m"][0]):
@@ -94,7 +95,9 @@ def _build(dim, dp, quick, *, travel, eps_dot_0):
     mat = aisi4340_material()
     jc = aisi4340_johnson_cook(eps_dot_0)
     T0 = jc.T_room
-    speed = PRESSING_GEOMETRY["tool_speed_m_s"]
+    if not (np.isfinite(speed_factor) and speed_factor > 0):
+        raise ValueError(f"option speed_factor must be positive, got {speed_factor!r}")
+    speed = float(speed_factor) * PRESSING_GEOMETRY["tool_speed_m_s"]
     block = make_state(xb, [0.0, 0.0], mat.rho0, dx * dy, T0=T0)
     tool = make_state(xt, [-speed, 0.0], mat.rho0, dx * dy, T0=T0, body=np.full(len(xt), TOOL_BODY))
     state = concatenate_states(block, tool)

@@ -36,7 +36,8 @@ from ..state import make_state
 from .base import Numerics, Scene, Setup
 from .measure import kinetic_energy
 
-__all__ = ["SCENE", "comparison_table", "taylor_material", "taylor_johnson_cook", "taylor_particles", "bar_length",
+__all__ = ["SCENE", "comparison_table", "taylor_material", "taylor_johnson_cook", "taylor_particles",
+           "lattice_cylinder", "bar_length",
            "bar_diameter"]
 
 REST_WINDOW = 30e-6      # s: the final length is the mean over this last stretch (two free-ringing periods)
@@ -45,6 +46,10 @@ TAYLOR_OPTIONS = {
     "T_melt": (TAYLOR_TABLE1["T_melt_K"], "melting temperature [K] (Table 1 prints 1293; 1793 is usual for 4340)"),
     "symmetry": (True, "use the symmetry planes (3D: quarter model, 2D: half model); False: whole body"),
     "eps_dot_0": (1.0, "Johnson-Cook reference strain rate [1/s] (not printed in Table 1; Johnson & Cook: 1)"),
+    "heating": (True, "plastic work heats the bar and softens it (Eq. (28)); False: isothermal, as LAMMPS-SMD"),
+    "speed_factor": (1.0, "impact speed / the experiment's 181 m/s (2: the hard case of chapter 10)"),
+    "layout": ("rings", "3D particle layout: 'rings' (exact volumes, see above) or 'lattice' (a cubic lattice cut to "
+                        "the cylinder, as LAMMPS's create_atoms makes it; dr = dz = dp)"),
 }
 
 
@@ -90,6 +95,24 @@ def taylor_particles(dim: int, dp: float, symmetry: bool, length: float, diamete
     return pts, vol, dr, dz
 
 
+def lattice_cylinder(dp: float, symmetry: bool, length: float, diameter: float):
+    """The cubic lattice of spacing dp (cell centres (i + 1/2) dp, the axis through a cell corner) cut to the
+    cylinder r <= R, 0 <= z <= L, and each particle's volume dp^3; the quarter x, y > 0 with ``symmetry``. It is
+    the particle set of LAMMPS's ``lattice sc dp origin 0.5 0.5 0.5`` + ``create_atoms`` in a cylinder region, in
+    LAMMPS's order (x fastest, then y, then z); its surface is a staircase (see the module text)."""
+    R = 0.5 * diameter
+    n = int(np.ceil(R / dp))
+    a = (np.arange(-n, n) + 0.5) * dp
+    if symmetry:
+        a = a[a > 0]
+    zs = (np.arange(int(np.ceil(length / dp))) + 0.5) * dp
+    zs = zs[zs <= length]
+    Z, Y, X = np.meshgrid(zs, a, a, indexing="ij")
+    pts = np.stack([X.ravel(), Y.ravel(), Z.ravel()], axis=1)
+    pts = pts[np.hypot(pts[:, 0], pts[:, 1]) <= R]
+    return pts, np.full(len(pts), dp**3), dp, dp
+
+
 def _default_dp(dim, quick):
     """2D: 0.5 mm quick, 0.25 mm otherwise. 3D: 1.0 mm quick, 0.75 mm otherwise -- the plain
     ``refsph run taylor`` (both methods in about a minute); the paper's 0.5 mm is ``--dp 0.5e-3``
@@ -99,7 +122,7 @@ def _default_dp(dim, quick):
     return 1.0e-3 if quick else 0.75e-3
 
 
-def _build(dim, dp, quick, *, T_melt, symmetry, eps_dot_0):
+def _build(dim, dp, quick, *, T_melt, symmetry, eps_dot_0, heating, layout, speed_factor):
     g = TAYLOR_GEOMETRY
     mat = taylor_material()
     jc = taylor_johnson_cook(T_melt, eps_dot_0)
@@ -108,9 +131,15 @@ def _build(dim, dp, quick, *, T_melt, symmetry, eps_dot_0):
     symmetry = bool(symmetry)
     if not (np.isfinite(T_melt) and T_melt > 293.0):
         raise ValueError(f"option T_melt must exceed the room temperature 293 K, got {T_melt!r}")
-    x, vol, dr, dz = taylor_particles(dim, dp, symmetry, g["length_m"], g["diameter_m"])
+    if layout not in ("rings", "lattice") or (layout == "lattice" and dim != 3):
+        raise ValueError(f"option layout must be 'rings' or (3D only) 'lattice', got {layout!r}")
+    make = lattice_cylinder if layout == "lattice" else lambda *a: taylor_particles(dim, *a)
+    x, vol, dr, dz = make(dp, symmetry, g["length_m"], g["diameter_m"])
     v = np.zeros_like(x)
-    v[:, -1] = -g["impact_velocity_m_s"]
+    if not (np.isfinite(speed_factor) and speed_factor > 0):
+        raise ValueError(f"option speed_factor must be positive, got {speed_factor!r}")
+    v0 = float(speed_factor) * g["impact_velocity_m_s"]
+    v[:, -1] = -v0
     state = make_state(x, v, mat.rho0, vol, T0=jc.T_room)
     t2 = TAYLOR_TABLE2
     numerics = Numerics(h_over_dp=t2["smoothing_length_m"] / t2["particle_spacing_m"], beta1=t2["beta1"],
@@ -121,11 +150,11 @@ def _build(dim, dp, quick, *, T_melt, symmetry, eps_dot_0):
     fraction_inv = (4.0 if dim == 3 else 2.0) if symmetry else 1.0     # whole body / model
     m_total = float(np.sum(state.m)) * fraction_inv
     return Setup(state=state, material=mat, dp=dp, numerics=numerics, t_end=t_end, n_snapshots=10,
-                 strength=jc, mirror=mirror, walls=(wall,), snapshot_times=(15e-6, 30e-6),
+                 strength=jc, heating=bool(heating), mirror=mirror, walls=(wall,), snapshot_times=(15e-6, 30e-6),
                  info=dict(dr=dr, dz=dz, symmetry=symmetry, length0=g["length_m"], diameter0=g["diameter_m"],
-                           v0=g["impact_velocity_m_s"], mass_per_model=float(np.sum(state.m)),
+                           v0=v0, mass_per_model=float(np.sum(state.m)),
                            mass_full_body=m_total, model_fraction_inverse=fraction_inv,
-                           model=("quarter" if dim == 3 else "half") if symmetry else "whole",
+                           model=("quarter" if dim == 3 else "half") if symmetry else "whole", layout=layout,
                            reference=TAYLOR_RESULTS))
 
 

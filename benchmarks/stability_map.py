@@ -1,0 +1,186 @@
+"""The stability map: each hard case, each method, the paper's settings and one change at a time.
+
+    python benchmarks/stability_map.py --jobs 2     # every run not yet done (about 40 CPU-minutes), then the map
+    python benchmarks/stability_map.py --report     # table and figure again from the committed JSON only
+
+Hard cases (quick resolution, 2D):
+  bar          the free elastic bar, 10 periods                     survived: energy not grown by 5 % (viscosity
+                                                                     may damp it: that is accuracy, not stability)
+  spinning     a free disc spinning at 1 % of c_L, a quarter turn    survived: |L/L0 - 1| < 1e-2, stress < 3x the
+                                                                     centrifugal scale (3 + nu)/8 rho w^2 R^2
+  rings        two elastic rings thrown at each other                survived: two pieces, never closer than dp/2
+  taylor2x     the Taylor bar at twice the speed (362 m/s)           survived: finite, one piece
+  pressing10x  the pressing block, the tool at a tenth of its speed:   survived: finite, the block one piece
+               the same 0.2 mm travel in ten times the end time
+Settings: the baseline is the paper's (artificial viscosity beta1 = beta2 = 1.5, ESPH artificial pressure
+gamma = 0.3, the predictor-corrector at Courant 0.3; ESPH uncorrected, TLSPH without hourglass control); each
+variant changes one thing (or, marked +, two). Accuracy: the case's own number (energy ratio, L/L0, restitution,
+final length, mean tool force), reported beside survived / failed, with the final state's fragment count and
+smallest pair distance (every case: particles clumping show there first).
+
+Writes benchmarks/stability_map.json (one record per run, resumable: a rerun skips what is done),
+benchmarks/stability_map.md and figures/10_stability_map.png. refsph.stability holds the rules the run-time warning
+applies; tests/test_hard_cases.py checks them against this map.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import time
+from concurrent.futures import ProcessPoolExecutor
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parent.parent
+OUT_JSON = ROOT / "benchmarks" / "stability_map.json"
+REPORT = ROOT / "benchmarks" / "stability_map.md"
+FIGURE = ROOT / "figures" / "10_stability_map.png"
+
+CASES = ("bar", "spinning", "rings", "taylor2x", "pressing10x")
+COMMON = {"baseline": {}, "beta 0": dict(beta1=0.0, beta2=0.0), "beta 0.5": dict(beta1=0.5, beta2=0.5),
+          "leapfrog": dict(integrator="leapfrog"), "leapfrog + beta 0": dict(integrator="leapfrog", beta1=0.0,
+                                                                              beta2=0.0),
+          "courant 0.6": dict(courant=0.6)}
+VARIANTS = {"esph": dict(COMMON, **{"gamma 0": dict(gamma=0.0), "corrected": dict(esph_correction=True)}),
+            "tlsph": dict(COMMON, **{"hourglass 1": dict(hourglass=1.0),
+                                     "hourglass 1 + leapfrog": dict(hourglass=1.0, integrator="leapfrog")})}
+
+
+def _case_args(case: str) -> tuple[str, dict]:
+    if case == "bar":
+        period = 2 * 20e-3 / 5382.7                       # 2D plane-strain c_bar of AISI 4340
+        return "bar", dict(quick=True, t_end=10 * period)
+    if case == "spinning":
+        return "spinning_disc", dict(quick=True, options=dict(speed=0.01, turns=0.25))
+    if case == "rings":
+        return "rings", dict(quick=True)
+    if case == "taylor2x":
+        return "taylor", dict(dim=2, quick=True, options=dict(speed_factor=2.0))
+    return "pressing", dict(quick=True, options=dict(speed_factor=0.1))
+
+
+def judge(case: str, res) -> tuple[bool, float, str]:
+    """(survived, accuracy number, what the number is) of a finished run."""
+    from refsph.scenes.measure import n_fragments
+    m, st, dp = res.summary["metrics"], res.state, res.setup.dp
+    if case == "bar":
+        e = m["energy_final_over_initial"]
+        return bool(np.isfinite(e) and e < 1.05), e, "energy ratio"
+    if case == "spinning":
+        scale = m["centrifugal_stress_over_1pct"]
+        ok = abs(m["angular_momentum_ratio"] - 1) < 1e-2 and m["max_stress_over_1pct"] < 3 * scale
+        return bool(ok), m["angular_momentum_ratio"], "L / L0"
+    if case == "rings":
+        ok = m["n_fragments"] == 2 and m["min_interbody_distance_over_dp"] > 0.5
+        return bool(ok), m["restitution"], "restitution"
+    body = st.x if st.body is None else st.x[st.body == 0]
+    one = n_fragments(body, 1.5 * dp) == 1
+    if case == "taylor2x":
+        return bool(one), m["final_length_mm"], "final length [mm]"
+    return bool(one), m["tool_force_mean_N_per_m"] * 1e-6, "mean tool force [MN/m]"
+
+
+def run_one(key: str) -> dict:
+    from refsph.scenes.measure import min_pair_distance, n_fragments
+    from refsph.simulate import SimulationError, run
+    case, method, variant = key.split("|")
+    scene, kw = _case_args(case)
+    numerics = dict(VARIANTS[method][variant], threads=1)
+    t0 = time.perf_counter()
+    rec = dict(key=key, case=case, scene=scene, method=method, variant=variant, numerics=VARIANTS[method][variant])
+    try:
+        res = run(scene, method, progress=False, numerics=numerics, **kw)
+        ok, acc, what = judge(case, res)
+        dp = res.setup.dp
+        rec.update(status="ok", survived=ok, accuracy=acc, measure=what, n_steps=res.summary["n_steps"],
+                   n_fragments=n_fragments(res.state.x, 1.5 * dp),
+                   min_pair_distance_over_dp=min_pair_distance(res.state.x, 1.5 * dp) / dp)
+    except SimulationError as e:
+        rec.update(status="failed", survived=False, accuracy=float("nan"), measure="", error=str(e)[:300])
+    rec["wall_time_s"] = time.perf_counter() - t0
+    return rec
+
+
+def keys() -> list[str]:
+    return [f"{c}|{m}|{v}" for c in CASES for m in VARIANTS for v in VARIANTS[m]]
+
+
+def load() -> dict:
+    return json.loads(OUT_JSON.read_text()) if OUT_JSON.exists() else dict(runs={})
+
+
+def save(res: dict) -> None:
+    OUT_JSON.write_text(json.dumps(res, indent=1, sort_keys=True, default=float) + "\n")
+
+
+def report(res: dict) -> str:
+    runs = res["runs"]
+    lines = ["# The stability map", "", "Made by `python benchmarks/stability_map.py` (module text: the cases, the "
+             "settings, what survived means). Each cell: survived (yes) or failed (NO), the case's accuracy number, "
+             "the wall time of the run on one core.", ""]
+    for method in VARIANTS:
+        lines += [f"## {method.upper()}", "", "| setting | " + " | ".join(CASES) + " |",
+                  "|---|" + "---|" * len(CASES)]
+        for v in VARIANTS[method]:
+            cells = []
+            for c in CASES:
+                r = runs.get(f"{c}|{method}|{v}")
+                if r is None:
+                    cells.append("(to run)")
+                    continue
+                acc = "" if not np.isfinite(r["accuracy"]) else f" {r['accuracy']:.3g}"
+                cells.append(f"{'yes' if r['survived'] else 'NO'}{acc} ({r['wall_time_s']:.0f} s)")
+            lines.append(f"| {v} | " + " | ".join(cells) + " |")
+        lines.append("")
+    done = [r["wall_time_s"] for r in runs.values()]
+    lines += [f"{len(done)} of {len(keys())} runs done, {sum(done) / 60:.1f} CPU-minutes in all.", ""]
+    return "\n".join(lines)
+
+
+def figure(res: dict) -> None:
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, axes = plt.subplots(1, 2, figsize=(12, 4.8), constrained_layout=True)
+    for ax, method in zip(axes, VARIANTS):
+        vs = list(VARIANTS[method])
+        grid = np.full((len(vs), len(CASES)), np.nan)
+        for i, v in enumerate(vs):
+            for j, c in enumerate(CASES):
+                r = res["runs"].get(f"{c}|{method}|{v}")
+                if r is not None:
+                    grid[i, j] = 1.0 if r["survived"] else 0.0
+                    ax.text(j, i, "yes" if r["survived"] else "NO", ha="center", va="center", fontsize=9)
+        ax.imshow(grid, cmap="RdYlGn", vmin=-0.3, vmax=1.3, aspect="auto")
+        ax.set_xticks(range(len(CASES)), CASES, rotation=20)
+        ax.set_yticks(range(len(vs)), vs)
+        ax.set_title(f"{method.upper()}: survived?")
+    fig.savefig(FIGURE, dpi=110)
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--jobs", type=int, default=1)
+    ap.add_argument("--only", nargs="*", default=None, help="cases to run (default: all)")
+    ap.add_argument("--report", action="store_true", help="table and figure from the committed JSON only")
+    args = ap.parse_args(argv)
+    res = load()
+    if not args.report:
+        todo = [k for k in keys() if k not in res["runs"] and (args.only is None or k.split("|")[0] in args.only)]
+        print(f"{len(todo)} runs to do ({len(res['runs'])} done)", flush=True)
+        with ProcessPoolExecutor(max_workers=max(1, args.jobs)) as pool:
+            for k, rec in enumerate(pool.map(run_one, todo)):
+                res["runs"][rec["key"]] = rec
+                save(res)
+                print(f"[{k + 1}/{len(todo)}] {rec['key']:40s} {'survived' if rec['survived'] else 'FAILED':9s} "
+                      f"{rec['accuracy']:.4g} {rec['wall_time_s']:6.1f} s", flush=True)
+    REPORT.write_text(report(res))
+    figure(res)
+    print(f"wrote {OUT_JSON}, {REPORT}, {FIGURE}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

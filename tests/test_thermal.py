@@ -95,3 +95,21 @@ def test_free_surface_detectors_agree_on_a_disc_and_a_ring():
         if r_in is not None:
             inner = r < r.min() + 0.5 * dp
             assert sph[inner].all() and alpha[inner].all()
+
+
+def test_the_second_papers_cutting_table():
+    """The 18 measured cuts (Appendix B) as transcribed: the grid of the issue, and the measured cutting force
+    grows with the uncut chip thickness at every speed (the trend a model must show)."""
+    from refsph.paper_data import RLA_CUTTING_CASES, TI6AL4V_RLA, rla_cutting_case
+    rows = [rla_cutting_case(k) for k in range(1, len(RLA_CUTTING_CASES) + 1)]
+    assert len(rows) == 18 and [r["case"] for r in rows] == list(range(1, 19))
+    for material, speeds in (("AISI1045", [60.0, 120.0, 180.0]), ("Ti6Al4V", [20.0, 40.0, 60.0])):
+        mine = [r for r in rows if r["material"] == material]
+        assert sorted({r["vc_m_per_min"] for r in mine}) == speeds
+        for v in speeds:
+            cut = sorted((r for r in mine if r["vc_m_per_min"] == v), key=lambda r: r["tu_mm"])
+            assert [r["tu_mm"] for r in cut] == [0.10, 0.15, 0.20]
+            assert cut[0]["Fc_exp_N"] < cut[1]["Fc_exp_N"] < cut[2]["Fc_exp_N"]
+    assert TI6AL4V_RLA["k_W_mK"] < 10 and rows[0]["Fp_exp_N"] / rows[0]["Fc_exp_N"] < 1
+    with pytest.raises(ValueError, match="1..18"):
+        rla_cutting_case(19)

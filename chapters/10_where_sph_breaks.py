@@ -132,7 +132,7 @@ plt.show()
 #
 # `python benchmarks/stability_map.py` runs every hard case (the bar, the disc, the rings, a Taylor bar at twice
 # the speed, the pressing block for ten times its end time) with each method at the paper's settings and one change
-# at a time. The committed map ([`benchmarks/stability_map.md`](../benchmarks/stability_map.md)):
+# at a time. The committed map ([`benchmarks/stability_map_report.md`](../benchmarks/stability_map_report.md)):
 
 # %%
 runs = json.loads((repository_root() / "benchmarks" / "stability_map.json").read_text())["runs"]

@@ -28,6 +28,7 @@ from .contact import PinballContact
 from .esph import ESPHParams
 from .integrate import Solver, cfl_time_step, get_stepper
 from .stability import warnings_for
+from .thermal import conduct, thermal_step_limit
 from .boundaries import Clamp
 from .io import json_ready, save_reactions, save_snapshot, state_from_particles, state_from_snapshot, write_json
 from .kernels import get_kernel
@@ -215,7 +216,8 @@ class RunRecord:
                             clamps=[c.to_dict() for c in setup.clamps],
                             friction=(dataclasses.asdict(setup.friction) if setup.friction is not None else None)),
             scene_info=setup.info, snapshot_times=[float(t) for t in self.times], refsph_version=__version__,
-            provenance=provenance(solver.threads), status="running", metrics={})
+            provenance=provenance(solver.threads), status="running", metrics={},
+            **({"thermal": json_ready(dataclasses.asdict(setup.thermal))} if setup.thermal is not None else {}))
 
     def record(self, state: State) -> None:
         if self.record_fn is not None:
@@ -298,7 +300,13 @@ def step_or_fail(state: State, solver: Solver, dt: float, rec: RunRecord, step=N
 
 
 def _time_step(setup: Setup, dt: float | None, state: State) -> float:
-    return dt if dt is not None else cfl_time_step(state, setup.material, setup.h, setup.numerics.courant)
+    """The fixed dt, or the CFL step (and with heat conduction no more than its limit, refsph.thermal)."""
+    if dt is not None:
+        return dt
+    step = cfl_time_step(state, setup.material, setup.h, setup.numerics.courant)
+    if setup.thermal is not None:
+        step = min(step, thermal_step_limit(state, setup.thermal, setup.h, [b.body for b in setup.rigid]))
+    return step
 
 
 def _warn_fixed_dt(setup: Setup, dt: float | None, state: State) -> None:
@@ -381,6 +389,8 @@ def simulate(setup: Setup, method: str | None = None, *, scene: Scene | None = N
         raise ValueError(f"method {method!r} does not match the solver's ({solver.method!r}); give one of them")
     method = method if solver is None else solver.method
     _validate(method, setup.state.dim, setup.dp, setup.numerics, setup.t_end, dt)
+    if setup.thermal is not None and setup.state.T is None:
+        raise ValueError("heat conduction (Setup.thermal) needs temperatures: make_state(..., T0=...)")
     record = record or (scene.record if scene is not None else None)
     metrics = metrics or (scene.metrics if scene is not None else None)
     solver = solver if solver is not None else make_solver(method, setup)
@@ -398,6 +408,9 @@ def simulate(setup: Setup, method: str | None = None, *, scene: Scene | None = N
             rec.dts.append(step_dt)                         # the step size chosen (before any cut to land on time)
             step_dt = min(step_dt, rec.next_output_time() - state.t)   # snapshots land on their nominal times
             prev, state = state, step_or_fail(state, solver, step_dt, rec, stepper)
+            if setup.thermal is not None:                   # heat conduction, after the mechanical step
+                state.T = conduct(state, setup.thermal, setup.h, get_kernel(setup.numerics.kernel), step_dt,
+                                  [b.body for b in setup.rigid])
             if hook is not None:
                 state = hook(state, solver) or state
                 if not (np.isfinite(state.v).all() and np.isfinite(state.x).all()):

@@ -2,7 +2,7 @@
 
 ``benchmarks/stability_map.py`` runs every hard case (an undamped bar, a spinning disc, two colliding rings, a
 Taylor bar at twice the speed, a long pressing run) with each method at the paper's settings and with one change at
-a time; ``benchmarks/stability_map.md`` is the map. The rules below are what it shows failing, each with the map
+a time; ``benchmarks/stability_map_report.md`` is the map. The rules below are what it shows failing, each with the map
 entries behind it (``evidence``, the map's keys case|method|setting); ``tests/test_hard_cases.py`` checks every
 rule against the committed map, so a rule cannot claim more than was measured. :func:`warnings_for` gives the
 messages for a run; :func:`refsph.simulate.simulate` issues them as ``UserWarning`` (they never stop a run).
@@ -58,5 +58,5 @@ RULES = (
 def warnings_for(scene: str | None, method: str, numerics) -> list[str]:
     """The warnings of the rules that apply to a run of ``scene`` (None: a user's own setup) with ``method`` and
     ``numerics`` (:class:`refsph.scenes.Numerics`), each naming the map entries that failed."""
-    return [f"{r.message} (stability map, benchmarks/stability_map.md: {', '.join(r.evidence)} failed)"
+    return [f"{r.message} (stability map, benchmarks/stability_map_report.md: {', '.join(r.evidence)} failed)"
             for r in RULES if r.applies(scene, method, numerics)]

@@ -1,5 +1,6 @@
 """Heat conduction in SPH (Rodriguez Prieto, Larsson & Afrasiabi, Eqs. (4), (26), (29)): the first piece of the
-thermomechanical cutting model (issue 16); the scenes do not use it yet.
+thermomechanical cutting model (issue 16). A run conducts heat only when its Setup asks (``Setup.thermal``, a
+:class:`Conduction`; None, the default and every scene so far: no conduction, the paper's adiabatic model).
 
     Eq. (4)   rho c_p dT/dt = k lap T + Q_s
     Eq. (26)  lap f_i = sum_j 2 f_ij / |r_ij| (e_ij . grad_i W_ij) V_j,    f_ij = f_i - f_j, e_ij = r_ij / |r_ij|
@@ -14,15 +15,25 @@ boundary) unless a boundary term is added (convection, radiation, a fixed temper
 
 Explicit time step (the second paper's Section 2.4.2): dt_t = rho c_p h^2 / k, times a Courant-like factor;
 :func:`thermal_time_step`.
+
+Between materials (the workpiece and a conducting tool) the conductivity of a pair is the harmonic mean
+k_ij = 2 k_i k_j / (k_i + k_j) (Cleary & Monaghan 1999, J. Comput. Phys. 148, 227), which reduces to Eq. (29) for
+one material and carries no flux to an insulating body (k = 0):
+
+    dT_i/dt = 1 / (rho_i c_i) sum_j 2 k_ij (T_i - T_j) (dW/dr)(r_ij) / r_ij V_j              (:func:`conduct`)
+
+Every pair term moves heat and creates none: sum_i m_i c_i T_i is conserved to round-off.
 """
 from __future__ import annotations
+
+from dataclasses import dataclass, field
 
 import numpy as np
 
 from .kernels import Kernel
 from .neighbours import PairSum, find_pairs
 
-__all__ = ["laplacian", "conduction_rate", "thermal_time_step"]
+__all__ = ["laplacian", "conduction_rate", "thermal_time_step", "Conduction", "conduct", "thermal_step_limit"]
 
 
 def laplacian(f: np.ndarray, x: np.ndarray, V: np.ndarray, h: float, kernel: Kernel,
@@ -52,3 +63,66 @@ def thermal_time_step(rho: float, cp: float, k: float, h: float, factor: float) 
         if not (np.isfinite(v) and v > 0):
             raise ValueError(f"{name} must be positive, got {v!r}")
     return factor * rho * cp * h * h / k
+
+
+@dataclass(frozen=True)
+class Conduction:
+    """Heat conduction during a run (``Setup.thermal``). ``k`` [W/(m K)] and ``cp`` [J/(kg K)]: the deformable
+    bodies'; ``courant``: the factor on rho c_p h^2 / k; ``tools``: {body id: (k, cp)} of the rigid bodies that
+    conduct (the others insulate); ``fixed``: particle indices held at ``T_fixed`` [K] (a fixed surface at room
+    temperature)."""
+
+    k: float
+    cp: float
+    courant: float
+    tools: dict = field(default_factory=dict)
+    fixed: tuple = ()
+    T_fixed: float | None = None
+
+    def __post_init__(self):
+        for name in ("k", "cp", "courant"):
+            v = getattr(self, name)
+            if not (np.isfinite(v) and v > 0):
+                raise ValueError(f"Conduction.{name} must be positive, got {v!r}")
+        if len(self.fixed) and self.T_fixed is None:
+            raise ValueError("Conduction.fixed needs T_fixed (the temperature the fixed particles are held at)")
+
+    def coefficients(self, body: np.ndarray | None, n: int) -> tuple[np.ndarray, np.ndarray]:
+        """Per-particle conductivity and heat capacity (deformable rows: k, cp; tool rows: their own; other rigid
+        rows are insulators: k = 0, cp = 1)."""
+        k, c = np.full(n, float(self.k)), np.full(n, float(self.cp))
+        if body is not None:
+            for b, (kb, cb) in self.tools.items():
+                k[body == b], c[body == b] = kb, cb
+        return k, c
+
+
+def thermal_step_limit(state, model: Conduction, h: float, rigid_ids=()) -> float:
+    """courant * min_i rho_i c_i h^2 / k_i over the conducting particles."""
+    k, c = model.coefficients(state.body, state.n)
+    if state.body is not None and len(rigid_ids):
+        insulating = np.isin(state.body, [b for b in rigid_ids if b not in model.tools])
+        k = np.where(insulating, 0.0, k)
+    on = k > 0
+    return float(model.courant * np.min(state.rho[on] * c[on] * h * h / k[on])) if np.any(on) else np.inf
+
+
+def conduct(state, model: Conduction, h: float, kernel: Kernel, dt: float, rigid_ids=()) -> np.ndarray:
+    """The temperatures after an explicit conduction step of dt (module text), fixed particles reset. Pairs are
+    found in the current configuration, across bodies (heat flows from the chip into a conducting tool)."""
+    n, d = state.x.shape
+    k, c = model.coefficients(state.body, n)
+    if state.body is not None and len(rigid_ids):
+        k = np.where(np.isin(state.body, [b for b in rigid_ids if b not in model.tools]), 0.0, k)
+    I, J = find_pairs(state.x, kernel.support * h)
+    r = np.sqrt(np.sum((state.x[I] - state.x[J]) ** 2, axis=1))
+    fr = kernel.dw_dr_over_r(r, h, d)
+    kk = k[I] + k[J]
+    k_ij = np.divide(2.0 * k[I] * k[J], kk, out=np.zeros_like(kk), where=kk > 0)
+    V = state.m / state.rho
+    q = 2.0 * k_ij * (state.T[I] - state.T[J]) * fr            # antisymmetric pair flux
+    dT = dt * PairSum(I, J, n).antisymmetric(q, V) / (state.rho * c)
+    T = state.T + dT
+    if len(model.fixed):
+        T[np.asarray(model.fixed)] = model.T_fixed
+    return T

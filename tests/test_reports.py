@@ -35,8 +35,8 @@ def test_readme_figures_are_what_the_code_draws(name, figure, tmp_path):
     assert new.shape == old.shape and np.abs(new - old).max() < 0.05     # the same picture (fonts may vary)
 
 
-@pytest.mark.parametrize("name, page", [("lammps_crosscheck", "lammps_crosscheck.md"),
-                                        ("stability_map", "stability_map.md")])
+@pytest.mark.parametrize("name, page", [("lammps_crosscheck", "lammps_crosscheck_report.md"),
+                                        ("stability_map", "stability_map_report.md")])
 def test_study_page_is_generated_from_the_json(name, page):
     """The LAMMPS cross-check and the stability map: their pages are what the scripts write from their JSON."""
     mod = _script(name)

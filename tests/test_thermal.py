@@ -113,3 +113,38 @@ def test_the_second_papers_cutting_table():
     assert TI6AL4V_RLA["k_W_mK"] < 10 and rows[0]["Fp_exp_N"] / rows[0]["Fc_exp_N"] < 1
     with pytest.raises(ValueError, match="1..18"):
         rla_cutting_case(19)
+
+
+@pytest.mark.parametrize("method", ["tlsph", "esph"])
+def test_conduction_during_a_run_between_two_bodies(method):
+    """Setup.thermal switches conduction on in a run: two 1 x 1 mm blocks side by side (TLSPH: two bodies), one at
+    400 K, one at 300 K, with a conductivity 1e4 times steel's so that heat crosses in a few hundred steps. Heat
+    flows across the contact and none is made (total to round-off); after 0.3 of the diffusion time L^2/a the
+    halves differ by 5.0 K, against 4.2 K for the first mode of the 1D slab, (8/pi^2) exp(-0.3 pi^2) 100 K
+    (10 particles per half, free surfaces: the first-order error of the insulated test above)."""
+    import warnings
+
+    from refsph.scenes import Numerics, Setup, aisi4340_material
+    from refsph.simulate import simulate
+    from refsph.state import concatenate_states, make_state
+    from refsph.thermal import Conduction
+    mat, dp = aisi4340_material(), 1e-4
+    x = lattice([10 * dp, 10 * dp], dp)
+    hot = make_state(x, [0.0, 0.0], mat.rho0, dp * dp, T0=400.0, body=np.zeros(len(x), int))
+    cold = make_state(x + [10 * dp, 0.0], [0.0, 0.0], mat.rho0, dp * dp, T0=300.0, body=np.ones(len(x), int))
+    st = concatenate_states(hot, cold)
+    k, cp = 5e5, 480.0
+    t_diff = (20 * dp) ** 2 * mat.rho0 * cp / k
+    setup = Setup(state=st, material=mat, dp=dp, numerics=Numerics(), t_end=0.3 * t_diff, n_snapshots=1,
+                  thermal=Conduction(k=k, cp=cp, courant=0.2))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")                       # ESPH: no contact law between the bodies
+        T = simulate(setup, method, progress=False).state.T
+    assert abs(T.sum() - st.T.sum()) < 1e-12 * st.T.sum()
+    gap = T[:len(x)].mean() - T[len(x):].mean()
+    assert 0.8 * 4.2 < gap < 1.4 * 4.2, gap
+    with pytest.raises(ValueError, match="temperatures"):
+        st0 = concatenate_states(make_state(x, [0.0, 0.0], mat.rho0, dp * dp), make_state(x + [1e-3, 0], [0.0, 0.0],
+                                                                                            mat.rho0, dp * dp))
+        simulate(Setup(state=st0, material=mat, dp=dp, numerics=Numerics(), t_end=1e-9, n_snapshots=1,
+                       thermal=Conduction(k=k, cp=cp, courant=0.2)), method, progress=False)

@@ -73,7 +73,8 @@ class Setup:
     particles (:class:`~refsph.boundaries.Clamp`); ``friction``: a :class:`~refsph.contact.CoulombFriction` for
     the TLSPH pinball contact (None: frictionless, as in the paper); ``info``: numbers that describe the scene
     (written to ``summary.json`` as ``scene_info``: JSON scalars, strings and short lists only); ``arrays``:
-    per-particle arrays the scene's measurements need (index sets; not written to the summary).
+    per-particle arrays the scene's measurements need (index sets; not written to the summary); ``thermal``: heat
+    conduction during the run (a :class:`refsph.thermal.Conduction`; None: none, the paper's adiabatic model).
     """
 
     state: State
@@ -92,6 +93,7 @@ class Setup:
     clamps: tuple = ()
     friction: object = None
     arrays: dict = field(default_factory=dict)
+    thermal: object = None
 
     def __post_init__(self):
         if self.strength is None:

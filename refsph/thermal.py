@@ -33,7 +33,8 @@ import numpy as np
 from .kernels import Kernel
 from .neighbours import PairSum, find_pairs
 
-__all__ = ["laplacian", "conduction_rate", "thermal_time_step", "Conduction", "conduct", "thermal_step_limit"]
+__all__ = ["laplacian", "conduction_rate", "thermal_time_step", "advance_at_rest", "Conduction", "conduct",
+           "thermal_step_limit"]
 
 
 def laplacian(f: np.ndarray, x: np.ndarray, V: np.ndarray, h: float, kernel: Kernel,
@@ -63,6 +64,20 @@ def thermal_time_step(rho: float, cp: float, k: float, h: float, factor: float) 
         if not (np.isfinite(v) and v > 0):
             raise ValueError(f"{name} must be positive, got {v!r}")
     return factor * rho * cp * h * h / k
+
+
+def advance_at_rest(T: np.ndarray, x: np.ndarray, V: np.ndarray, a: float, h: float, kernel: Kernel, t_end: float,
+                    factor: float, rho: float, cp: float, k: float) -> tuple[np.ndarray, int]:
+    """Eq. (29) alone, for particles at rest, to ``t_end``: midpoint (RK2) steps of at most
+    ``thermal_time_step(rho, cp, k, h, factor)``; returns (T, number of steps). The analytic checks use it."""
+    dt = thermal_time_step(rho, cp, k, h, factor)
+    n = int(np.ceil(t_end / dt))
+    dt = t_end / n
+    pairs = find_pairs(x, kernel.support * h)
+    for _ in range(n):
+        k1 = conduction_rate(T, x, V, a, h, kernel, pairs)
+        T = T + dt * conduction_rate(T + 0.5 * dt * k1, x, V, a, h, kernel, pairs)
+    return T, n
 
 
 @dataclass(frozen=True)

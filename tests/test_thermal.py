@@ -4,9 +4,8 @@ import numpy as np
 import pytest
 
 from refsph.kernels import get_kernel
-from refsph.neighbours import find_pairs
 from refsph.scenes import lattice
-from refsph.thermal import conduction_rate, laplacian, thermal_time_step
+from refsph.thermal import advance_at_rest, laplacian, thermal_time_step
 
 RHO, CP, K = 7800.0, 432.0, 50.0          # a steel (AISI 1045-like): diffusivity a = 1.48e-5 m^2/s
 A = K / (RHO * CP)
@@ -15,14 +14,7 @@ KERNEL = get_kernel("cubic")
 
 def _advance(T, x, V, h, t_end, factor=0.1):
     """Midpoint (RK2) steps of Eq. (29) at the thermal step factor * rho c_p h^2 / k."""
-    dt = thermal_time_step(RHO, CP, K, h, factor)
-    n = int(np.ceil(t_end / dt))
-    dt = t_end / n
-    pairs = find_pairs(x, KERNEL.support * h)
-    for _ in range(n):
-        k1 = conduction_rate(T, x, V, A, h, KERNEL, pairs)
-        T = T + dt * conduction_rate(T + 0.5 * dt * k1, x, V, A, h, KERNEL, pairs)
-    return T
+    return advance_at_rest(T, x, V, A, h, KERNEL, t_end, factor, RHO, CP, K)[0]
 
 
 def test_laplacian_of_a_quadratic_inside_a_lattice():

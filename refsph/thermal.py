@@ -32,9 +32,10 @@ import numpy as np
 
 from .kernels import Kernel
 from .neighbours import PairSum, find_pairs
+from .surface import surface_sph
 
-__all__ = ["laplacian", "conduction_rate", "thermal_time_step", "advance_at_rest", "Conduction", "conduct",
-           "thermal_step_limit"]
+__all__ = ["laplacian", "conduction_rate", "thermal_time_step", "advance_at_rest", "Conduction", "SurfaceLoss",
+           "conduct", "thermal_step_limit", "STEFAN_BOLTZMANN"]
 
 
 def laplacian(f: np.ndarray, x: np.ndarray, V: np.ndarray, h: float, kernel: Kernel,
@@ -80,12 +81,34 @@ def advance_at_rest(T: np.ndarray, x: np.ndarray, V: np.ndarray, a: float, h: fl
     return T, n
 
 
+STEFAN_BOLTZMANN = 5.670374419e-8          # W/(m^2 K^4)
+
+
+@dataclass(frozen=True)
+class SurfaceLoss:
+    """Heat lost on free surfaces (the second paper's Eq. (6)): q = h_c (T_s - T_inf) + emissivity sigma_SB
+    (T_s^4 - T_inf^4) [W/m^2], on the particles :func:`refsph.surface.surface_sph` marks, each with the area
+    V^((d-1)/d) (a spacing per unit thickness in 2D, a spacing squared in 3D)."""
+
+    h_c: float
+    emissivity: float
+    T_ambient: float
+
+    def __post_init__(self):
+        if not (self.h_c >= 0 and 0 <= self.emissivity <= 1 and self.T_ambient > 0):
+            raise ValueError(f"SurfaceLoss needs h_c >= 0, 0 <= emissivity <= 1, T_ambient > 0; got {self}")
+
+    def flux(self, T: np.ndarray) -> np.ndarray:
+        """q(T) [W/m^2], Eq. (6)."""
+        return self.h_c * (T - self.T_ambient) + self.emissivity * STEFAN_BOLTZMANN * (T ** 4 - self.T_ambient ** 4)
+
+
 @dataclass(frozen=True)
 class Conduction:
     """Heat conduction during a run (``Setup.thermal``). ``k`` [W/(m K)] and ``cp`` [J/(kg K)]: the deformable
     bodies'; ``courant``: the factor on rho c_p h^2 / k; ``tools``: {body id: (k, cp)} of the rigid bodies that
     conduct (the others insulate); ``fixed``: particle indices held at ``T_fixed`` [K] (a fixed surface at room
-    temperature)."""
+    temperature); ``loss``: convection and radiation on the free surfaces (:class:`SurfaceLoss`; None: none)."""
 
     k: float
     cp: float
@@ -93,6 +116,7 @@ class Conduction:
     tools: dict = field(default_factory=dict)
     fixed: tuple = ()
     T_fixed: float | None = None
+    loss: SurfaceLoss | None = None
 
     def __post_init__(self):
         for name in ("k", "cp", "courant"):
@@ -137,6 +161,10 @@ def conduct(state, model: Conduction, h: float, kernel: Kernel, dt: float, rigid
     V = state.m / state.rho
     q = 2.0 * k_ij * (state.T[I] - state.T[J]) * fr            # antisymmetric pair flux
     dT = dt * PairSum(I, J, n).antisymmetric(q, V) / (state.rho * c)
+    if model.loss is not None:                              # Eq. (6) on the free surface of the conducting rows
+        on = surface_sph(state.x, V, h, kernel) & (k > 0)
+        area = V[on] ** ((d - 1) / d)
+        dT[on] -= dt * model.loss.flux(state.T[on]) * area / (state.m[on] * c[on])
     T = state.T + dT
     if len(model.fixed):
         T[np.asarray(model.fixed)] = model.T_fixed

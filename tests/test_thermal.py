@@ -140,3 +140,34 @@ def test_conduction_during_a_run_between_two_bodies(method):
                                                                                             mat.rho0, dp * dp))
         simulate(Setup(state=st0, material=mat, dp=dp, numerics=Numerics(), t_end=1e-9, n_snapshots=1,
                        thermal=Conduction(k=k, cp=cp, courant=0.2)), method, progress=False)
+
+
+def test_convective_cooling_of_a_block():
+    """Conduction with SurfaceLoss (Eq. (6)): a 1 x 1 mm block at 600 K cooling into 300 K air with Biot number
+    h_c L / k = 0.1, nearly uniform inside, follows the lumped law exp(-t / tau), tau = M c_p / (h_c A), to 1 % with
+    A the area the surface detector gives (36 spacings: the outer ring of particles, one face each). The true
+    perimeter is 40 spacings (the four corners have two faces), so against it the cooling is 11 % slow at t = tau:
+    the surface area of a particle body is known only to a spacing."""
+    from refsph.scenes import aisi4340_material
+    from refsph.state import make_state
+    from refsph.surface import surface_sph
+    from refsph.thermal import STEFAN_BOLTZMANN, Conduction, SurfaceLoss, conduct, thermal_step_limit
+    mat, dp = aisi4340_material(), 1e-4
+    L, h, k, cp = 10 * dp, 1.5e-4, 50.0, 480.0
+    st = make_state(lattice([L, L], dp), [0.0, 0.0], mat.rho0, dp * dp, T0=600.0)
+    loss = SurfaceLoss(h_c=0.1 * k / L, emissivity=0.0, T_ambient=300.0)
+    model = Conduction(k=k, cp=cp, courant=0.2, loss=loss)
+    V = st.m / st.rho
+    area = np.sum(V[surface_sph(st.x, V, h, KERNEL)] ** 0.5)
+    assert area == pytest.approx(36 * dp)
+    tau = st.m.sum() * cp / (loss.h_c * area)
+    dt = thermal_step_limit(st, model, h)
+    n = int(np.ceil(tau / dt))
+    for _ in range(n):
+        st.T = conduct(st, model, h, KERNEL, tau / n)
+    theta = (st.T.mean() - 300.0) / 300.0
+    assert abs(theta / np.exp(-1.0) - 1) < 0.02, theta
+    hot = SurfaceLoss(h_c=0.0, emissivity=0.5, T_ambient=300.0).flux(np.array([1000.0]))
+    assert hot[0] == pytest.approx(0.5 * STEFAN_BOLTZMANN * (1000.0 ** 4 - 300.0 ** 4))
+    with pytest.raises(ValueError, match="emissivity"):
+        SurfaceLoss(h_c=1.0, emissivity=2.0, T_ambient=300.0)

@@ -120,18 +120,19 @@ def _at_time(snaps: list, t: float) -> dict | None:
     out = {"t": t}
     if "id" in a:                    # ids are matched, never interpolated (4079.0 may come back as 4078.999...)
         out["id"] = a["id"]
+    rows = _rows_of(b, a["id"]) if "id" in a else slice(None)
     for f in FIELDS:
         if f in a and f in b:
-            fb = _by_id(b, a["id"], f) if "id" in a and "id" in b else b[f]
-            out[f] = (1 - w) * a[f] + w * fb
+            out[f] = (1 - w) * a[f] + w * b[f][rows]
     return out
 
 
-def _by_id(z: dict, ids: np.ndarray, field: str) -> np.ndarray:
+def _rows_of(z: dict, ids: np.ndarray):
+    """The rows of snapshot ``z`` that hold particles ``ids`` (all rows, in order, where z has no ids)."""
     if "id" not in z:
-        return z[field]
+        return slice(None)
     order = np.argsort(z["id"])
-    return z[field][order][np.searchsorted(z["id"][order], ids)]
+    return order[np.searchsorted(z["id"][order], ids)]
 
 
 def compare_runs(ref: Path, test: Path, tolerances: dict | None = None) -> list[Row]:
@@ -146,12 +147,12 @@ def compare_runs(ref: Path, test: Path, tolerances: dict | None = None) -> list[
              for f in FIELDS if all(f in z for z in ref_snaps)}
     for p, z in zip(p_ref, ref_snaps):
         other = _at_time(test_snaps, z["t"])
-        ids = z.get("id", np.arange(len(z["x"])))
+        match = _rows_of(other, z.get("id", np.arange(len(z["x"])))) if other is not None else None
         for f in FIELDS:
             limit = _tolerance(tol, "field", f)
             if f not in z or limit is None:
                 continue
-            err = (_rel(_by_id(other, ids, f), z[f], scale.get(f)) if other is not None and f in other
+            err = (_rel(other[f][match], z[f], scale.get(f)) if other is not None and f in other
                    else float("inf"))
             rows.append(Row(f"{p.stem} (t = {z['t']:.4g} s) {f}", err, limit))
     return rows

@@ -150,9 +150,9 @@ def esph_rates(state: State, mat: ElasticMaterial, prm: ESPHParams, I: np.ndarra
     sums = blocks.reduce(lambda blk: _block_sums(blk, particle, mat, prm, d, part))
     rows = _row_layout(d, prm.correction, part)
 
-    zero = np.zeros((n, d, d))
-    drho, l, dS, dS_zz = np.zeros(n), None, zero, np.zeros(n)
-    if part != "forces":
+    if part == "forces":                                                # the deformation half is not asked for
+        drho, l, dS, dS_zz = np.zeros(n), None, np.zeros((n, d, d)), np.zeros(n)
+    else:
         drho = sums[rows["drho"]]                                       # Eq. (10)
         l = empty(n, d)                                                 # Eq. (23)
         for a in range(d):
@@ -165,7 +165,7 @@ def esph_rates(state: State, mat: ElasticMaterial, prm: ESPHParams, I: np.ndarra
                     M[:, a, b] = sums[rows["M"] + a * d + b]
             l = matmul(l, transpose(correction_matrix(M)[0]))
         dS, dS_zz = jaumann_deviatoric_rate(state.S, state.S_zz, l, mat.G)
-    acc = np.zeros((d, n))
+    acc = np.zeros((d, n)) if part == "deformation" else np.empty((d, n))
     if part != "deformation":
         # Eq. (11) with s = sigma / rho^2, the stress term split in an i-side and a j-side sum (as in TLSPH's
         # ReferenceOperator.momentum_sum), so that no pair array of d x d stresses is gathered:

@@ -207,7 +207,7 @@ def write_run(out, frames: list, history: dict, summary: dict, dim: int = 3) -> 
     out = Path(out)
     (out / "snapshots").mkdir(parents=True, exist_ok=True)
     first = frames[0]
-    X = _positions(first, dim)[np.argsort(np.argsort(first["id"]))]
+    X = _positions(first, dim)                  # every frame has the first frame's rows (checked below)
     ids0 = first["id"]
     for k, fr in enumerate(frames):
         if not np.array_equal(fr["id"], ids0):

@@ -402,6 +402,7 @@ def simulate(setup: Setup, method: str | None = None, *, scene: Scene | None = N
     rec.summary.update(meta or {})
     record_every = rec.record_every
     show = _Progress(label or f"{name} {method} {state.dim}D", setup.t_end, progress)
+    kernel, rigid_ids = get_kernel(setup.numerics.kernel), [b.body for b in setup.rigid]
     try:
         while state.t < setup.t_end * (1 - 1e-12):
             step_dt = _time_step(setup, dt, state)
@@ -409,8 +410,7 @@ def simulate(setup: Setup, method: str | None = None, *, scene: Scene | None = N
             step_dt = min(step_dt, rec.next_output_time() - state.t)   # snapshots land on their nominal times
             prev, state = state, step_or_fail(state, solver, step_dt, rec, stepper)
             if setup.thermal is not None:                   # heat conduction, after the mechanical step
-                state.T = conduct(state, setup.thermal, setup.h, get_kernel(setup.numerics.kernel), step_dt,
-                                  [b.body for b in setup.rigid])
+                state.T = conduct(state, setup.thermal, setup.h, kernel, step_dt, rigid_ids)
             if hook is not None:
                 state = hook(state, solver) or state
                 if not (np.isfinite(state.v).all() and np.isfinite(state.x).all()):

@@ -18,6 +18,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial import Delaunay
 
+from .esph import velocity_gradient
 from .kernels import Kernel
 from .neighbours import PairSum, find_pairs
 
@@ -30,13 +31,9 @@ def moment_min_eigenvalue(x: np.ndarray, V: np.ndarray, h: float, kernel: Kernel
     n, d = x.shape
     I, J = find_pairs(x, kernel.support * h)
     dx = x[I] - x[J]
-    fr = kernel.dw_dr_over_r(np.sqrt(np.sum(dx * dx, axis=1)), h, d)
-    ps = PairSum(I, J, n)
-    M = np.empty((n, d, d))
-    for a in range(d):
-        for b in range(d):
-            M[:, a, b] = -ps.symmetric(dx[:, a] * dx[:, b] * fr, V)      # x_ij,a (fr x_ij,b): symmetric pair term
-    return np.linalg.eigvalsh(M)[:, 0]
+    gW = kernel.dw_dr_over_r(np.sqrt(np.sum(dx * dx, axis=1)), h, d)[:, None] * dx
+    M = velocity_gradient(PairSum(I, J, n), V, dx, gW)     # Eq. (23) with v replaced by x: the moment matrix
+    return np.linalg.eigvalsh(np.ascontiguousarray(M))[:, 0]
 
 
 def surface_sph(x: np.ndarray, V: np.ndarray, h: float, kernel: Kernel, threshold: float = 0.75) -> np.ndarray:

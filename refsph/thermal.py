@@ -43,12 +43,16 @@ def laplacian(f: np.ndarray, x: np.ndarray, V: np.ndarray, h: float, kernel: Ker
     """Eq. (26), Brookshaw's SPH Laplacian of the particle field ``f`` (N,) at positions ``x`` (N, d) with volumes
     ``V``: lap f_i = sum_j 2 (f_i - f_j) (dW/dr)(r_ij) / r_ij V_j. ``pairs``: half pairs (I, J) within the
     support, if the caller has them (refsph's convention: I < J, each pair once)."""
-    n, d = x.shape
+    I, J, fr = _pairs_and_fr(x, h, kernel, pairs)
+    t = 2.0 * (f[I] - f[J]) * fr                            # antisymmetric under i <-> j
+    return PairSum(I, J, len(x)).antisymmetric(t, V)
+
+
+def _pairs_and_fr(x: np.ndarray, h: float, kernel: Kernel, pairs: tuple | None = None):
+    """Half pairs within the support (``pairs`` if given) and (dW/dr)/r on each."""
     I, J = pairs if pairs is not None else find_pairs(x, kernel.support * h)
     r = np.sqrt(np.sum((x[I] - x[J]) ** 2, axis=1))
-    fr = kernel.dw_dr_over_r(r, h, d)                       # (dW/dr) / r, zero beyond the support
-    t = 2.0 * (f[I] - f[J]) * fr                            # antisymmetric under i <-> j
-    return PairSum(I, J, n).antisymmetric(t, V)
+    return I, J, kernel.dw_dr_over_r(r, h, x.shape[1])      # zero beyond the support
 
 
 def conduction_rate(T: np.ndarray, x: np.ndarray, V: np.ndarray, a: np.ndarray | float, h: float, kernel: Kernel,
@@ -126,22 +130,20 @@ class Conduction:
         if len(self.fixed) and self.T_fixed is None:
             raise ValueError("Conduction.fixed needs T_fixed (the temperature the fixed particles are held at)")
 
-    def coefficients(self, body: np.ndarray | None, n: int) -> tuple[np.ndarray, np.ndarray]:
-        """Per-particle conductivity and heat capacity (deformable rows: k, cp; tool rows: their own; other rigid
-        rows are insulators: k = 0, cp = 1)."""
+    def coefficients(self, body: np.ndarray | None, n: int, rigid_ids=()) -> tuple[np.ndarray, np.ndarray]:
+        """Per-particle conductivity and heat capacity: deformable rows k, cp; the rows of a conducting tool its
+        own; the rows of the other rigid bodies ``rigid_ids`` insulate (k = 0)."""
         k, c = np.full(n, float(self.k)), np.full(n, float(self.cp))
         if body is not None:
             for b, (kb, cb) in self.tools.items():
                 k[body == b], c[body == b] = kb, cb
+            k[np.isin(body, [b for b in rigid_ids if b not in self.tools])] = 0.0
         return k, c
 
 
 def thermal_step_limit(state, model: Conduction, h: float, rigid_ids=()) -> float:
     """courant * min_i rho_i c_i h^2 / k_i over the conducting particles."""
-    k, c = model.coefficients(state.body, state.n)
-    if state.body is not None and len(rigid_ids):
-        insulating = np.isin(state.body, [b for b in rigid_ids if b not in model.tools])
-        k = np.where(insulating, 0.0, k)
+    k, c = model.coefficients(state.body, state.n, rigid_ids)
     on = k > 0
     return float(model.courant * np.min(state.rho[on] * c[on] * h * h / k[on])) if np.any(on) else np.inf
 
@@ -150,12 +152,8 @@ def conduct(state, model: Conduction, h: float, kernel: Kernel, dt: float, rigid
     """The temperatures after an explicit conduction step of dt (module text), fixed particles reset. Pairs are
     found in the current configuration, across bodies (heat flows from the chip into a conducting tool)."""
     n, d = state.x.shape
-    k, c = model.coefficients(state.body, n)
-    if state.body is not None and len(rigid_ids):
-        k = np.where(np.isin(state.body, [b for b in rigid_ids if b not in model.tools]), 0.0, k)
-    I, J = find_pairs(state.x, kernel.support * h)
-    r = np.sqrt(np.sum((state.x[I] - state.x[J]) ** 2, axis=1))
-    fr = kernel.dw_dr_over_r(r, h, d)
+    k, c = model.coefficients(state.body, n, rigid_ids)
+    I, J, fr = _pairs_and_fr(state.x, h, kernel)
     kk = k[I] + k[J]
     k_ij = np.divide(2.0 * k[I] * k[J], kk, out=np.zeros_like(kk), where=kk > 0)
     V = state.m / state.rho

@@ -279,13 +279,15 @@ def tlsph_rates(state: State, mat: ElasticMaterial, prm: TLSPHParams, op: Refere
     rho = rho_ref / J                                       # Eq. (2)
     p = eos_pressure(rho, mat.rho0, mat.K)                  # Eq. (24)
     l, P = None, None
-    dS, dS_zz = np.zeros((n, d, d)), np.zeros(n)
-    if part != "forces":
+    if part == "forces":                                    # the deformation half is not asked for
+        dS, dS_zz = np.zeros((n, d, d)), np.zeros(n)
+    else:
         Fdot = op.gradient(v)                               # Eq. (19)
         l = matmul(Fdot, Finv)
         dS, dS_zz = jaumann_deviatoric_rate(state.S, state.S_zz, l, mat.G)
-    a = np.zeros((n, d))
-    if part != "deformation":
+    if part == "deformation":                               # the force half is not asked for
+        a = np.zeros((n, d))
+    else:
         sigma = cauchy_stress(state.S, p)
         P = first_piola(sigma, J, Finv)
         # Eq. (17), stress part: a_i = sum_j m_j (P_i / rho_0i^2 grad~_i W_ij - P_j / rho_0j^2 grad~_j W_ji)

@@ -68,14 +68,14 @@ def test_compare_null_tolerance(tmp_path):
 def test_interpolation_matches_ids_exactly():
     """TEST snapshots between REF's times are interpolated particle by particle: ids are matched, not
     interpolated (0.7 * 4079 + 0.3 * 4079 is 4078.999... in floating point), whatever the row order."""
-    from refsph.compare import _at_time, _by_id
+    from refsph.compare import _at_time, _rows_of
     ids = np.arange(10000)
     perm = np.random.default_rng(2).permutation(ids)
     a = dict(t=0.0, id=ids, v=ids.astype(float)[:, None] * np.ones((1, 2)))
     b = dict(t=1.0, id=perm, v=perm.astype(float)[:, None] * np.ones((1, 2)))
     for t in (0.3, 0.7, 0.123):
         z = _at_time([a, b], t)
-        assert np.max(np.abs(_by_id(z, ids, "v")[:, 0] - ids)) < 1e-9        # not a neighbour's value
+        assert np.max(np.abs(z["v"][_rows_of(z, ids)][:, 0] - ids)) < 1e-9        # not a neighbour's value
 
 
 def test_bar_period_from_amplitude():

@@ -46,8 +46,9 @@ Eqs. (10)-(11)):
     f_t = - min(mu(T) F_ij, m_ij |v_t| / dt) v_t / |v_t|,   mu(T) = mu0 (1 - ((T - T_r)/(T_m - T_r))^q)
 
 with T the temperature of the deformable particle. The cap m_ij |v_t| / dt (sticking) keeps friction from
-reversing the sliding within a step. The frictional heat (their Eq. (7)) is not added: refsph has no heat
-conduction, which is where that heat would go.
+reversing the sliding within a step. The friction power of each pair, |f_t| |v_t| [W; per metre of thickness in
+2D], is returned per particle on both sides (``ContactResult.friction_power_a`` / ``_b``): the frictional heat
+of their Eq. (7), q = eta |f_fric| |v_rel|, which :mod:`refsph.thermal` deposits when a run conducts heat.
 """
 from __future__ import annotations
 
@@ -140,12 +141,16 @@ def pinball_force(p_d, pdot, m_ij, mu_ij, R_i, R_j, dt, K_p, thickness=1.0):
 class ContactResult:
     """Forces of one contact evaluation. ``a``: (n_a, d) acceleration added to each particle of the
     deformable set (Eq. (36)); ``force_on_b``: (n_b, d) force on each partner particle (the reaction, equal and
-    opposite pair by pair); ``n_contacts``: pairs with p_d > 0; ``max_penetration``: max p_d [m] (0 if none)."""
+    opposite pair by pair); ``n_contacts``: pairs with p_d > 0; ``max_penetration``: max p_d [m] (0 if none);
+    ``friction_power_a``, ``friction_power_b``: (n_a,), (n_b,) the friction power |f_t| |v_t| of each particle's
+    pairs [W] (each pair's power counted once on each side; zeros without friction)."""
 
     a: np.ndarray
     force_on_b: np.ndarray
     n_contacts: int
     max_penetration: float
+    friction_power_a: np.ndarray | None = None
+    friction_power_b: np.ndarray | None = None
 
 
 def pinball_contact(x_a, v_a, m_a, x_b, v_b, m_b, R, mu_a, mu_b, dt, contact: PinballContact,
@@ -178,6 +183,7 @@ def pinball_contact(x_a, v_a, m_a, x_b, v_b, m_b, R, mu_a, mu_b, dt, contact: Pi
     mu_ij = reduced(mu_a, mu_b)
     F = pinball_force(p_d, pdot, m_ij, mu_ij, R, R, dt, contact.K_p, thickness)   # Eqs. (33)-(35)
     f = e * F[:, None]                                                   # on a, along the line of centres
+    power_a, power_b = np.zeros(n_a), np.zeros(len(x_b))
     if contact.friction is not None:
         if T_a is None:
             raise ValueError("friction needs the temperatures of the deformable body")
@@ -186,9 +192,11 @@ def pinball_contact(x_a, v_a, m_a, x_b, v_b, m_b, R, mu_a, mu_b, dt, contact: Pi
         ft = np.minimum(contact.friction.mu(np.take(T_a, I)) * F, m_ij * speed / dt)
         with np.errstate(invalid="ignore", divide="ignore"):
             f -= np.where(speed[:, None] > 0, vt / speed[:, None], 0.0) * ft[:, None]
+        power_a = np.bincount(I, weights=ft * speed, minlength=n_a)      # |f_t| |v_t|, the work friction does
+        power_b = np.bincount(J, weights=ft * speed, minlength=len(x_b))
     for k in range(d):                                                   # Eq. (36), equal and opposite
         a[:, k] = np.bincount(I, weights=f[:, k], minlength=n_a) / m_a
         force_b[:, k] = -np.bincount(J, weights=f[:, k], minlength=len(x_b))
     inside = p_d > 0
     return ContactResult(a, force_b, int(np.count_nonzero(inside)),
-                         float(np.max(p_d[inside])) if inside.any() else 0.0)
+                         float(np.max(p_d[inside])) if inside.any() else 0.0, power_a, power_b)

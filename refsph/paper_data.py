@@ -11,7 +11,8 @@ from __future__ import annotations
 
 __all__ = ["TAYLOR_TABLE1", "TAYLOR_TABLE2", "TAYLOR_GEOMETRY", "TAYLOR_RESULTS", "AISI4340_TABLE3",
            "PRESSING_TABLE4", "PRESSING_GEOMETRY", "PRESSING_RESOLUTIONS_M", "CUTTING_TABLE5", "CUTTING_GEOMETRY",
-           "CUTTING_OBSERVED", "AISI1045_RLA", "TI6AL4V_RLA", "TOOL_CARBIDE_RLA", "CONTACT_RLA", "RLA_CUTTING_COLUMNS",
+           "CUTTING_OBSERVED", "AISI1045_RLA", "TI6AL4V_RLA", "TOOL_CARBIDE_RLA", "CONTACT_RLA", "RLA_SURFACE_LOSS",
+           "RLA_CUTTING_COLUMNS",
            "RLA_CUTTING_CASES", "rla_cutting_case"]
 
 # Table 1: Johnson-Cook parameters of low-strength 4340 steel, as printed (T_m = 1293 K; 1793 K is usual)
@@ -75,6 +76,10 @@ TI6AL4V_RLA = dict(rho=4430.0, E_Pa=110e9, nu=0.342, k_W_mK=7.44, cp_J_kgK=553.0
 # the tool: rigid mechanically, conducting heat; cp as printed (15 J/(kg K): a reduced heat capacity, so that the
 # tool reaches its steady temperature within the short simulated cut)
 TOOL_CARBIDE_RLA = dict(rho=15700.0, E_Pa=600e9, nu=0.2, k_W_mK=59.0, cp_J_kgK=15.0)
+# Not printed by the paper: the convection coefficient and emissivity of their Eq. (6). refsph takes h_c = 20
+# W/(m^2 K) (free convection in air, the usual default of cutting codes) and emissivity 0.3 (bright machined steel);
+# over a few ms of cut these losses are below 1e-3 of the heat made (benchmarks/thermal_cutting.json, heat balance).
+RLA_SURFACE_LOSS = dict(h_c=20.0, emissivity=0.3)
 CONTACT_RLA = dict(T_ref_K=293.0, plastic_work_to_heat=0.9, friction_work_to_heat=1.0)
 RLA_CUTTING_COLUMNS = ("case", "material", "vc_m_per_min", "tu_mm", "Fc_exp_N", "Fp_exp_N", "TRF_exp_K", "TFCS_exp_K",
                        "Fc_sph_N", "Fp_sph_N", "TRF_sph_K", "TFCS_sph_K", "Fc_pfem_N", "Fp_pfem_N", "TRF_pfem_K",

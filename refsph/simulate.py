@@ -28,7 +28,7 @@ from .contact import PinballContact
 from .esph import ESPHParams
 from .integrate import Solver, cfl_time_step, get_stepper
 from .stability import warnings_for
-from .thermal import conduct, thermal_step_limit
+from .thermal import thermal_step, thermal_step_limit
 from .boundaries import Clamp
 from .io import json_ready, save_reactions, save_snapshot, state_from_particles, state_from_snapshot, write_json
 from .kernels import get_kernel
@@ -166,6 +166,7 @@ class RunRecord:
         self.times, self.next_snap = times, 0
         self.n_steps, self.dts, self.record_every = 0, [], 1
         self.t0, self.c0 = time.perf_counter(), time.process_time()
+        self.heat = None if setup.thermal is None else dict(plastic=0.0, friction=0.0, lost=0.0, removed=0.0)
         if resume is not None:
             self._resume(resume)
         if self.out is not None:
@@ -186,6 +187,8 @@ class RunRecord:
         self.dts = list(np.asarray(ck["dts"], dtype=float))
         self.t0 -= float(r["wall_time_s"])
         self.c0 -= float(r["cpu_time_s"])
+        if self.heat is not None:
+            self.heat = {k: float(v) for k, v in r["heat"].items()}
 
     def checkpoint(self, snapshot: str) -> None:
         """``snapshots/restart.npz``: what :func:`simulate` needs to continue from snapshot ``snapshot`` exactly as
@@ -195,7 +198,8 @@ class RunRecord:
         run = dict(snapshot=snapshot, history={k: v for k, v in self.history.items() if k != "reaction"},
                    snapshots=self.snapshots, next_snap=self.next_snap, n_steps=self.n_steps,
                    record_every=self.record_every, wall_time_s=time.perf_counter() - self.t0,
-                   cpu_time_s=time.process_time() - self.c0, restarts=self.summary.get("restarts", 0))
+                   cpu_time_s=time.process_time() - self.c0, restarts=self.summary.get("restarts", 0),
+                   heat=self.heat)
         arrays = {f"solver/{k}": v for k, v in self.solver.checkpoint().items()}
         arrays.update({f"stepper/{k}": v for k, v in (getattr(self.solver, "stepper_state", None) or {}).items()})
         path = self.out / "snapshots" / CHECKPOINT
@@ -223,6 +227,32 @@ class RunRecord:
         if self.record_fn is not None:
             for k, val in self.record_fn(state, self.setup).items():
                 self.history.setdefault(k, []).append(val)
+        if self.heat is not None:
+            for k, val in self.heat_balance(state).items():
+                self.history.setdefault(f"heat_{k}", []).append(val)
+
+    def heat_capacity(self, state: State) -> np.ndarray:
+        """m c per row [J/K] (the conducting model's c; rigid rows that do not conduct: their cp, never heated)."""
+        rigid = [b.body for b in self.setup.rigid]
+        return state.m * self.setup.thermal.coefficients(state.body, state.n, rigid)[1]
+
+    def add_heat(self, before: State, after: State, moved: dict) -> None:
+        """Add one step to the heat ledger: the plastic heat is what the mechanical step added to the
+        temperatures (the return map, Eq. (28)); ``moved``: the heat :func:`refsph.thermal.thermal_step` moved."""
+        self.heat["plastic"] += float(np.sum(self.heat_capacity(after) * (after.T - before.T)))
+        for k in ("friction", "lost", "removed"):
+            self.heat[k] += moved[k]
+
+    def heat_balance(self, state: State) -> dict:
+        """The heat ledger [J; per metre of thickness in 2D]: made (plastic, friction), stored (sum m c (T - T0)),
+        lost (surface), removed (at fixed temperatures), and the residual made - stored - lost - removed."""
+        stored = float(np.sum(self.heat_capacity(state) * (state.T - self.setup.state.T)))
+        h = self.heat
+        made = h["plastic"] + h["friction"]
+        residual = made - stored - h["lost"] - h["removed"]
+        return dict(plastic_J=h["plastic"], friction_J=h["friction"], stored_J=stored, lost_J=h["lost"],
+                    removed_J=h["removed"], residual_J=residual,
+                    residual_rel=residual / made if made > 0 else 0.0)
 
     def save(self, name: str, state: State) -> Path:
         path = self.out / "snapshots" / name
@@ -258,6 +288,8 @@ class RunRecord:
             dt_min=float(min(dts)) if dts else None, dt_max=float(max(dts)) if dts else None,
             particle_steps_per_s=state.n * self.n_steps / wall if wall > 0 else None,
             snapshots=list(self.snapshots), diagnostics=self.solver.diagnostics())
+        if self.heat is not None:
+            self.summary["heat_balance"] = self.heat_balance(state)
         reactions = self.solver.reaction_history()
         if reactions:
             self.history["reaction"] = reactions
@@ -410,7 +442,10 @@ def simulate(setup: Setup, method: str | None = None, *, scene: Scene | None = N
             step_dt = min(step_dt, rec.next_output_time() - state.t)   # snapshots land on their nominal times
             prev, state = state, step_or_fail(state, solver, step_dt, rec, stepper)
             if setup.thermal is not None:                   # heat conduction, after the mechanical step
-                state.T = conduct(state, setup.thermal, setup.h, kernel, step_dt, rigid_ids)
+                T, moved = thermal_step(state, setup.thermal, setup.h, kernel, step_dt, rigid_ids,
+                                        getattr(solver, "friction_power", None))
+                rec.add_heat(prev, state, moved)
+                state.T = T
             if hook is not None:
                 state = hook(state, solver) or state
                 if not (np.isfinite(state.v).all() and np.isfinite(state.x).all()):

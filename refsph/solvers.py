@@ -197,6 +197,7 @@ class TLSPHSolver:
         self.dp, self.contact = dp, contact
         self.max_penetration = 0.0
         self.n_contacts = 0
+        self.friction_power: tuple | None = None           # (deformable rows, rigid rows) [W], last contact
         self.op: ReferenceOperator | None = None
         self._ghost_constant: tuple | None = None          # extended (m, X, V0) of the operator's ghosts
         self._constant: tuple | None = None                # (whole m, X, V0) -> their deformable rows (views)
@@ -362,6 +363,7 @@ class TLSPHSolver:
                                      T_a=None if state.T is None else state.T[:n])
         self.max_penetration = max(self.max_penetration, c.max_penetration)
         self.n_contacts = c.n_contacts
+        self.friction_power = (c.friction_power_a, c.friction_power_b)   # the frictional heat (refsph.thermal)
         return c
 
     def finish_stage(self, old: State, new: State, rates: Rates, dt: float, final: bool) -> State:

@@ -23,6 +23,23 @@ one material and carries no flux to an insulating body (k = 0):
     dT_i/dt = 1 / (rho_i c_i) sum_j 2 k_ij (T_i - T_j) (dW/dr)(r_ij) / r_ij V_j              (:func:`conduct`)
 
 Every pair term moves heat and creates none: sum_i m_i c_i T_i is conserved to round-off.
+
+The sources and sinks of a cutting run (:func:`thermal_step`, one explicit step after the mechanical one):
+
+* **plastic heat** chi sigma_y epsdot_p (their Eq. (5)): added by the return map of the strength model
+  (:mod:`refsph.plasticity`, Eq. (28) of the first paper), as in the adiabatic runs;
+* **frictional heat** q = eta |f_fric| |v_rel| (their Eq. (7)), from the friction power of each contact pair
+  (:mod:`refsph.contact`), split by :class:`FrictionHeat`: a fraction ``chip_fraction`` to the workpiece particle
+  of the pair, the rest to the tool particle. The second paper does not say how it splits; the heat is made at
+  the interface and conduction across it (harmonic-mean k, above) moves it to wherever the temperatures send it,
+  so the split only places the source; 1/2 is the neutral choice (Blok's partition would need the contact
+  temperature it is meant to predict);
+* **losses** on the free surface (:class:`SurfaceLoss`, Eq. (6)), on the particles a surface detector marks
+  (:mod:`refsph.surface`: the SPH detector or the alpha-shape);
+* **fixed temperatures** (Dirichlet rows): the heat the reset removes is counted.
+
+:func:`thermal_step` returns the heat of each kind it moved in the step, so a run can keep the balance
+plastic + friction = stored + lost + removed at fixed rows (``summary.json``'s ``heat_balance``).
 """
 from __future__ import annotations
 
@@ -32,10 +49,10 @@ import numpy as np
 
 from .kernels import Kernel
 from .neighbours import PairSum, find_pairs
-from .surface import surface_sph
+from .surface import surface_alpha_shape, surface_sph
 
 __all__ = ["laplacian", "conduction_rate", "thermal_time_step", "advance_at_rest", "Conduction", "SurfaceLoss",
-           "conduct", "thermal_step_limit", "STEFAN_BOLTZMANN"]
+           "FrictionHeat", "conduct", "thermal_step", "thermal_step_limit", "free_surface", "STEFAN_BOLTZMANN"]
 
 
 def laplacian(f: np.ndarray, x: np.ndarray, V: np.ndarray, h: float, kernel: Kernel,
@@ -49,7 +66,7 @@ def laplacian(f: np.ndarray, x: np.ndarray, V: np.ndarray, h: float, kernel: Ker
 
 
 def _pairs_and_fr(x: np.ndarray, h: float, kernel: Kernel, pairs: tuple | None = None):
-    """Half pairs within the support (``pairs`` if given) and (dW/dr)/r on each."""
+    """Half pairs within the support (``pairs`` if given) and (dW/dr)/r on each: (I, J, fr)."""
     I, J = pairs if pairs is not None else find_pairs(x, kernel.support * h)
     r = np.sqrt(np.sum((x[I] - x[J]) ** 2, axis=1))
     return I, J, kernel.dw_dr_over_r(r, h, x.shape[1])      # zero beyond the support
@@ -91,16 +108,23 @@ STEFAN_BOLTZMANN = 5.670374419e-8          # W/(m^2 K^4)
 @dataclass(frozen=True)
 class SurfaceLoss:
     """Heat lost on free surfaces (the second paper's Eq. (6)): q = h_c (T_s - T_inf) + emissivity sigma_SB
-    (T_s^4 - T_inf^4) [W/m^2], on the particles :func:`refsph.surface.surface_sph` marks, each with the area
-    V^((d-1)/d) (a spacing per unit thickness in 2D, a spacing squared in 3D)."""
+    (T_s^4 - T_inf^4) [W/m^2], on the particles the ``detector`` marks ('sph': :func:`refsph.surface.surface_sph`;
+    'alpha': :func:`refsph.surface.surface_alpha_shape` with circumradius limit ``alpha_radius`` [m]), each with
+    the area V^((d-1)/d) (a spacing per unit thickness in 2D, a spacing squared in 3D)."""
 
     h_c: float
     emissivity: float
     T_ambient: float
+    detector: str = "sph"
+    alpha_radius: float | None = None
 
     def __post_init__(self):
         if not (self.h_c >= 0 and 0 <= self.emissivity <= 1 and self.T_ambient > 0):
             raise ValueError(f"SurfaceLoss needs h_c >= 0, 0 <= emissivity <= 1, T_ambient > 0; got {self}")
+        if self.detector not in ("sph", "alpha"):
+            raise ValueError(f"SurfaceLoss.detector must be 'sph' or 'alpha', got {self.detector!r}")
+        if self.detector == "alpha" and not (self.alpha_radius is not None and self.alpha_radius > 0):
+            raise ValueError("the alpha-shape detector needs alpha_radius > 0 [m] (PFEM codes: 1.2-1.5 spacings)")
 
     def flux(self, T: np.ndarray) -> np.ndarray:
         """q(T) [W/m^2], Eq. (6)."""
@@ -108,11 +132,28 @@ class SurfaceLoss:
 
 
 @dataclass(frozen=True)
+class FrictionHeat:
+    """The frictional heat of the second paper's Eq. (7), q = ``eta`` |f_fric| |v_rel| (eta: the fraction of the
+    friction work that becomes heat, 1 in their Table A3), a fraction ``chip_fraction`` of it into the
+    deformable particle of each contact pair, the rest into the tool particle (module text). No defaults."""
+
+    eta: float
+    chip_fraction: float
+
+    def __post_init__(self):
+        for name in ("eta", "chip_fraction"):
+            v = getattr(self, name)
+            if not (np.isfinite(v) and 0.0 <= v <= 1.0):
+                raise ValueError(f"FrictionHeat.{name} must lie in [0, 1], got {v!r}")
+
+
+@dataclass(frozen=True)
 class Conduction:
     """Heat conduction during a run (``Setup.thermal``). ``k`` [W/(m K)] and ``cp`` [J/(kg K)]: the deformable
     bodies'; ``courant``: the factor on rho c_p h^2 / k; ``tools``: {body id: (k, cp)} of the rigid bodies that
     conduct (the others insulate); ``fixed``: particle indices held at ``T_fixed`` [K] (a fixed surface at room
-    temperature); ``loss``: convection and radiation on the free surfaces (:class:`SurfaceLoss`; None: none)."""
+    temperature); ``loss``: convection and radiation on the free surfaces (:class:`SurfaceLoss`; None: none);
+    ``friction_heat``: where the friction work goes (:class:`FrictionHeat`; None: friction makes no heat)."""
 
     k: float
     cp: float
@@ -121,6 +162,7 @@ class Conduction:
     fixed: tuple = ()
     T_fixed: float | None = None
     loss: SurfaceLoss | None = None
+    friction_heat: FrictionHeat | None = None
 
     def __post_init__(self):
         for name in ("k", "cp", "courant"):
@@ -148,9 +190,28 @@ def thermal_step_limit(state, model: Conduction, h: float, rigid_ids=()) -> floa
     return float(model.courant * np.min(state.rho[on] * c[on] * h * h / k[on])) if np.any(on) else np.inf
 
 
+def free_surface(x: np.ndarray, V: np.ndarray, h: float, kernel: Kernel, loss: SurfaceLoss,
+                 pairs: tuple | None = None) -> np.ndarray:
+    """The free-surface rows by ``loss.detector`` (every particle of the scene takes part, so that a face in contact
+    with another body is not free). ``pairs``: the half pairs within the support, if the caller has them."""
+    if loss.detector == "alpha":
+        return surface_alpha_shape(x, 1.0, alpha=loss.alpha_radius)
+    return surface_sph(x, V, h, kernel, pairs=pairs)
+
+
 def conduct(state, model: Conduction, h: float, kernel: Kernel, dt: float, rigid_ids=()) -> np.ndarray:
-    """The temperatures after an explicit conduction step of dt (module text), fixed particles reset. Pairs are
-    found in the current configuration, across bodies (heat flows from the chip into a conducting tool)."""
+    """The temperatures after an explicit conduction step of dt (module text), fixed particles reset: the
+    temperatures of :func:`thermal_step` without frictional heat."""
+    return thermal_step(state, model, h, kernel, dt, rigid_ids)[0]
+
+
+def thermal_step(state, model: Conduction, h: float, kernel: Kernel, dt: float, rigid_ids=(),
+                 friction_power: tuple | None = None) -> tuple[np.ndarray, dict]:
+    """One explicit step dt of Eq. (29) with the harmonic-mean conductivity between materials (module text),
+    the frictional heat (``friction_power``: (deformable rows, rigid rows) [W], as the TLSPH contact leaves it;
+    split by ``model.friction_heat``), the surface loss, then the fixed rows reset. Pairs are found in the
+    current configuration, across bodies (heat flows from the chip into a conducting tool). Returns (T, heat)
+    with heat = {'friction', 'lost', 'removed'} [J; per metre of thickness in 2D] moved in the step."""
     n, d = state.x.shape
     k, c = model.coefficients(state.body, n, rigid_ids)
     I, J, fr = _pairs_and_fr(state.x, h, kernel)
@@ -158,12 +219,25 @@ def conduct(state, model: Conduction, h: float, kernel: Kernel, dt: float, rigid
     k_ij = np.divide(2.0 * k[I] * k[J], kk, out=np.zeros_like(kk), where=kk > 0)
     V = state.m / state.rho
     q = 2.0 * k_ij * (state.T[I] - state.T[J]) * fr            # antisymmetric pair flux
+    mc = state.m * c
     dT = dt * PairSum(I, J, n).antisymmetric(q, V) / (state.rho * c)
+    heat = dict(friction=0.0, lost=0.0, removed=0.0)
+    if model.friction_heat is not None and friction_power is not None and friction_power[0] is not None:
+        fh = model.friction_heat
+        Q = np.zeros(n)                                     # the heat each row receives in the step [J]
+        Pa, Pb = friction_power
+        Q[:len(Pa)] += fh.eta * fh.chip_fraction * dt * Pa
+        Q[n - len(Pb):] += fh.eta * (1.0 - fh.chip_fraction) * dt * Pb
+        dT += Q / mc
+        heat["friction"] = float(Q.sum())
     if model.loss is not None:                              # Eq. (6) on the free surface of the conducting rows
-        on = surface_sph(state.x, V, h, kernel) & (k > 0)
-        area = V[on] ** ((d - 1) / d)
-        dT[on] -= dt * model.loss.flux(state.T[on]) * area / (state.m[on] * c[on])
+        on = free_surface(state.x, V, h, kernel, model.loss, (I, J)) & (k > 0)
+        lost = dt * model.loss.flux(state.T[on]) * V[on] ** ((d - 1) / d)
+        dT[on] -= lost / mc[on]
+        heat["lost"] = float(lost.sum())
     T = state.T + dT
     if len(model.fixed):
-        T[np.asarray(model.fixed)] = model.T_fixed
-    return T
+        fixed = np.asarray(model.fixed)
+        heat["removed"] = float(np.sum(mc[fixed] * (T[fixed] - model.T_fixed)))
+        T[fixed] = model.T_fixed
+    return T, heat

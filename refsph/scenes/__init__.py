@@ -6,11 +6,11 @@ report. The registry :data:`SCENES` is what ``refsph list`` prints.
 * :mod:`.measure` -- what the scenes share: lattices, the Table 3 material, time averages, energies, momentum;
 * :mod:`.bar`, :mod:`.tension` -- elastic test cases; :mod:`.spinning_disc`, :mod:`.rings` -- hard cases
   (objectivity; contact and fracture); :mod:`.taylor`, :mod:`.pressing`, :mod:`.cutting` -- the
-  paper's three benchmarks (Sections 3.1-3.3).
+  paper's three benchmarks (Sections 3.1-3.3); :mod:`.thermal_cutting` -- the second paper's 18 measured cuts.
 """
 from __future__ import annotations
 
-from . import bar, cutting, pressing, rings, spinning_disc, taylor, tension
+from . import bar, cutting, pressing, rings, spinning_disc, taylor, tension, thermal_cutting
 from .base import Numerics, Scene, Setup, convert_options, parse_bool
 from .measure import (aisi4340_johnson_cook, aisi4340_material, block_lattice, elastic_energy, kinetic_energy,
                       lattice, linear_momentum, min_pair_distance)
@@ -20,7 +20,7 @@ __all__ = ["Numerics", "Setup", "Scene", "SCENES", "get_scene", "convert_options
            "linear_momentum", "min_pair_distance"]
 
 SCENES: dict[str, Scene] = {m.SCENE.name: m.SCENE for m in (bar, tension, spinning_disc, rings, taylor,
-                                                              pressing, cutting)}
+                                                              pressing, cutting, thermal_cutting)}
 
 
 def get_scene(name: str) -> Scene:

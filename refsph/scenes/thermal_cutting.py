@@ -1,0 +1,299 @@
+"""Thermomechanical orthogonal cutting after Rodriguez Prieto, Larsson & Afrasiabi (2023): the 18 measured cuts of
+their Appendix B (AISI 1045 at 60/120/180 m/min, Ti6Al4V at 20/40/60 m/min; uncut chip thickness 0.10/0.15/0.20 mm),
+2D plane strain, TLSPH (the formulation whose tool contact carries friction; ESPH's tool is a set of SPH
+neighbours with no friction law, so this scene runs TLSPH only).
+
+The model, as in their Sections 2.1-2.4 and Tables 1-2, A1-A3 (``refsph.paper_data``), and what refsph chooses:
+
+* **Workpiece** [0, L] x [0, 3 t_u] (L = 3 mm, 3 t_u high: their "at least 3x"), spacing dx = t_u / ``n_tu``
+  (5 by default: the time budget of a 2-core machine; their PFEM uses 10-20 across t_u, their SPH does not say),
+  held (v = 0, T = 293 K) on its bottom row and its left column (their "fixed surfaces").
+* **Material**: modified Johnson-Cook (their Eq. (9): hardening frozen past plastic strain 2, AISI 1045; Ti6Al4V
+  has no limit in their table), chi = 0.9 (Table A3), plastic heat through the return map.
+* **Tool**: rigid, 10 deg rake, 10 deg clearance, moving at -v_c along x with its cutting edge at the cut depth
+  3 t_u - t_u = 2 t_u. Its particles are a lattice aligned with the rake face (the face the chip slides on is
+  flat, not a staircase), 5 t_u along the rake face and 3 t_u deep, the wedge of 70 deg between rake and
+  clearance face, the edge rounded to 10 um (below the spacing at the default resolution: the lattice has no
+  particle in the cut-off corner, so the edge is as sharp as dx). Mechanically it is only contact (the pinball,
+  :mod:`refsph.contact`); thermally it conducts with its own k and the paper's reduced heat capacity
+  c_p = 15 J/(kg K) (Table A2; their reason, after Childs: the tool reaches its steady temperature within the
+  short simulated cut instead of seconds), held at 293 K on its top and back faces.
+* **Friction**: Coulomb, mu(T) = mu0 (1 - T*^q) (their Eqs. (10)-(11), Table 2) in the pinball contact;
+  frictional heat eta |f| |v_rel| with eta = 1, half into the chip, half into the tool
+  (:class:`refsph.thermal.FrictionHeat`, ``chip_fraction``).
+* **Heat**: Brookshaw conduction in workpiece and tool (:mod:`refsph.thermal`), convection and radiation on the
+  free surface (their Eq. (6); h_c and the emissivity are not printed: :data:`refsph.paper_data.RLA_SURFACE_LOSS`)
+  on the particles the ``detector`` marks ('sph' or 'alpha').
+* **Numerics**: Wendland kernel, h = 1.3 dx, leapfrog, Courant 0.3 (their 0.25-0.40) on the smaller of the
+  mechanical and thermal steps; artificial viscosity beta1 = beta2 = 0.5 (the first paper's cutting, Table 5).
+* **Mass scaling** (the run-time remedy; their GPU code runs at the real speed): the density is multiplied by
+  s and the heat capacity divided by s, so rho c_p (hence conduction and the heating per unit plastic work) is
+  unchanged and only inertia changes; the wave speed falls by sqrt(s), the explicit step grows by about sqrt(s).
+  s is chosen so that s rho v_c^2 = ``inertia_ratio`` A (1 % of the initial yield stress by default), unless
+  ``mass_scale`` gives it. ``benchmarks/thermal_cutting.py --scaling`` measures what it changes.
+* **Cut length**: ``travel`` t_u (8 by default); steady-state means over the second half of the cut.
+
+Measurements (``metrics``; the experiment's values: :func:`refsph.paper_data.rla_cutting_case`):
+
+* ``cutting_force_N_per_m`` / ``passive_force_N_per_m``: the force of the workpiece on the tool along +x
+  (against the cut) and +y (pushing the tool off the workpiece), per metre of width, time means over the second
+  half of the cut; ``force_ratio`` = Fp / Fc (width-free, compared with the measured ratio);
+* ``rake_face_temperature_K``: the mean temperature of the chip particles in contact with the rake face (centre
+  within one spacing of it, from the cutting edge to the end of contact), time mean over the second half
+  (``rake_face_temperature_max_K``: the hottest of them);
+* ``free_chip_surface_temperature_K``: the mean temperature of the chip's outer layer (in each dx-band along
+  the rake face, the chip particles within one spacing of the farthest from the face) between 1 and 3 t_u along
+  the rake face, where the chip leaves the contact (what a camera on the chip's back sees), time mean;
+* ``chip_thickness_mm``: the median over dx-bands between 0.5 and 2 t_u along the rake face of the distance of
+  the farthest chip particle from the face plus dx/2, time mean; ``contact_length_mm``: the distance along the
+  rake face from the edge to the last chip particle in contact, time mean;
+* the histories (forces, temperatures), the heat balance (``summary.json`` ``heat_balance``) and the tool work.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..boundaries import Clamp, RigidBody
+from ..contact import CoulombFriction
+from ..material import ElasticMaterial
+from ..paper_data import (AISI1045_RLA, CONTACT_RLA, RLA_SURFACE_LOSS, TI6AL4V_RLA, TOOL_CARBIDE_RLA,
+                          rla_cutting_case)
+from ..plasticity import JohnsonCook, ModifiedJohnsonCook
+from ..state import concatenate_states, make_state
+from ..thermal import Conduction, FrictionHeat, SurfaceLoss
+from .base import Numerics, Scene, Setup, parse_bool
+from .measure import N_FORCE_BINS, TOOL_BODY, binned_mean, block_lattice, time_mean
+
+__all__ = ["SCENE", "MATERIALS", "tool_particles", "mass_scale_for", "rake_frame", "chip_measures",
+           "thermal_cutting_metrics", "thermal_cutting_table", "STEADY_FROM"]
+
+STEADY_FROM = 0.5               # means over the second half of the cut
+RAKE_DEG, CLEARANCE_DEG, EDGE_RADIUS = 10.0, 10.0, 10e-6
+MATERIALS = {"AISI1045": AISI1045_RLA, "Ti6Al4V": TI6AL4V_RLA}
+OPTIONS = {
+    "case": (0, "row 1-18 of the second paper's Appendix B (sets material, vc, tu); 0: material, vc, tu as given"),
+    "material": ("AISI1045", "workpiece: AISI1045 or Ti6Al4V"),
+    "vc": (1.0, "cutting speed [m/s] (the paper's m/min / 60)"),
+    "tu": (0.1e-3, "uncut chip thickness [m]"),
+    "n_tu": (5.0, "particles across the uncut chip thickness (dx = tu / n_tu; --dp overrides)"),
+    "travel": (8.0, "length of cut in units of tu"),
+    "length": (3.0e-3, "workpiece length [m]"),
+    "mass_scale": (0.0, "density factor s (c_p / s keeps rho c_p); 0: chosen from inertia_ratio"),
+    "inertia_ratio": (0.01, "with mass_scale 0: s such that s rho vc^2 = inertia_ratio x A"),
+    "detector": ("sph", "free-surface detector of the heat losses: sph or alpha"),
+    "chip_fraction": (0.5, "share of the frictional heat that goes into the chip (the rest into the tool)"),
+    "friction": (True, "Coulomb friction mu(T) on the tool (false: frictionless)"),
+    "conduction": (True, "heat conduction, frictional heat and losses (false: adiabatic, the first paper's model)"),
+}
+
+
+def mass_scale_for(material: dict, vc: float, inertia_ratio: float) -> float:
+    """s with s rho v_c^2 = inertia_ratio A (never below 1): the density factor of the mass scaling."""
+    return max(1.0, inertia_ratio * material["A_Pa"] / (material["rho"] * vc * vc))
+
+
+def tool_particles(dx: float, tu: float, apex) -> tuple[np.ndarray, np.ndarray]:
+    """The tool's particles (a lattice in rake-face coordinates u along the face from the edge, w into the tool:
+    u, w = (i + 1/2) dx, (j + 1/2) dx, 0 < u < 5 tu, 0 < w < 3 tu), those inside the 70 deg wedge and the
+    rounded edge, placed with the edge at ``apex``; and a mask of the held rows (top and back layers)."""
+    g, beta = math.radians(RAKE_DEG), math.radians(90.0 - RAKE_DEG - CLEARANCE_DEG)
+    nu_, nw = round(5 * tu / dx), round(3 * tu / dx)
+    u, w = [a.ravel() * dx for a in np.meshgrid(np.arange(nu_) + 0.5, np.arange(nw) + 0.5, indexing="ij")]
+    keep = np.arctan2(w, u) <= beta
+    rc = EDGE_RADIUS / math.sin(beta / 2)                 # the edge circle's centre, on the bisector
+    cu, cw = rc * math.cos(beta / 2), rc * math.sin(beta / 2)
+    tangent = EDGE_RADIUS / math.tan(beta / 2)             # tangent points at this distance from the apex
+    corner = (u < tangent) & (u * math.cos(beta) + w * math.sin(beta) < tangent)
+    keep &= ~(corner & ((u - cu) ** 2 + (w - cw) ** 2 > EDGE_RADIUS ** 2))
+    u, w = u[keep], w[keep]
+    held = (u > (nu_ - 1) * dx) | (w > (nw - 1) * dx)
+    x = apex[0] + u * math.sin(g) + w * math.cos(g)
+    y = apex[1] + u * math.cos(g) - w * math.sin(g)
+    return np.stack([x, y], axis=1), held
+
+
+def _case_values(case, material, vc, tu):
+    if int(case) == 0:
+        if material not in MATERIALS:
+            raise ValueError(f"material must be one of {', '.join(MATERIALS)}, got {material!r}")
+        return None, material, float(vc), float(tu)
+    row = rla_cutting_case(int(case))
+    return row, row["material"], row["vc_m_per_min"] / 60.0, row["tu_mm"] * 1e-3
+
+
+def _strength(mat: dict, s: float) -> JohnsonCook:
+    jc = dict(A=mat["A_Pa"], B=mat["B_Pa"], n=mat["n"], C=mat["C"], m=mat["m"], eps_dot_0=mat["eps_dot_0"],
+              T_room=CONTACT_RLA["T_ref_K"], T_melt=mat["T_melt_K"], cp=mat["cp_J_kgK"] / s,
+              chi=CONTACT_RLA["plastic_work_to_heat"])
+    if "hardening_saturation_strain" in mat:
+        return ModifiedJohnsonCook(**jc, hardening_saturation_strain=mat["hardening_saturation_strain"])
+    return JohnsonCook(**jc)
+
+
+def _default_dp(dim, quick):
+    return None                                       # from the options: tu / n_tu
+
+
+def _build(dim, dp, quick, *, case, material, vc, tu, n_tu, travel, length, mass_scale, inertia_ratio, detector,
+           chip_fraction, friction, conduction):
+    if dim != 2:
+        raise ValueError("the thermal cutting scene is 2D plane strain")
+    row, material, vc, tu = _case_values(case, material, vc, tu)
+    for name, v in (("vc", vc), ("tu", tu), ("travel", travel), ("length", length), ("n_tu", n_tu),
+                    ("inertia_ratio", inertia_ratio)):
+        if not (np.isfinite(v) and v > 0):
+            raise ValueError(f"option {name} must be positive, got {v!r}")
+    mat = MATERIALS[material]
+    dx = float(dp) if dp is not None else tu / (n_tu * (0.8 if quick else 1.0))
+    if tu < 2 * dx or travel * tu > 0.8 * length:
+        raise ValueError(f"need tu >= 2 dx and a cut (travel x tu) within 80 % of the workpiece length; got "
+                         f"tu = {tu!r} m, dx = {dx!r} m, travel = {travel!r} tu, length = {length!r} m")
+    s = float(mass_scale) if mass_scale > 0 else mass_scale_for(mat, vc, inertia_ratio * (4.0 if quick else 1.0))
+    H = 3.0 * tu
+    nx, ny = round(length / dx), round(H / dx)
+    xw, i, j = block_lattice(nx, ny, dx, dx)
+    held = np.flatnonzero((i == 0) | (j == 0))
+    y0 = ny * dx - tu
+    xt, tool_held = tool_particles(dx, tu, (nx * dx, y0))
+    T0 = CONTACT_RLA["T_ref_K"]
+    work = make_state(xw, [0.0, 0.0], s * mat["rho"], dx * dx, T0=T0)
+    tool_mat = TOOL_CARBIDE_RLA
+    tool = make_state(xt, [-vc, 0.0], tool_mat["rho"], dx * dx, T0=T0, body=np.full(len(xt), TOOL_BODY))
+    numerics = Numerics(h_over_dp=1.3, kernel="wendland", integrator="leapfrog", courant=0.3, beta1=0.5, beta2=0.5)
+    thermal = None
+    if parse_bool(conduction, "option conduction"):
+        loss = SurfaceLoss(**RLA_SURFACE_LOSS, T_ambient=T0, detector=detector, alpha_radius=1.3 * dx)
+        thermal = Conduction(k=mat["k_W_mK"], cp=mat["cp_J_kgK"] / s, courant=0.3,
+                             tools={TOOL_BODY: (tool_mat["k_W_mK"], tool_mat["cp_J_kgK"])},
+                             fixed=tuple(int(k) for k in np.concatenate([held, work.n + np.flatnonzero(tool_held)])),
+                             T_fixed=T0, loss=loss,
+                             friction_heat=FrictionHeat(eta=CONTACT_RLA["friction_work_to_heat"],
+                                                        chip_fraction=float(chip_fraction)))
+    mu = CoulombFriction(mu0=mat["mu0"], q=mat["q_friction"], T_room=T0, T_melt=mat["T_melt_K"])
+    info = dict(case=int(case), material=material, vc_m_s=vc, tu_m=tu, dx=dx, length_m=nx * dx, height_m=ny * dx,
+                y0=y0, n_work=work.n, n_tool=tool.n, travel_m=travel * tu, mass_scale=s,
+                inertia_ratio=s * mat["rho"] * vc * vc / mat["A_Pa"], rake_deg=RAKE_DEG, clearance_deg=CLEARANCE_DEG,
+                edge_radius_m=EDGE_RADIUS, apex0=[nx * dx, y0], detector=detector, chip_fraction=float(chip_fraction),
+                A_Pa=mat["A_Pa"], measured=row)
+    return Setup(state=concatenate_states(work, tool), material=ElasticMaterial(s * mat["rho"], mat["E_Pa"], mat["nu"]),
+                 dp=dx, numerics=numerics, t_end=travel * tu / vc, n_snapshots=8, info=info,
+                 strength=_strength(mat, s), rigid=(RigidBody("tool", TOOL_BODY, (-vc, 0.0)),),
+                 clamps=(Clamp("held", held),), friction=mu if parse_bool(friction, "option friction") else None,
+                 thermal=thermal)
+
+
+def rake_frame(x: np.ndarray, t: float, info: dict) -> tuple[np.ndarray, np.ndarray]:
+    """(u, n) of points x at time t: u along the rake face from the cutting edge, n the distance in front of the
+    face (n > 0 in the chip, n < 0 inside the tool)."""
+    g = math.radians(info["rake_deg"])
+    dx_ = x[:, 0] - (info["apex0"][0] - info["vc_m_s"] * t)
+    dy_ = x[:, 1] - info["apex0"][1]
+    return dx_ * math.sin(g) + dy_ * math.cos(g), -(dx_ * math.cos(g) - dy_ * math.sin(g))
+
+
+def chip_measures(x: np.ndarray, X: np.ndarray, T: np.ndarray, t: float, info: dict) -> dict:
+    """The rake-face, chip and contact measures of one workpiece state (module text): x, X (reference), T of the
+    workpiece rows."""
+    dx, tu = info["dx"], info["tu_m"]
+    u, n = rake_frame(x, t, info)
+    chip = X[:, 1] > info["y0"]
+    touch = chip & (n < dx) & (u > -dx)
+    out = dict(T_RF=np.nan, T_RF_max=np.nan, T_FCS=np.nan, chip_mm=np.nan, contact_mm=np.nan)
+    if np.any(touch):
+        lc = float(u[touch].max())
+        out.update(T_RF=float(T[touch].mean()), T_RF_max=float(T[touch].max()), contact_mm=1e3 * max(lc, 0.0))
+    bands = np.floor(u / dx).astype(int)
+    outer, thick = [], []
+    for b in range(int(0.5 * tu / dx), int(3 * tu / dx)):
+        sel = chip & (bands == b) & (n > -dx)
+        if np.count_nonzero(sel) < 2:
+            continue
+        far = n[sel].max()
+        if b * dx >= tu:                                  # the free chip surface: 1-3 tu along the face
+            outer.append(T[sel][n[sel] > far - dx])
+        if b * dx <= 2 * tu:                              # the thickness: 0.5-2 tu along the face
+            thick.append(far + 0.5 * dx)
+    if outer:
+        out["T_FCS"] = float(np.concatenate(outer).mean())
+    if thick:
+        out["chip_mm"] = 1e3 * float(np.median(thick))
+    return out
+
+
+def _record(state, setup):
+    n = setup.info["n_work"]
+    m = chip_measures(state.x[:n], state.X[:n], state.T[:n], state.t, setup.info)
+    return dict(t=state.t, max_T=float(np.max(state.T[:n])), max_eps_p=float(np.max(state.eps_p[:n])), **m)
+
+
+def _steady(hist: dict, key: str, t_from: float) -> float:
+    t, v = np.asarray(hist["t"]), np.asarray(hist[key], dtype=float)
+    sel = (t >= t_from) & np.isfinite(v)
+    return float(v[sel].mean()) if sel.any() else float("nan")
+
+
+def thermal_cutting_metrics(hist: dict, info: dict, t_end: float) -> dict:
+    """The ``metrics`` of a run from its history (the recorded measures and the tool's reaction)."""
+    r = hist["reaction"]
+    t_r, dt, F = np.asarray(r["t"]), np.asarray(r["dt"]), np.asarray(r["tool"])
+    t_from = STEADY_FROM * t_end
+    Fc, Fp = time_mean(t_r, dt, F[:, 0], t_from), time_mean(t_r, dt, F[:, 1], t_from)
+    nb = min(N_FORCE_BINS, max(1, len(t_r)))
+    tb, cb = binned_mean(t_r, dt, F[:, 0], t_end, nb)
+    _, pb = binned_mean(t_r, dt, F[:, 1], t_end, nb)
+    out = dict(
+        cutting_force_N_per_m=Fc, passive_force_N_per_m=Fp, force_ratio=Fp / Fc if Fc else float("nan"),
+        rake_face_temperature_K=_steady(hist, "T_RF", t_from),
+        rake_face_temperature_max_K=_steady(hist, "T_RF_max", t_from),
+        free_chip_surface_temperature_K=_steady(hist, "T_FCS", t_from),
+        chip_thickness_mm=_steady(hist, "chip_mm", t_from), contact_length_mm=_steady(hist, "contact_mm", t_from),
+        max_temperature_K=float(np.max(hist["max_T"])), max_plastic_strain=float(np.max(hist["max_eps_p"])),
+        tool_work_J_per_m=float(np.sum(F[:, 0] * dt) * info["vc_m_s"]),
+        cut_length_mm=1e3 * info["vc_m_s"] * float(hist["t"][-1]),
+        mass_scale=info["mass_scale"], inertia_ratio=info["inertia_ratio"],
+        cutting_force_history=np.stack([tb, cb], axis=1), passive_force_history=np.stack([tb, pb], axis=1),
+        temperature_history=np.stack([np.asarray(hist["t"]), np.asarray(hist["T_RF"], dtype=float),
+                                      np.asarray(hist["T_FCS"], dtype=float)], axis=1))
+    row = info.get("measured")
+    if row:
+        out["measured"] = dict(Fc_N=row["Fc_exp_N"], Fp_N=row["Fp_exp_N"], T_RF_K=row["TRF_exp_K"],
+                               T_FCS_K=row["TFCS_exp_K"], force_ratio=row["Fp_exp_N"] / row["Fc_exp_N"])
+        out["width_matching_Fc_mm"] = 1e3 * row["Fc_exp_N"] / Fc if Fc else float("nan")
+    return out
+
+
+def _metrics(hist, state, setup):
+    return thermal_cutting_metrics(hist, setup.info, setup.t_end)
+
+
+def thermal_cutting_table(summaries: list) -> str:
+    """The runs side by side with the measurement of their case (forces per mm of width; the measured forces'
+    width is not stated, so their ratio is what compares)."""
+    rows = [f"{'case':>4s} {'mat':8s} {'vc':>5s} {'tu':>5s} {'status':8s} {'Fc[N/mm]':>8s} {'Fp[N/mm]':>8s} "
+            f"{'Fp/Fc':>5s} {'meas':>5s} {'T_RF':>5s} {'meas':>5s} {'T_FCS':>5s} {'meas':>5s} {'chip':>5s} "
+            f"{'l_c':>5s} {'wall[s]':>7s}"]
+    for s in summaries:
+        i, m = s.get("scene_info", {}), s.get("metrics") or {}
+        meas = m.get("measured") or {}
+        f = lambda v, w, p: f"{v:{w}.{p}f}" if isinstance(v, (int, float)) and math.isfinite(v) else f"{'-':>{w}s}"  # noqa: E731
+        rows.append(f"{i.get('case', 0):4d} {i.get('material', '?'):8s} {60 * i.get('vc_m_s', 0):5.0f} "
+                    f"{1e3 * i.get('tu_m', 0):5.2f} {s.get('status', '?'):8s} "
+                    f"{f(1e-3 * m.get('cutting_force_N_per_m', math.nan), 8, 1)} "
+                    f"{f(1e-3 * m.get('passive_force_N_per_m', math.nan), 8, 1)} {f(m.get('force_ratio'), 5, 2)} "
+                    f"{f(meas.get('force_ratio'), 5, 2)} {f(m.get('rake_face_temperature_K'), 5, 0)} "
+                    f"{f(meas.get('T_RF_K'), 5, 0)} {f(m.get('free_chip_surface_temperature_K'), 5, 0)} "
+                    f"{f(meas.get('T_FCS_K'), 5, 0)} {f(m.get('chip_thickness_mm'), 5, 3)} "
+                    f"{f(m.get('contact_length_mm'), 5, 3)} {f(s.get('wall_time_s'), 7, 0)}")
+    rows.append("(vc in m/min, tu and chip thickness, contact length l_c in mm, temperatures in K; means over the "
+                "second half of the cut)")
+    return "\n".join(rows)
+
+
+SCENE = Scene(
+    "thermal_cutting",
+    "thermomechanical orthogonal cutting (Rodriguez Prieto, Larsson & Afrasiabi 2023): AISI 1045 / Ti6Al4V, "
+    "friction mu(T), conduction into the tool; --case 1..18",
+    _default_dp, _build, _record, _metrics, options=OPTIONS, default_dim=2, methods=("tlsph",),
+    report=thermal_cutting_table)

@@ -1,0 +1,106 @@
+"""The thermomechanical cutting model (issue 16): frictional heat, the heat balance of a cutting run, mass scaling,
+the tool's geometry and the scene's options. The 18-case comparison is a benchmark
+(benchmarks/thermal_cutting.py), its page checked in tests/test_reports.py."""
+import math
+
+import numpy as np
+import pytest
+
+from refsph.contact import CoulombFriction, PinballContact, pinball_contact
+from refsph.kernels import get_kernel
+from refsph.scenes import get_scene
+from refsph.scenes.thermal_cutting import EDGE_RADIUS, tool_particles
+from refsph.simulate import cfl_time_step, run
+from refsph.state import make_state
+from refsph.thermal import Conduction, FrictionHeat, thermal_step
+
+
+def test_friction_power_is_force_times_sliding_speed_and_is_split_as_asked():
+    """One particle sliding over a rigid one while pressed onto it: the pinball's friction power is |f_t| |v_t|
+    (module text of refsph.contact), and thermal_step puts eta x chip_fraction of it into the particle and the
+    rest into the tool row."""
+    R, dt, m = 0.5e-5, 1e-9, 2e-6
+    xa, va = np.array([[0.0, 0.9e-5]]), np.array([[3.0, -1.0]])          # approaching (p_d > 0) and sliding
+    xb, vb = np.array([[0.0, 0.0]]), np.zeros((1, 2))
+    fr = CoulombFriction(mu0=0.5, q=2.0, T_room=293.0, T_melt=1800.0)
+    c = pinball_contact(xa, va, np.array([m]), xb, vb, np.inf, R, 80e9, np.inf, dt,
+                        PinballContact(k=1 / 3, K_p=50.0, friction=fr), thickness=1e-5, T_a=np.array([293.0]))
+    f_t = c.a[0, 0] * m                                                   # the only x force is friction
+    assert f_t < 0 and c.friction_power_a[0] == pytest.approx(abs(f_t) * 3.0, rel=1e-12)
+    assert c.friction_power_b[0] == c.friction_power_a[0]
+    state = make_state(np.vstack([xa, xb]), np.zeros((2, 2)), 7800.0, 1e-10, T0=293.0, body=np.array([0, 1]))
+    model = Conduction(k=1e-30, cp=500.0, courant=0.3, tools={1: (1e-30, 15.0)},
+                       friction_heat=FrictionHeat(eta=1.0, chip_fraction=0.25))
+    T, heat = thermal_step(state, model, 1.3e-5, get_kernel("wendland"), dt, [1],
+                           (c.friction_power_a, c.friction_power_b))
+    P = c.friction_power_a[0]
+    assert heat["friction"] == pytest.approx(P * dt, rel=1e-12)
+    mc = state.m * np.array([500.0, 15.0])
+    assert (T - 293.0) * mc == pytest.approx([0.25 * P * dt, 0.75 * P * dt], rel=1e-6)
+
+
+@pytest.fixture(scope="module")
+def short_cut():
+    """A short quick cut (1.5 t_u on a 0.6 mm workpiece) with everything switched on."""
+    return run("thermal_cutting", "tlsph", quick=True, progress=False,
+               options=dict(case=1, length=0.6e-3, travel=1.5), numerics=dict(threads=1))
+
+
+def test_heat_balance_of_a_cutting_run(short_cut):
+    """plastic + frictional heat = heat stored + lost + removed at the fixed rows (to round-off: every term is
+    counted where it is made), and the heat made is a fraction of the tool's work (chi = 0.9 of the plastic work;
+    the rest is elastic and kinetic energy and viscous and contact dissipation)."""
+    hb, m = short_cut.summary["heat_balance"], short_cut.summary["metrics"]
+    assert short_cut.summary["status"] == "ok"
+    assert hb["plastic_J"] > 0 and hb["friction_J"] > 0 and hb["lost_J"] > 0 and hb["removed_J"] > 0
+    assert abs(hb["residual_rel"]) < 1e-9
+    made = hb["plastic_J"] + hb["friction_J"]
+    assert 0.5 < made / m["tool_work_J_per_m"] < 1.0
+    assert 293.0 < m["rake_face_temperature_K"] < m["max_temperature_K"] < 1773.0
+    assert m["cutting_force_N_per_m"] > 0 and m["passive_force_N_per_m"] > 0
+
+
+def test_mass_scaling_keeps_rho_cp_and_lengthens_the_step():
+    scene = get_scene("thermal_cutting")
+    a = scene.setup(case=1, mass_scale=1.0, length=0.6e-3, travel=2.0)
+    b = scene.setup(case=1, mass_scale=100.0, length=0.6e-3, travel=2.0)
+    n = a.info["n_work"]
+    assert b.state.rho[:n] * b.thermal.cp == pytest.approx(a.state.rho[:n] * a.thermal.cp, rel=1e-12)
+    assert b.strength.cp * b.material.rho0 == pytest.approx(a.strength.cp * a.material.rho0, rel=1e-12)
+    ratio = cfl_time_step(b.state, b.material, b.h, 0.3) / cfl_time_step(a.state, a.material, a.h, 0.3)
+    assert ratio == pytest.approx(10.0, rel=0.02)                       # c_L / sqrt(s), v_c << c_L
+    assert b.info["inertia_ratio"] == pytest.approx(100 * a.info["inertia_ratio"])
+
+
+def test_tool_geometry():
+    """Rake face 10 deg from the normal to the cut, a 70 deg wedge, the first layer exactly on a line (no
+    staircase), and the 10 um edge rounding removing the corner particles once dx resolves it."""
+    tu, dx = 0.1e-3, 2e-6
+    x, held = tool_particles(dx, tu, (0.0, 0.0))
+    u = x[:, 0] * math.sin(math.radians(10)) + x[:, 1] * math.cos(math.radians(10))
+    w = x[:, 0] * math.cos(math.radians(10)) - x[:, 1] * math.sin(math.radians(10))
+    assert w.min() == pytest.approx(0.5 * dx) and u.min() > 0
+    first = w < dx
+    assert np.ptp(w[first]) < 1e-12                                      # a flat rake face
+    assert np.degrees(np.arctan2(w, u)).max() <= 70.0 + 1e-9
+    g = (np.arange(round(2 * EDGE_RADIUS / dx)) + 0.5) * dx              # the sharp wedge's corner lattice
+    gu, gw = np.meshgrid(g, g, indexing="ij")
+    sharp = np.count_nonzero(np.degrees(np.arctan2(gw, gu)) <= 70.0)
+    rounded = np.count_nonzero((u < 2 * EDGE_RADIUS) & (w < 2 * EDGE_RADIUS))
+    assert 0 < rounded < sharp
+    assert held.any() and not held[first & (u < tu)].any()
+
+
+def test_scene_options_and_refusals():
+    scene = get_scene("thermal_cutting")
+    s = scene.setup(case=13, length=0.6e-3, travel=2.0)
+    assert s.info["material"] == "Ti6Al4V" and s.info["vc_m_s"] == pytest.approx(40 / 60)
+    assert s.info["tu_m"] == pytest.approx(0.1e-3) and s.dp == pytest.approx(0.1e-3 / 5)
+    assert s.friction is not None and s.thermal is not None and s.numerics.kernel == "wendland"
+    assert scene.setup(material="AISI1045", vc=2.0, tu=0.15e-3, conduction=False, friction=False).thermal is None
+    with pytest.raises(ValueError, match="material"):
+        scene.setup(material="copper")
+    with pytest.raises(ValueError, match="case"):
+        scene.setup(case=19)
+    with pytest.raises(ValueError, match="friction"):
+        run("thermal_cutting", "esph", quick=True, progress=False, options=dict(length=0.6e-3, travel=1.0))

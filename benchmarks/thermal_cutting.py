@@ -6,7 +6,9 @@ refsph's thermomechanical cutting scene, next to the measurements and the paper'
     python benchmarks/thermal_cutting.py --scheduler tcp://HOST:8786   # the same on a dask.distributed cluster
     python benchmarks/thermal_cutting.py --scaling           # case 1 at mass-scaling factors s/4, s, 4 s, 16 s
     python benchmarks/thermal_cutting.py --detector          # case 1 with the alpha-shape surface detector
+    python benchmarks/thermal_cutting.py --resolution        # case 1 at 4 and 8 particles across t_u (5: case 1)
     python benchmarks/thermal_cutting.py --report            # table, page and figures from the committed JSON only
+    python benchmarks/thermal_cutting.py --quick --json /tmp/q.json --only 1 2   # a try-out (quick cuts, seconds)
 
 Each run is ``refsph run thermal_cutting --case N`` at the scene's default resolution (dx = t_u / 5, mass
 scaling to 1 % of A, 8 t_u of cut) in ``runs/thermal_cutting/<key>/`` on one core. Resumable twice over: a
@@ -38,13 +40,14 @@ REPORT = ROOT / "benchmarks" / "thermal_cutting_report.md"
 RUNS = ROOT / "runs" / "thermal_cutting"
 FIG = ROOT / "figures"
 SCALING = (0.25, 1.0, 4.0, 16.0)           # factors on the default mass scale (case 1)
+RESOLUTION = (4.0, 8.0)                    # particles across t_u besides the default 5 (case 1)
 KEEP = ("cutting_force_N_per_m", "passive_force_N_per_m", "force_ratio", "rake_face_temperature_K",
         "rake_face_temperature_max_K", "free_chip_surface_temperature_K", "chip_thickness_mm", "contact_length_mm",
         "max_temperature_K", "max_plastic_strain", "tool_work_J_per_m", "cut_length_mm", "mass_scale",
         "inertia_ratio", "width_matching_Fc_mm", "measured")
 
 
-def jobs(scaling: bool, detector: bool, only=None) -> dict:
+def jobs(scaling: bool, detector: bool, only=None, resolution: bool = False) -> dict:
     """{key: scene options} of the runs asked for."""
     from refsph.paper_data import AISI1045_RLA, rla_cutting_case
     from refsph.scenes.thermal_cutting import mass_scale_for
@@ -53,19 +56,24 @@ def jobs(scaling: bool, detector: bool, only=None) -> dict:
         return {f"scaling {f:g}": dict(case=1, mass_scale=f * s1) for f in SCALING if f != 1.0}
     if detector:
         return {"detector alpha": dict(case=1, detector="alpha")}
+    if resolution:
+        return {f"resolution {n:g}": dict(case=1, n_tu=n) for n in RESOLUTION}
     return {f"case {n}": dict(case=n) for n in range(1, 19) if only is None or n in only}
 
 
-def run_case(key: str, options: dict) -> dict:
+QUICK = dict(length=1.2e-3, travel=4.0)       # --quick: chapter 11's short cut at the quick resolution
+
+
+def run_case(key: str, options: dict, quick: bool = False) -> dict:
     """One run (continued from its checkpoint if an earlier attempt was killed); its record."""
     from refsph.simulate import SimulationError, run
-    out = RUNS / key.replace(" ", "_")
+    out = RUNS / (key.replace(" ", "_") + ("_quick" if quick else ""))
     restart = (out / "snapshots" / "restart.npz").exists()
     t0 = time.perf_counter()
-    rec = dict(key=key, options=options)
+    rec = dict(key=key, options=options, quick=quick)
     try:
-        res = run("thermal_cutting", "tlsph", out=out, progress=False, options=options, restart=restart,
-                  numerics=dict(threads=1))
+        res = run("thermal_cutting", "tlsph", out=out, progress=False, restart=restart, quick=quick,
+                  options=dict(options, **(QUICK if quick else {})), numerics=dict(threads=1))
         s = res.summary
     except SimulationError as e:
         s = json.loads((out / "summary.json").read_text())
@@ -88,15 +96,23 @@ def _thin(a, n: int = 100) -> list:
     return [[float(v) if np.isfinite(v) else None for v in row] for row in a[idx]]
 
 
-def load() -> dict:
-    return json.loads(OUT_JSON.read_text()) if OUT_JSON.exists() else dict(runs={})
+def load(path: Path = OUT_JSON) -> dict:
+    return json.loads(path.read_text()) if path.exists() else dict(runs={})
 
 
-def save(res: dict) -> None:
-    OUT_JSON.write_text(json.dumps(res, indent=1, sort_keys=True, default=float) + "\n")
+def save(res: dict, path: Path = OUT_JSON) -> None:
+    """Merge ``res``'s records into the file (under a lock: two sweeps may share it) and write it atomically."""
+    import fcntl
+    with open(path.with_suffix(".lock"), "w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        merged = load(path)
+        merged["runs"].update(res["runs"])
+        tmp = path.with_suffix(".tmp")
+        tmp.write_text(json.dumps(merged, indent=1, sort_keys=True, default=float) + "\n")
+        tmp.replace(path)
 
 
-def _execute(todo: dict, n_jobs: int, scheduler: str | None):
+def _execute(todo: dict, n_jobs: int, scheduler: str | None, quick: bool = False):
     """Yield records as runs finish: local processes, or a dask.distributed cluster at ``scheduler``."""
     if scheduler:
         try:
@@ -104,13 +120,13 @@ def _execute(todo: dict, n_jobs: int, scheduler: str | None):
         except ImportError:
             raise SystemExit("--scheduler needs dask.distributed: pip install -e '.[dask]'") from None
         client = Client(scheduler)
-        futures = [client.submit(run_case, k, o, key=f"refsph-{k}", pure=False) for k, o in todo.items()]
+        futures = [client.submit(run_case, k, o, quick, key=f"refsph-{k}", pure=False) for k, o in todo.items()]
         for f in as_completed(futures):
             yield f.result()
         return
     from concurrent.futures import ProcessPoolExecutor, as_completed
     with ProcessPoolExecutor(max_workers=max(1, n_jobs)) as pool:
-        futures = [pool.submit(run_case, k, o) for k, o in todo.items()]
+        futures = [pool.submit(run_case, k, o, quick) for k, o in todo.items()]
         for f in as_completed(futures):
             yield f.result()
 
@@ -140,6 +156,8 @@ def comparison(res: dict) -> list[dict]:
             row[f"{q}"] = m.get(key) if ok else None
             for src in ("", "_sph", "_pfem"):
                 row[f"{q}{src}_err"] = _err(row[f"{q}{src}"], row[f"{q}_exp"])
+        row["TRFmax"] = m.get("rake_face_temperature_max_K") if ok else None
+        row["TRFmax_err"] = _err(row["TRFmax"], row["TRF_exp"])
         row["ratio"] = m.get("force_ratio") if ok else None
         for src in ("", "_sph", "_pfem"):
             row[f"ratio{src}_err"] = _err(row[f"ratio{src}"], row["ratio_exp"])
@@ -197,13 +215,13 @@ def report(res: dict) -> str:
              "the paper's printed predictions and errors (not printed themselves). SPH, PFEM: the paper's "
              "Appendix B. Errors: 100 |x - measured| / measured, as the paper gives them.", "",
              "## Temperatures and the force ratio", "",
-             "| case | material | vc [m/min] | tu [mm] | status | T_RF refsph | measured | SPH | PFEM | T_FCS refsph "
-             "| measured | SPH | PFEM | Fp/Fc refsph | measured | SPH | PFEM |",
-             "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+             "| case | material | vc [m/min] | tu [mm] | status | T_RF refsph | (hottest) | measured | SPH | PFEM | "
+             "T_FCS refsph | measured | SPH | PFEM | Fp/Fc refsph | measured | SPH | PFEM |",
+             "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for r in rows:
         lines.append(
             f"| {r['case']} | {r['material']} | {r['vc']:.0f} | {r['tu']:.2f} | {r['status']} | "
-            f"{_f(r['TRF'], '.0f')} ({_f(r['TRF_err'], '.0f')} %) | {r['TRF_exp']:.0f} | "
+            f"{_f(r['TRF'], '.0f')} ({_f(r['TRF_err'], '.0f')} %) | {_f(r['TRFmax'], '.0f')} | {r['TRF_exp']:.0f} | "
             f"{r['TRF_sph']:.0f} ({r['TRF_sph_err']:.0f} %) | {r['TRF_pfem']:.0f} ({r['TRF_pfem_err']:.0f} %) | "
             f"{_f(r['TFCS'], '.0f')} ({_f(r['TFCS_err'], '.0f')} %) | {r['TFCS_exp']:.0f} | "
             f"{r['TFCS_sph']:.0f} ({r['TFCS_sph_err']:.0f} %) | {r['TFCS_pfem']:.0f} ({r['TFCS_pfem_err']:.0f} %) | "
@@ -218,6 +236,7 @@ def report(res: dict) -> str:
         for q, name in (("TRF", "T_RF"), ("TFCS", "T_FCS"), ("ratio", "Fp/Fc")):
             lines.append(f"| {mat} | {name} | {_f(_mean(sel, f'{q}_err'), '.1f')} | {_mean(sel, f'{q}_sph_err'):.1f} "
                          f"| {_mean(sel, f'{q}_pfem_err'):.1f} | {len(ran)} of {len(sel)} |")
+        lines.append(f"| {mat} | T_RF, hottest contact particle | {_f(_mean(sel, 'TRFmax_err'), '.1f')} | | | |")
     lines += ["", "## Forces, chip and the width of cut", "",
               "The paper does not state the width of cut b. refsph's forces are per mm of width; 'b for Fc' is the "
               "width at which refsph's Fc equals the measured one (a constant b across the cases means the trends "
@@ -241,32 +260,57 @@ def report(res: dict) -> str:
     return "\n".join(lines)
 
 
+def _row(cells) -> str:
+    """A Markdown table row from (value, format) pairs ('-' for a missing value)."""
+    return "| " + " | ".join(_f(v, fmt) for v, fmt in cells) + " |"
+
+
+def _case1_row(r: dict, columns) -> str:
+    m = r.get("metrics") or {}
+    got = dict(m, Fc=1e-3 * m.get("cutting_force_N_per_m", math.nan), dx_um=1e6 * r["dp"], across=1e-4 / r["dp"],
+               n_particles=r.get("n_particles"), n_steps=r.get("n_steps"), wall=r.get("wall_time_s"),
+               lost=(r.get("heat_balance") or {}).get("lost_J"),
+               made=sum((r.get("heat_balance") or {}).get(k, math.nan) for k in ("plastic_J", "friction_J")))
+    return _row((got.get(key), fmt) for key, fmt in columns)
+
+
+STUDIES = (
+    ("Mass scaling (case 1)", lambda k: k.startswith("scaling") or k == "case 1", "mass_scale",
+     (("s", "mass_scale", ".0f"), ("s rho vc^2 / A", "inertia_ratio", ".4f"), ("Fc [N/mm]", "Fc", ".1f"),
+      ("Fp/Fc", "force_ratio", ".3f"), ("T_RF [K]", "rake_face_temperature_K", ".0f"),
+      ("T_FCS [K]", "free_chip_surface_temperature_K", ".0f"), ("chip [mm]", "chip_thickness_mm", ".3f"),
+      ("steps", "n_steps", "d"), ("wall [s]", "wall", ".0f"))),
+    ("Resolution (case 1)", lambda k: k.startswith("resolution") or k == "case 1", "across",
+     (("particles across t_u", "across", ".0f"), ("dx [um]", "dx_um", ".1f"), ("particles", "n_particles", "d"),
+      ("Fc [N/mm]", "Fc", ".1f"), ("Fp/Fc", "force_ratio", ".3f"), ("T_RF [K]", "rake_face_temperature_K", ".0f"),
+      ("T_RF max [K]", "rake_face_temperature_max_K", ".0f"),
+      ("T_FCS [K]", "free_chip_surface_temperature_K", ".0f"), ("chip [mm]", "chip_thickness_mm", ".3f"),
+      ("contact [mm]", "contact_length_mm", ".3f"), ("steps", "n_steps", "d"), ("wall [s]", "wall", ".0f"))),
+    ("Surface detector (case 1: SPH detector; alpha: the alpha-shape)",
+     lambda k: k in ("case 1", "detector alpha"), "lost",
+     (("Fc [N/mm]", "Fc", ".2f"), ("Fp/Fc", "force_ratio", ".4f"), ("T_RF [K]", "rake_face_temperature_K", ".1f"),
+      ("T_FCS [K]", "free_chip_surface_temperature_K", ".1f"), ("heat lost [J/m]", "lost", ".3e"),
+      ("heat made [J/m]", "made", ".3f"), ("wall [s]", "wall", ".0f"))),
+)
+
+
 def _study_lines(res: dict) -> list[str]:
-    runs = res["runs"]
-    lines = ["", "## Mass scaling (case 1)", "",
-             "| s | s rho vc^2 / A | Fc [N/mm] | Fp/Fc | T_RF [K] | T_FCS [K] | chip [mm] | steps | wall [s] |",
-             "|---|---|---|---|---|---|---|---|---|"]
-    keys = sorted((k for k in runs if k.startswith("scaling") or k == "case 1"),
-                  key=lambda k: (runs[k].get("metrics") or {}).get("mass_scale", 0.0))
-    for k in keys:
-        r, m = runs[k], runs[k].get("metrics") or {}
-        lines.append(f"| {_f(m.get('mass_scale'), '.0f')} | {_f(m.get('inertia_ratio'), '.4f')} | "
-                     f"{_f(1e-3 * m['cutting_force_N_per_m'] if 'cutting_force_N_per_m' in m else None, '.1f')} | "
-                     f"{_f(m.get('force_ratio'), '.3f')} | {_f(m.get('rake_face_temperature_K'), '.0f')} | "
-                     f"{_f(m.get('free_chip_surface_temperature_K'), '.0f')} | {_f(m.get('chip_thickness_mm'), '.3f')} "
-                     f"| {r.get('n_steps')} | {_f(r.get('wall_time_s'), '.0f')} |")
-    lines += ["", "## Surface detector (case 1)", "", "| detector | Fc [N/mm] | Fp/Fc | T_RF [K] | T_FCS [K] | "
-              "heat lost [J/m] | heat made [J/m] |", "|---|---|---|---|---|---|---|"]
-    for k, name in (("case 1", "SPH (Marrone et al.)"), ("detector alpha", "alpha-shape")):
-        if k not in runs:
-            lines.append(f"| {name} | (to run) | | | | | |")
-            continue
-        m, hb = runs[k].get("metrics") or {}, runs[k].get("heat_balance") or {}
-        lines.append(f"| {name} | {_f(1e-3 * m.get('cutting_force_N_per_m', math.nan), '.2f')} | "
-                     f"{_f(m.get('force_ratio'), '.4f')} | {_f(m.get('rake_face_temperature_K'), '.1f')} | "
-                     f"{_f(m.get('free_chip_surface_temperature_K'), '.1f')} | {_f(hb.get('lost_J'), '.3e')} | "
-                     f"{_f(hb.get('plastic_J', 0) + hb.get('friction_J', 0), '.3f')} |")
+    """The case-1 studies: mass scaling, resolution, surface detector (a row per recorded run)."""
+    runs, lines = res["runs"], []
+    for title, member, order, columns in STUDIES:
+        lines += ["", f"## {title}", "", "| run | " + " | ".join(c[0] for c in columns) + " |",
+                  "|---" * (len(columns) + 1) + "|"]
+        keys = [k for k in runs if member(k)]
+        keys.sort(key=lambda k: _case1_value(runs[k], order))
+        for k in keys:
+            lines.append(f"| {k} " + _case1_row(runs[k], [c[1:] for c in columns]))
     return lines
+
+
+def _case1_value(r: dict, key: str) -> float:
+    m, hb = r.get("metrics") or {}, r.get("heat_balance") or {}
+    return {"mass_scale": m.get("mass_scale", 0.0), "across": 1e-4 / r["dp"] if r.get("dp") else 0.0,
+            "lost": hb.get("lost_J", 0.0)}[key]
 
 
 def figures(res: dict) -> None:
@@ -317,22 +361,31 @@ def main(argv=None) -> int:
     ap.add_argument("--only", type=int, nargs="*", default=None, help="case numbers to run (default: all 18)")
     ap.add_argument("--scaling", action="store_true", help="the mass-scaling study on case 1")
     ap.add_argument("--detector", action="store_true", help="case 1 with the alpha-shape detector")
+    ap.add_argument("--resolution", action="store_true", help="case 1 at other resolutions")
     ap.add_argument("--redo", nargs="*", default=(), help="keys to run again (e.g. 'case 3')")
     ap.add_argument("--report", action="store_true", help="table and figures from the committed JSON only")
+    ap.add_argument("--quick", action="store_true", help="quick short cuts (a try-out; give --json elsewhere)")
+    ap.add_argument("--json", type=Path, default=OUT_JSON, help="the records (default: the committed JSON)")
     args = ap.parse_args(argv)
-    res = load()
+    if args.quick and args.json == OUT_JSON:
+        ap.error("--quick writes try-out records: give them their own --json file")
+    res = load(args.json)
     if not args.report:
-        todo = {k: o for k, o in jobs(args.scaling, args.detector, args.only).items()
+        todo = {k: o for k, o in jobs(args.scaling, args.detector, args.only, args.resolution).items()
                 if k not in res["runs"] or k in args.redo}
         print(f"{len(todo)} runs to do ({len(res['runs'])} recorded)", flush=True)
         t0 = time.perf_counter()
-        for k, rec in enumerate(_execute(todo, args.jobs, args.scheduler)):
+        for k, rec in enumerate(_execute(todo, args.jobs, args.scheduler, args.quick)):
             res["runs"][rec["key"]] = rec
-            save(res)
+            save(res, args.json)
             m = rec["metrics"]
             print(f"[{k + 1}/{len(todo)}] {rec['key']:16s} {rec['status']:6s} Fp/Fc {_f(m.get('force_ratio'), '.2f')} "
                   f"T_RF {_f(m.get('rake_face_temperature_K'), '.0f')} K, {_f(rec['wall_time_s'], '.0f')} s "
                   f"({(time.perf_counter() - t0) / 60:.1f} min elapsed)", flush=True)
+    if args.json != OUT_JSON:
+        print(report(res))
+        print(f"wrote {args.json}")
+        return 0
     REPORT.write_text(report(res))
     figures(res)
     print(f"wrote {OUT_JSON}, {REPORT}, figures/11_thermal_cutting_*.png")

@@ -36,9 +36,11 @@ def test_readme_figures_are_what_the_code_draws(name, figure, tmp_path):
 
 
 @pytest.mark.parametrize("name, page", [("lammps_crosscheck", "lammps_crosscheck_report.md"),
-                                        ("stability_map", "stability_map_report.md")])
+                                        ("stability_map", "stability_map_report.md"),
+                                        ("thermal_cutting", "thermal_cutting_report.md")])
 def test_study_page_is_generated_from_the_json(name, page):
-    """The LAMMPS cross-check and the stability map: their pages are what the scripts write from their JSON."""
+    """The LAMMPS cross-check, the stability map, the 18 measured cuts: their pages are what the scripts write from
+    their JSON."""
     mod = _script(name)
     assert mod.report(json.loads((ROOT / "benchmarks" / f"{name}.json").read_text())) == \
         (ROOT / "benchmarks" / page).read_text()

@@ -41,9 +41,9 @@ def test_friction_power_is_force_times_sliding_speed_and_is_split_as_asked():
 
 @pytest.fixture(scope="module")
 def short_cut():
-    """A short quick cut (1.5 t_u on a 0.6 mm workpiece) with everything switched on."""
+    """A short quick cut (one t_u on a 0.5 mm workpiece) with everything switched on."""
     return run("thermal_cutting", "tlsph", quick=True, progress=False,
-               options=dict(case=1, length=0.6e-3, travel=1.5), numerics=dict(threads=1))
+               options=dict(case=1, length=0.5e-3, travel=1.0), numerics=dict(threads=1))
 
 
 def test_heat_balance_of_a_cutting_run(short_cut):

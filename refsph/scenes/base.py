@@ -110,10 +110,11 @@ class Setup:
 @dataclass(frozen=True)
 class Scene:
     """A scene as data. ``build(dim, dp, quick, **options) -> Setup`` (every option given; :meth:`setup` fills in
-    the defaults); ``default_dp(dim, quick)``; ``record(state, setup) -> dict`` of scalars stored in the history
-    every few steps; ``metrics(history, state, setup) -> dict``, the ``metrics`` of ``summary.json``;
-    ``options``: the scene's own settings, {name: (default, help)}; ``default_dim``, ``methods``: what a plain
-    ``refsph run SCENE`` runs; ``report(summaries) -> str``: a table of runs."""
+    the defaults); ``default_dp(dim, quick)`` (None: ``build`` derives the spacing from its options);
+    ``record(state, setup) -> dict`` of scalars stored in the history every few steps;
+    ``metrics(history, state, setup) -> dict``, the ``metrics`` of ``summary.json``; ``options``: the scene's own
+    settings, {name: (default, help)}; ``default_dim``, ``methods``: what a plain ``refsph run SCENE`` runs;
+    ``report(summaries) -> str``: a table of runs."""
 
     name: str
     description: str

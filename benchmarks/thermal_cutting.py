@@ -6,7 +6,7 @@ refsph's thermomechanical cutting scene, next to the measurements and the paper'
     python benchmarks/thermal_cutting.py --scheduler tcp://HOST:8786   # the same on a dask.distributed cluster
     python benchmarks/thermal_cutting.py --scaling           # case 1 at mass-scaling factors s/4, s, 4 s, 16 s
     python benchmarks/thermal_cutting.py --detector          # case 1 with the alpha-shape surface detector
-    python benchmarks/thermal_cutting.py --resolution        # case 1 at 4 and 8 particles across t_u (5: case 1)
+    python benchmarks/thermal_cutting.py --resolution        # case 1 at 4 and 7 particles across t_u (5: case 1)
     python benchmarks/thermal_cutting.py --report            # table, page and figures from the committed JSON only
     python benchmarks/thermal_cutting.py --quick --json /tmp/q.json --only 1 2   # a try-out (quick cuts, seconds)
 
@@ -40,7 +40,7 @@ REPORT = ROOT / "benchmarks" / "thermal_cutting_report.md"
 RUNS = ROOT / "runs" / "thermal_cutting"
 FIG = ROOT / "figures"
 SCALING = (0.25, 1.0, 4.0, 16.0)           # factors on the default mass scale (case 1)
-RESOLUTION = (4.0, 8.0)                    # particles across t_u besides the default 5 (case 1)
+RESOLUTION = (4.0, 7.0)                    # particles across t_u besides the default 5 (case 1)
 KEEP = ("cutting_force_N_per_m", "passive_force_N_per_m", "force_ratio", "rake_face_temperature_K",
         "rake_face_temperature_max_K", "free_chip_surface_temperature_K", "chip_thickness_mm", "contact_length_mm",
         "max_temperature_K", "max_plastic_strain", "tool_work_J_per_m", "cut_length_mm", "mass_scale",
@@ -382,6 +382,7 @@ def main(argv=None) -> int:
             print(f"[{k + 1}/{len(todo)}] {rec['key']:16s} {rec['status']:6s} Fp/Fc {_f(m.get('force_ratio'), '.2f')} "
                   f"T_RF {_f(m.get('rake_face_temperature_K'), '.0f')} K, {_f(rec['wall_time_s'], '.0f')} s "
                   f"({(time.perf_counter() - t0) / 60:.1f} min elapsed)", flush=True)
+        res = load(args.json)                             # with what another sweep on the same file added
     if args.json != OUT_JSON:
         print(report(res))
         print(f"wrote {args.json}")

@@ -38,8 +38,8 @@ Measurements (``metrics``; the experiment's values: :func:`refsph.paper_data.rla
 * ``cutting_force_N_per_m`` / ``passive_force_N_per_m``: the force of the workpiece on the tool along +x
   (against the cut) and +y (pushing the tool off the workpiece), per metre of width, time means over the second
   half of the cut; ``force_ratio`` = Fp / Fc (width-free, compared with the measured ratio);
-* ``rake_face_temperature_K``: the mean temperature of the chip particles in contact with the rake face (centre
-  within one spacing of it, from the cutting edge to the end of contact), time mean over the second half
+* ``rake_face_temperature_K``: the mean temperature of the workpiece particles in contact with the rake face
+  (centre within one spacing of it, from the cutting edge to the end of contact), time mean over the second half
   (``rake_face_temperature_max_K``: the hottest of them);
 * ``free_chip_surface_temperature_K``: the mean temperature of the chip's outer layer (in each dx-band along
   the rake face, the chip particles within one spacing of the farthest from the face) between 1 and 3 t_u along
@@ -193,17 +193,17 @@ def rake_frame(x: np.ndarray, t: float, info: dict) -> tuple[np.ndarray, np.ndar
     return dx_ * math.sin(g) + dy_ * math.cos(g), -(dx_ * math.cos(g) - dy_ * math.sin(g))
 
 
-def chip_measures(x: np.ndarray, X: np.ndarray, T: np.ndarray, t: float, info: dict) -> dict:
-    """The rake-face, chip and contact measures of one workpiece state (module text): x, X (reference), T of the
-    workpiece rows."""
+def chip_measures(x: np.ndarray, X0: np.ndarray, T: np.ndarray, t: float, info: dict) -> dict:
+    """The rake-face, chip and contact measures of one workpiece state (module text): current positions x,
+    *initial* positions X0 (the chip is the material that started above the cut line; TLSPH's reference positions
+    X move with its reference updates, so they do not say that) and temperatures T of the workpiece rows."""
     dx, tu = info["dx"], info["tu_m"]
     u, n = rake_frame(x, t, info)
-    chip = X[:, 1] > info["y0"]
-    touch = chip & (n < dx) & (u > -dx)
+    chip = X0[:, 1] > info["y0"]
+    touch = (np.abs(n) < dx) & (u >= 0.0)                   # on the rake face, whatever material it is
     out = dict(T_RF=np.nan, T_RF_max=np.nan, T_FCS=np.nan, chip_mm=np.nan, contact_mm=np.nan)
     if np.any(touch):
-        lc = float(u[touch].max())
-        out.update(T_RF=float(T[touch].mean()), T_RF_max=float(T[touch].max()), contact_mm=1e3 * max(lc, 0.0))
+        out.update(T_RF=float(T[touch].mean()), T_RF_max=float(T[touch].max()), contact_mm=1e3 * float(u[touch].max()))
     bands = np.floor(u / dx).astype(int)
     outer, thick = [], []
     for b in range(int(0.5 * tu / dx), int(3 * tu / dx)):
@@ -224,7 +224,7 @@ def chip_measures(x: np.ndarray, X: np.ndarray, T: np.ndarray, t: float, info: d
 
 def _record(state, setup):
     n = setup.info["n_work"]
-    m = chip_measures(state.x[:n], state.X[:n], state.T[:n], state.t, setup.info)
+    m = chip_measures(state.x[:n], setup.state.x[:n], state.T[:n], state.t, setup.info)
     return dict(t=state.t, max_T=float(np.max(state.T[:n])), max_eps_p=float(np.max(state.eps_p[:n])), **m)
 
 

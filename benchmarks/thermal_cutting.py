@@ -265,13 +265,12 @@ def _row(cells) -> str:
     return "| " + " | ".join(_f(v, fmt) for v, fmt in cells) + " |"
 
 
-def _case1_row(r: dict, columns) -> str:
-    m = r.get("metrics") or {}
-    got = dict(m, Fc=1e-3 * m.get("cutting_force_N_per_m", math.nan), dx_um=1e6 * r["dp"], across=1e-4 / r["dp"],
-               n_particles=r.get("n_particles"), n_steps=r.get("n_steps"), wall=r.get("wall_time_s"),
-               lost=(r.get("heat_balance") or {}).get("lost_J"),
-               made=sum((r.get("heat_balance") or {}).get(k, math.nan) for k in ("plastic_J", "friction_J")))
-    return _row((got.get(key), fmt) for key, fmt in columns)
+def _case1_values(r: dict) -> dict:
+    """A case-1 study run's metrics with the derived columns of the study tables (and their sort keys)."""
+    m, hb = r.get("metrics") or {}, r.get("heat_balance") or {}
+    return dict(m, Fc=1e-3 * m.get("cutting_force_N_per_m", math.nan), dx_um=1e6 * r["dp"], across=1e-4 / r["dp"],
+                n_particles=r.get("n_particles"), n_steps=r.get("n_steps"), wall=r.get("wall_time_s"),
+                lost=hb.get("lost_J"), made=sum(hb.get(k, math.nan) for k in ("plastic_J", "friction_J")))
 
 
 STUDIES = (
@@ -300,17 +299,10 @@ def _study_lines(res: dict) -> list[str]:
     for title, member, order, columns in STUDIES:
         lines += ["", f"## {title}", "", "| run | " + " | ".join(c[0] for c in columns) + " |",
                   "|---" * (len(columns) + 1) + "|"]
-        keys = [k for k in runs if member(k)]
-        keys.sort(key=lambda k: _case1_value(runs[k], order))
-        for k in keys:
-            lines.append(f"| {k} " + _case1_row(runs[k], [c[1:] for c in columns]))
+        values = {k: _case1_values(runs[k]) for k in runs if member(k)}
+        for k in sorted(values, key=lambda k: values[k].get(order) or 0.0):
+            lines.append(f"| {k} " + _row((values[k].get(key), fmt) for _, key, fmt in columns))
     return lines
-
-
-def _case1_value(r: dict, key: str) -> float:
-    m, hb = r.get("metrics") or {}, r.get("heat_balance") or {}
-    return {"mass_scale": m.get("mass_scale", 0.0), "across": 1e-4 / r["dp"] if r.get("dp") else 0.0,
-            "lost": hb.get("lost_J", 0.0)}[key]
 
 
 def figures(res: dict) -> None:

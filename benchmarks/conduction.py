@@ -12,14 +12,20 @@ Midpoint (RK2) time steps at 0.1 rho c_p h^2 / k, h = 1.5 dp, cubic kernel. Erro
 from __future__ import annotations
 
 import json
+import sys
 import time
 from pathlib import Path
 
-import numpy as np
+sys.path.insert(0, str(Path(__file__).resolve().parent))      # benchmarks/study.py, however this file is loaded
+import study  # noqa: E402
 
-from refsph.kernels import get_kernel
-from refsph.scenes import lattice
-from refsph.thermal import advance_at_rest
+study.pin_threads()
+
+import numpy as np  # noqa: E402
+
+from refsph.kernels import get_kernel  # noqa: E402
+from refsph.scenes import lattice  # noqa: E402
+from refsph.thermal import advance_at_rest  # noqa: E402
 
 OUT = Path(__file__).with_name("conduction.json")
 RHO, CP, K = 7870.0, 486.0, 50.7            # AISI 1045 of the second paper (Table 2)
@@ -49,7 +55,10 @@ def insulated(n, L=10e-3, W=2e-3):
     return float(np.max(np.abs(T - exact)) / 100.0), steps, dp
 
 
-def main():
+def main(argv=None):
+    ap = study.parser(__doc__)
+    ap.add_argument("--json", type=Path, default=OUT, help="where to write the results (default: conduction.json)")
+    path = ap.parse_args(argv).json
     out = {}
     for name, fn, sizes in (("pulse", pulse, (24, 48, 96)), ("insulated", insulated, (10, 20, 40, 80))):
         rows = []
@@ -64,8 +73,8 @@ def main():
         for r in rows:
             print(f"  {r['n']:4d} across, dp = {r['dp_m'] * 1e3:.3f} mm: error {r['error']:.2e}"
                   + (f", order {r['order']:.2f}" if "order" in r else ""))
-    OUT.write_text(json.dumps(out, indent=1) + "\n")
-    print(f"wrote {OUT}")
+    path.write_text(json.dumps(out, indent=1) + "\n")
+    print(f"wrote {path}")
 
 
 if __name__ == "__main__":

@@ -20,18 +20,15 @@ issue's 30-minute target is about; CPU times add up all threads.
 """
 from __future__ import annotations
 
-import os
+import json
+import sys
+import time
+from pathlib import Path
 
-# one core per run: pin the BLAS / OpenMP thread pools before NumPy is imported (inherited by the workers)
-for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "BLIS_NUM_THREADS",
-             "VECLIB_MAXIMUM_THREADS", "NUMEXPR_NUM_THREADS"):
-    os.environ[_var] = "1"
+sys.path.insert(0, str(Path(__file__).resolve().parent))      # benchmarks/study.py, however this file is loaded
+import study  # noqa: E402
 
-import argparse  # noqa: E402
-import json  # noqa: E402
-import time  # noqa: E402
-from concurrent.futures import ProcessPoolExecutor  # noqa: E402
-from pathlib import Path  # noqa: E402
+study.pin_threads()         # one core per run: BLAS / OpenMP pools at one thread (inherited by the workers)
 
 import numpy as np  # noqa: E402
 
@@ -97,7 +94,7 @@ def load(name):
 def record(job, runs=None):
     """The record of a finished or failed run in folder runs (default RUNS); the measurements are recomputed from
     the run's files with the current code (refsph.scenes.cutting.analyse_run), so a changed measure needs no new run."""
-    from refsph.scenes.cutting import analyse_run
+    from refsph.io import analyse_cutting_run as analyse_run
     from refsph.io import load_run, load_snapshot
     name = job["name"]
     folder = (RUNS if runs is None else Path(runs)) / name
@@ -243,7 +240,7 @@ SNAP_INSTANTS = (2, 4, 6, 8)          # snapshots at 1/4, 1/2, 3/4 and all of th
 
 
 def _picture(ax, z, dp, field, vmax, cmap="jet", vmin=0.0, xlim=(1.3, 3.6), ylim=(0.25, 2.15)):
-    from refsph.plots import particle_field
+    from refsph.teaching.plots import particle_field
     # the committed figures were drawn with jet and squares 1.15 spacings wide; the next rerun of the paper-resolution
     # runs (about 2 CPU-hours each pair) should draw them with the defaults (viridis, 1.5: no gaps)
     return particle_field(ax, z["x"], z[field], dp, body=z["body"], xlim=xlim, ylim=ylim, cmap=cmap, vmin=vmin,
@@ -259,7 +256,7 @@ def strain_figure(by: dict, feed: float) -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     from refsph.io import load_snapshot
-    from refsph.plots import particle_field
+    from refsph.teaching.plots import particle_field
 
     fig = plt.figure(figsize=(16, 7.6))
     axs = fig.subplots(2, 4, gridspec_kw=dict(left=0.04, right=0.92, bottom=0.07, top=0.88, wspace=0.08,
@@ -293,21 +290,26 @@ def strain_figure(by: dict, feed: float) -> None:
 
 def plots(records):
     import matplotlib
-    import matplotlib.ticker
     matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    from refsph.io import load_snapshot
-
     FIG.mkdir(exist_ok=True)
-    colors = dict(esph="C0", tlsph="C3")
     by = {r["name"]: r for r in records}
-    paper = [r for r in records if r["name"].startswith("paper-")]
-
     # Figs. 12-13 and 17-18: plastic strain at four instants, ESPH above TLSPH, one figure per feed
     for feed in FEEDS:
         strain_figure(by, feed)
+    temperature_figure(by)
+    forces_figure([r for r in records if r["name"].startswith("paper-")])
+    bands_figure(by)
+    work_precision_figure(records)
+    reference_updates_figure(by)
 
-    # Figs. 14-15: temperature at the end of the cut, both methods and feeds
+
+COLORS = dict(esph="C0", tlsph="C3")
+
+
+def temperature_figure(by):
+    """Figs. 14-15: temperature at the end of the cut, both methods and feeds."""
+    import matplotlib.pyplot as plt
+    from refsph.io import load_snapshot
     fig = plt.figure(figsize=(9, 8))
     axs = fig.subplots(2, 2, gridspec_kw=dict(left=0.07, right=0.88, bottom=0.06, top=0.9, wspace=0.1,
                                               hspace=0.25))
@@ -330,7 +332,11 @@ def plots(records):
     fig.savefig(FIG / "08_cutting_temperature.png", dpi=110)
     plt.close(fig)
 
-    # forces against cut length
+
+def forces_figure(paper):
+    """Forces against cut length."""
+    import matplotlib.pyplot as plt
+    colors = COLORS
     fig, axs = plt.subplots(1, 2, figsize=(12, 4.2), constrained_layout=True, sharey=True)
     for ax, key, label in ((axs[0], "cutting_force_history_mm_MN_per_m", "cutting force Fc"),
                            (axs[1], "thrust_force_history_mm_MN_per_m", "thrust force Ft")):
@@ -351,7 +357,11 @@ def plots(records):
     fig.savefig(FIG / "08_cutting_forces.png", dpi=120)
     plt.close(fig)
 
-    # the band measurement: plastic strain along the chip (middle row of the cut layer) with the bands found
+
+def bands_figure(by):
+    """The band measurement: plastic strain along the chip (middle row of the cut layer) with the bands found."""
+    import matplotlib.pyplot as plt
+    colors = COLORS
     fig, axs = plt.subplots(2, 2, figsize=(12, 6.5), constrained_layout=True, sharex=True)
     for row, m in enumerate(("esph", "tlsph")):
         for col, feed in enumerate(FEEDS):
@@ -379,7 +389,13 @@ def plots(records):
     fig.savefig(FIG / "08_cutting_bands.png", dpi=120)
     plt.close(fig)
 
-    # work-precision: the coarse runs' distance to dp = 0.01 mm against wall time, feed 0.3 mm
+
+def work_precision_figure(records):
+    """Work-precision: the coarse runs' distance to dp = 0.01 mm against wall time, feed 0.3 mm (from the records
+    alone)."""
+    import matplotlib.ticker
+    import matplotlib.pyplot as plt
+    colors, by = COLORS, {r["name"]: r for r in records}
     fig, axs = plt.subplots(1, 2, figsize=(11, 4.2), constrained_layout=True)
     for ax, key, label in ((axs[0], "cutting_force_rel", "mean cutting force"),
                            (axs[1], "chip_thickness_rel", "chip thickness")):
@@ -408,8 +424,12 @@ def plots(records):
     fig.savefig(FIG / "08_cutting_work_precision.png", dpi=120)
     plt.close(fig)
 
-    # TLSPH with and without reference-configuration updates (reduced size): both at the same cut length, and the
-    # run without updates at its end (its last good state if it failed)
+
+def reference_updates_figure(by):
+    """TLSPH with and without reference-configuration updates (reduced size): both at the same cut length, and the
+    run without updates at its end (its last good state if it failed)."""
+    import matplotlib.pyplot as plt
+    from refsph.io import load_snapshot
     pair = [by.get("coarse-tlsph-f0.3-25um"), by.get("noupdate-tlsph-f0.3-25um")]
     if all(pair):
         with_upd, without = pair
@@ -443,17 +463,8 @@ def plots(records):
 TARGET_S = 30 * 60      # the issue's target: 1 mm of cut at the paper's resolution in 30 minutes (two cores)
 
 
-def _v(v, spec: str, scale: float = 1.0) -> str:
-    """A report cell: '-' for a measure that could not be made (null in the JSON) or is not a number."""
-    if v is None or isinstance(v, (str, dict, list)) or (isinstance(v, float) and not np.isfinite(v)):
-        return "-"
-    return format(v * scale if scale != 1.0 else v, spec)
-
-
-def _md_table(head: list, rows: list) -> str:
-    lines = ["| " + " | ".join(head) + " |", "|" + "|".join("---" for _ in head) + "|"]
-    lines += ["| " + " | ".join(str(c) for c in row) + " |" for row in rows]
-    return "\n".join(lines)
+_v = study.fmt            # a report cell: '-' for a measure that could not be made (null in the JSON)
+_md_table = study.md_table
 
 
 def _fig(name: str, caption: str) -> str:
@@ -464,43 +475,38 @@ def _ratio(a, b):
     return a / b if a is not None and b not in (None, 0) else None
 
 
+def _pct(v) -> str:
+    return _v(v, "+.1f", 100.0)
+
+
 def report(records) -> str:
-    """benchmarks/cutting_report.md: the study as text, every number from the records of cutting.json."""
-    from refsph.paper_data import CUTTING_OBSERVED
-    from refsph.scenes.cutting import BAND_REL_PROMINENCE
-    by = {r["name"]: r for r in records}
+    """benchmarks/cutting_report.md: the study as text, every number from the records of cutting.json; the prose is
+    benchmarks/templates/cutting_report.md."""
+    P = study.Page("cutting_report")
     ok = [r for r in records if r["status"] == "ok"]
     paper = [r for r in ok if r["name"].startswith("paper-")]
-    angle_paper = CUTTING_OBSERVED["band_angle_deg"]
-    out = ["# Orthogonal cutting (Section 3.3): the benchmark report", "",
-           "Made by `python benchmarks/cutting.py --report` from `benchmarks/cutting.json` alone (it runs nothing; "
-           "edit the script, not this file). The lesson, with the set-up, the measurements written as plain loops "
-           "and runs at a coarse spacing, is `chapters/08_cutting.py`; the measurements are "
-           "`refsph.scenes.cutting` (`cutting_metrics`, `shear_bands`, `chip_thickness`).", "",
-           "## What was run", "",
-           "The scene `refsph.scenes.cutting`: a workpiece of AISI 4340 (Table 3) in 2D plane strain, held on its "
-           "bottom row and left column, cut by a rigid, frictionless tool of rake and clearance angle 0 at the "
-           "paper's speed; Table 5's smoothing length and artificial viscosity, the CFL time step, TLSPH reference "
-           "updates at max |E| > `ref_update_strain`. `paper-` runs are at the paper's spacing, `coarse-` runs at "
-           "larger spacings (for the cost against precision), `noupdate-` is TLSPH with reference updates off. "
-           "Each run is one process; its pair sums share the machine's cores (`threads` 0: all of them).", ""]
-    out.append(_md_table(
+    out = _report_runs(P, records, ok, paper)
+    out += _report_feed(P, {r["name"]: r for r in records}, ok)
+    out += _report_thrust(P, ok)
+    out += _report_noupdate(P, {r["name"]: r for r in records})
+    out += _report_rerun(P, paper)
+    out += _report_cost(P, paper)
+    out += _report_coarse(P, ok)
+    return "\n".join(out)
+
+
+def _report_runs(P, records, ok, paper) -> list[str]:
+    """What was run, the results table and how to read it."""
+    from refsph.paper_data import CUTTING_OBSERVED
+    from refsph.scenes.cutting import BAND_REL_PROMINENCE
+    angle_paper = f"{CUTTING_OBSERVED['band_angle_deg']:g}"
+    out = [P("head"), "", _md_table(
         ["run", "method", "feed [mm]", "dp [mm]", "h [mm]", "particles", "steps", "cut [mm]", "ref. update at",
          "threads", "status"],
         [[r["name"], r["method"].upper(), _v(r["feed_mm"], "g"), _v(r["dp_mm"], ".4g"), _v(r["h_mm"], ".4g"),
           r["n_particles"], r["n_steps"], _v(r["cut_length_mm"], ".2f"), _v(r["ref_update_strain"], "g"),
-          r.get("threads", "-"), r["status"]] for r in records]))
-    out += ["", "## Results", "",
-            "Fc, Ft: the cutting and thrust force of the workpiece on the tool per unit thickness [MN/m = kN/mm], "
-            "means over the second half of the cut; drift: the mean Fc of the last quarter over the third, minus 1 "
-            "(how steady the force is); chip: the chip thickness [mm]; phi_c = atan(feed / chip) [deg], Merchant's "
-            "shear angle for that chip; bands: the shear bands counted (peaks of the plastic strain along the middle "
-            f"row of the cut layer, prominence at least {BAND_REL_PROMINENCE:g} x the profile's median); "
-            "spacing along the chip now and "
-            "in the uncut workpiece [mm]; angle: the median band angle to the cutting direction [deg] (the paper: "
-            f"about {angle_paper:g}); eps_p max and 99th percentile, T max and 99th percentile [K] of the workpiece "
-            "at the end.", ""]
-    out.append(_md_table(
+          r.get("threads", "-"), r["status"]] for r in records])]
+    out += ["", P("results", band_prominence=f"{BAND_REL_PROMINENCE:g}", angle_paper=angle_paper), "", _md_table(
         ["run", "Fc", "Ft", "Ft/Fc", "drift", "chip", "phi_c", "bands", "spacing chip", "spacing uncut", "angle",
          "eps_p max", "eps_p p99", "T max", "T p99"],
         [[r["name"], _v(r.get("cutting_force_mean_MN_per_m"), ".3f"), _v(r.get("thrust_force_mean_MN_per_m"), ".3f"),
@@ -510,33 +516,24 @@ def report(records) -> str:
           _v(r.get("band_spacing_mm"), ".3f"), _v(r.get("band_spacing_material_mm"), ".3f"),
           _v(r.get("band_angle_deg"), ".0f"), _v(r.get("max_plastic_strain"), ".1f"),
           _v(r.get("plastic_strain_p99"), ".2f"), _v(r.get("max_temperature_K"), ".0f"),
-          _v(r.get("temperature_p99_K"), ".0f")] for r in ok]))
+          _v(r.get("temperature_p99_K"), ".0f")] for r in ok])]
     drift = max(abs(r["cutting_force_drift"]) for r in paper) if paper else None
     phi = [r["shear_angle_from_chip_deg"] for r in paper]
     angles = [r["band_angle_deg"] for r in paper if r.get("band_angle_deg") is not None]
-    out += ["", "How to read it. Both methods form a continuous chip at the paper's spacing. The cutting force has "
-            f"settled in the second half of the cut: its drift is at most {_v(drift, '.1%')} at the paper's spacing. "
-            "Every chip there is thicker than the feed, so the shear angle it implies "
-            f"(phi_c, {_v(min(phi, default=None), '.0f')} to {_v(max(phi, default=None), '.0f')} deg) is below "
-            f"Merchant's {angle_paper:g} deg for a frictionless tool of zero rake; the median band angles "
-            f"({_v(min(angles, default=None), '.0f')} to {_v(max(angles, default=None), '.0f')} deg) lie around, "
-            f"mostly below, the paper's \"approximately {angle_paper:g} deg\". The largest plastic strains "
-            "and temperatures are a few particles pressed against the rake face next to the sharp edge, where the "
-            "strain has no finite limit as the spacing shrinks and (no heat conduction) the temperature runs to the "
-            "melting point: compare the 99th percentiles, not the maxima.", "",
-            "Plastic strain at 1/4, 1/2, 3/4 and all of the cut, ESPH above TLSPH (cf. the paper's Figs. 12-13 and "
-            "17-18):", "", _fig("08_cutting_strain_f0.3.png", "plastic strain, feed 0.3 mm"), "",
-            _fig("08_cutting_strain_f0.5.png", "plastic strain, feed 0.5 mm"), "",
-            "Temperature at the end of the cut (cf. Figs. 14-15):", "",
-            _fig("08_cutting_temperature.png", "temperature"), "",
-            "Forces against the cut length, and the band measure (the profile along the chip; dotted: the bands "
-            "counted):", "", _fig("08_cutting_forces.png", "forces"), "", _fig("08_cutting_bands.png", "shear bands"),
-            ""]
+    return out + ["", P("how_to_read", drift=_v(drift, ".1%"), phi_min=_v(min(phi, default=None), ".0f"),
+                        phi_max=_v(max(phi, default=None), ".0f"), angle_paper=angle_paper,
+                        angle_min=_v(min(angles, default=None), ".0f"), angle_max=_v(max(angles, default=None), ".0f"),
+                        fig_strain_3=_fig("08_cutting_strain_f0.3.png", "plastic strain, feed 0.3 mm"),
+                        fig_strain_5=_fig("08_cutting_strain_f0.5.png", "plastic strain, feed 0.5 mm"),
+                        fig_temperature=_fig("08_cutting_temperature.png", "temperature"),
+                        fig_forces=_fig("08_cutting_forces.png", "forces"),
+                        fig_bands=_fig("08_cutting_bands.png", "shear bands")), ""]
 
-    # the paper's trend
-    out += ["## The deeper feed", "",
-            f"The paper: a deeper feed gives a {CUTTING_OBSERVED['deeper_feed']}. Feed 0.5 mm against 0.3 mm, per "
-            "method and spacing:", ""]
+
+def _report_feed(P, by, ok) -> list[str]:
+    """The paper's trend with the feed, and the band count against its threshold."""
+    from refsph.paper_data import CUTTING_OBSERVED
+    from refsph.scenes.cutting import BAND_REL_PROMINENCE
     rows = []
     for r3 in [r for r in ok if abs(r["feed_mm"] - 0.3) < 1e-9]:
         r5 = by.get(r3["name"].replace("-f0.3", "-f0.5"))
@@ -551,165 +548,106 @@ def report(records) -> str:
                      f"{_v(s3, '.3f')} -> {_v(s5, '.3f')}", yes(s3 is not None and s5 is not None and s5 > s3,
                                                                s3 is not None and s5 is not None),
                      f"{_v(r3['chip_thickness_mm'], '.3f')} -> {_v(r5['chip_thickness_mm'], '.3f')}"])
-    out.append(_md_table(["runs", "Fc ratio", "feed ratio", "larger force", "bands", "fewer bands",
-                          "spacing uncut [mm]", "wider spacing", "chip [mm]"], rows))
+    out = [P("deeper_feed", deeper_feed=CUTTING_OBSERVED["deeper_feed"]), "",
+           _md_table(["runs", "Fc ratio", "feed ratio", "larger force", "bands", "fewer bands",
+                      "spacing uncut [mm]", "wider spacing", "chip [mm]"], rows)]
     grows = all(float(row[1]) > 1 for row in rows)
-    out += ["", f"The force grows with the feed {'at every spacing' if grows else 'not in every pair of runs'}. "
-            "The band count and spacing need the paper's "
-            "spacing: a band in a simulation is one to two particle spacings wide, so at the coarse spacings "
-            "neighbouring bands merge and one or two are found (the chapter's Exercise 3 shows it on drawn bands).",
-            "", "## The band count against its threshold", "",
-            "A band is a peak of the strain profile whose prominence is at least a threshold times the profile's "
-            f"median; {BAND_REL_PROMINENCE:g} is a choice (`refsph.scenes.cutting.BAND_REL_PROMINENCE`). "
-            "The count at other thresholds, "
-            "from the same final states:", ""]
+    out += ["", P("deeper_feed_end", grows="at every spacing" if grows else "not in every pair of runs",
+                  band_prominence=f"{BAND_REL_PROMINENCE:g}"), ""]
     thr = sorted({k for r in ok for k in (r.get("n_shear_bands_by_prominence") or {})}, key=float)
     out.append(_md_table(["run"] + [f"threshold {t}" for t in thr],
                          [[r["name"]] + [r["n_shear_bands_by_prominence"].get(t, "-") for t in thr]
                           for r in ok if r.get("n_shear_bands_by_prominence")]))
-    out += ["", "Where the count changes little with the threshold the bands are distinct peaks; where it changes a "
-            "lot they are humps and ripples, and the count is the threshold's as much as the simulation's.", ""]
+    return out + ["", P("threshold_end"), ""]
 
-    # the thrust and the clearance face
-    out += ["## A frictionless tool that pushes up", "",
-            "Merchant's frictionless tool of zero rake feels no thrust: its face is vertical. Both methods give one. "
-            "Part of it is real for a sharp edge: the clearance face rides on the new surface, which springs back "
-            "under it. The rest is how each method makes contact. ESPH's tool particles are SPH neighbours of the "
-            "chip (they enter its velocity gradient and artificial viscosity), so its face drags the chip. TLSPH's "
-            "face is a row of pinballs one spacing apart, a washboard rather than a plane. With a clearance angle "
-            "of 0 the face slides over the new surface at about one spacing, so how hard it rubs depends on a "
-            "fraction of a spacing of springback. At the end of each run: the workpiece particles under the "
-            "clearance face within 1.5 spacings of it, and their mean gap in spacings:", ""]
-    out.append(_md_table(["run", "Ft/Fc", "particles under the face", "mean gap / dp"],
-                         [[r["name"], _v(_ratio(r["thrust_force_mean_MN_per_m"], r["cutting_force_mean_MN_per_m"]),
-                                         ".2f"), _v(r.get("flank_particles"), "d"),
-                           _v(r.get("flank_gap_over_dp"), ".2f")] for r in ok]))
+
+def _report_thrust(P, ok) -> list[str]:
+    """The thrust and the clearance face."""
+    out = [P("thrust"), "", _md_table(
+        ["run", "Ft/Fc", "particles under the face", "mean gap / dp"],
+        [[r["name"], _v(_ratio(r["thrust_force_mean_MN_per_m"], r["cutting_force_mean_MN_per_m"]), ".2f"),
+          _v(r.get("flank_particles"), "d"), _v(r.get("flank_gap_over_dp"), ".2f")] for r in ok])]
     esph_free = all(r.get("flank_particles") == 0 for r in ok if r["method"] == "esph")
-    out += ["", ("ESPH leaves no particles under the face (its new surface lies lower); its thrust is the rake "
-                 "face's drag. " if esph_free else "")
-            + "A tool with a few degrees of clearance would remove this sensitivity; the paper's "
-            "rectangle has none, and refsph keeps the paper's geometry.", ""]
+    return out + ["", P("thrust_end", esph_free=P("thrust_esph_free") + " " if esph_free else ""), ""]
 
-    # no reference updates
+
+def _report_noupdate(P, by) -> list[str]:
+    """TLSPH with and without reference updates."""
     nu, wu = by.get("noupdate-tlsph-f0.3-25um"), by.get("coarse-tlsph-f0.3-25um")
-    if nu is not None and wu is not None:
-        out += ["## TLSPH without reference updates", "",
-                "TLSPH keeps the neighbours each particle had in its reference configuration. A chip separates "
-                "from the workpiece along the cut line, so particles that started one spacing apart end up in the "
-                "chip and under the tool, still tied to each other unless the reference is updated. The same run "
-                "with and without updates:", ""]
-        out.append(_md_table(["run", "status", "cut [mm]", "updates", "eps_p max (last state)", "eps_p p99",
-                              "deepest pinball penetration / dp", "Fc"],
-                             [[r["name"], r["status"], _v(r["cut_length_mm"], ".2f"), _v(r["reference_updates"], "d"),
-                               _v(r.get("max_plastic_strain_last_snapshot"), ".1f"),
-                               _v(r.get("plastic_strain_p99"), ".2f"),
-                               _v(r.get("max_pinball_penetration_over_dp"), ".2f"),
-                               _v(r.get("cutting_force_mean_MN_per_m"), ".3f")] for r in (wu, nu)]))
-        err = (nu.get("error") or "").split(" (")[0]
-        out += ["", f"Without updates the run is lost (status `{nu['status']}`: {err}). Its last good state "
-                "shows the chip "
-                "root torn apart: the material under the cut line, held by its reference neighbours in the chip, "
-                "is dragged along, and the particles at the edge are sheared without end (their plastic strain far "
-                "beyond anything in the run with updates) and squeezed between the tool and their neighbours (the "
-                "pinball penetration). With updates the same run cuts the whole length.", "",
-                _fig("08_cutting_reference_updates.png", "TLSPH with and without reference updates"), ""]
+    if nu is None or wu is None:
+        return []
+    out = [P("noupdate"), "", _md_table(
+        ["run", "status", "cut [mm]", "updates", "eps_p max (last state)", "eps_p p99",
+         "deepest pinball penetration / dp", "Fc"],
+        [[r["name"], r["status"], _v(r["cut_length_mm"], ".2f"), _v(r["reference_updates"], "d"),
+          _v(r.get("max_plastic_strain_last_snapshot"), ".1f"), _v(r.get("plastic_strain_p99"), ".2f"),
+          _v(r.get("max_pinball_penetration_over_dp"), ".2f"), _v(r.get("cutting_force_mean_MN_per_m"), ".3f")]
+         for r in (wu, nu)])]
+    return out + ["", P("noupdate_end", status=nu["status"], error=(nu.get("error") or "").split(" (")[0],
+                        figure=_fig("08_cutting_reference_updates.png", "TLSPH with and without reference updates")),
+                  ""]
 
-    # reproducibility
+
+def _report_rerun(P, paper) -> list[str]:
+    """Reproducibility: the paper runs against the same runs made by other code (vs_rerun)."""
     rr = [r for r in paper if r.get("vs_rerun")]
-    if rr:
-        d0 = rr[0]["vs_rerun"]
-        out += ["## Reproducibility: the same runs with arithmetic that differs by round-off", "",
-                f"The paper-resolution runs were made twice: by this code and by {d0['runs']}, the same equations "
-                "summed in a different order, so that every rate differs by round-off only. A cutting "
-                "simulation amplifies "
-                "such differences (contact that switches on and off, particles that leave the chip or stay, bands "
-                "that start a step earlier), so how far the two end apart is the tolerance any comparison of two "
-                "implementations of these equations can expect at this resolution:", ""]
-        pct = lambda v: _v(v, "+.1f", 100.0)  # noqa: E731
-        out.append(_md_table(
-            ["run", "Fc [%]", "Ft [%]", "chip [%]", "bands", "spacing uncut [mm]", "angle [deg]", "eps_p p99",
-             "particles under the face", "steps", "updates"],
-            [[r["name"], pct(d["cutting_force_rel"]), pct(d["thrust_force_rel"]), pct(d["chip_thickness_rel"]),
-              f"{d['n_shear_bands'][0]} -> {d['n_shear_bands'][1]}",
-              f"{_v(d['band_spacing_material_mm'][0], '.3f')} -> {_v(d['band_spacing_material_mm'][1], '.3f')}",
-              f"{_v(d['band_angle_deg'][0], '.0f')} -> {_v(d['band_angle_deg'][1], '.0f')}",
-              f"{_v(d['plastic_strain_p99'][0], '.2f')} -> {_v(d['plastic_strain_p99'][1], '.2f')}",
-              f"{_v(d['flank_particles'][0], 'd')} -> {_v(d['flank_particles'][1], 'd')}",
-              f"{d['n_steps'][0]} -> {d['n_steps'][1]}",
-              f"{_v(d['reference_updates'][0], 'd')} -> {_v(d['reference_updates'][1], 'd')}"]
-             for r in rr for d in [r["vs_rerun"]]]))
-        fc = max(abs(r["vs_rerun"]["cutting_force_rel"]) for r in rr)
-        ch = max(abs(r["vs_rerun"]["chip_thickness_rel"]) for r in rr)
-        dn = max(abs(r["vs_rerun"]["n_shear_bands"][1] - r["vs_rerun"]["n_shear_bands"][0]) for r in rr)
-        ft = max(rr, key=lambda r: abs(r["vs_rerun"]["thrust_force_rel"]))
-        out += ["", "Relative differences: this code against the rerun, (this / rerun - 1). So a comparison at this "
-                f"resolution can ask for the cutting force within {_v(fc, '.1%')}, the chip thickness within "
-                f"{_v(ch, '.1%')} and the band count within {dn}, as in the table; the thrust moved most in "
-                f"{ft['name']} ({pct(ft['vs_rerun']['thrust_force_rel'])} %), where the two runs settled into "
-                "different contacts under the tool's clearance face (the particles under the face, above). A "
-                "backend inside those bounds is as close to refsph as refsph is to itself.", ""]
+    if not rr:
+        return []
+    out = [P("rerun", runs=rr[0]["vs_rerun"]["runs"]), "", _md_table(
+        ["run", "Fc [%]", "Ft [%]", "chip [%]", "bands", "spacing uncut [mm]", "angle [deg]", "eps_p p99",
+         "particles under the face", "steps", "updates"],
+        [[r["name"], _pct(d["cutting_force_rel"]), _pct(d["thrust_force_rel"]), _pct(d["chip_thickness_rel"]),
+          f"{d['n_shear_bands'][0]} -> {d['n_shear_bands'][1]}",
+          f"{_v(d['band_spacing_material_mm'][0], '.3f')} -> {_v(d['band_spacing_material_mm'][1], '.3f')}",
+          f"{_v(d['band_angle_deg'][0], '.0f')} -> {_v(d['band_angle_deg'][1], '.0f')}",
+          f"{_v(d['plastic_strain_p99'][0], '.2f')} -> {_v(d['plastic_strain_p99'][1], '.2f')}",
+          f"{_v(d['flank_particles'][0], 'd')} -> {_v(d['flank_particles'][1], 'd')}",
+          f"{d['n_steps'][0]} -> {d['n_steps'][1]}",
+          f"{_v(d['reference_updates'][0], 'd')} -> {_v(d['reference_updates'][1], 'd')}"]
+         for r in rr for d in [r["vs_rerun"]]])]
+    fc = max(abs(r["vs_rerun"]["cutting_force_rel"]) for r in rr)
+    ch = max(abs(r["vs_rerun"]["chip_thickness_rel"]) for r in rr)
+    dn = max(abs(r["vs_rerun"]["n_shear_bands"][1] - r["vs_rerun"]["n_shear_bands"][0]) for r in rr)
+    ft = max(rr, key=lambda r: abs(r["vs_rerun"]["thrust_force_rel"]))
+    return out + ["", P("rerun_end", fc=_v(fc, ".1%"), chip=_v(ch, ".1%"), bands=dn, thrust_run=ft["name"],
+                        thrust=_pct(ft["vs_rerun"]["thrust_force_rel"])), ""]
 
-    # cost
-    out += ["## Cost", "",
-            f"The issue asks for 1 mm of cut at the paper's resolution in {TARGET_S / 60:.0f} minutes of wall time "
-            "on the machine's two cores. A run shares its pair sums out to threads (`Numerics.threads`); the CPU "
-            "time adds up all threads, so it is above the wall time when both cores worked.", ""]
-    out.append(_md_table(
+
+def _report_cost(P, paper) -> list[str]:
+    out = [P("cost", target_min=f"{TARGET_S / 60:.0f}"), "", _md_table(
         ["run", "particles", "steps", "cut [mm]", "wall [min]", "CPU [min]", "wall / target", "particle-steps/s"],
         [[r["name"], r["n_particles"], r["n_steps"], _v(r["cut_length_mm"], ".2f"), _v(r["wall_time_s"], ".1f", 1 / 60),
           _v(r.get("cpu_time_s"), ".1f", 1 / 60), _v(r["wall_time_s"] / TARGET_S, ".2f"),
-          _v(r["n_particles"] * r["n_steps"] / r["wall_time_s"], ",.0f")] for r in paper]))
+          _v(r["n_particles"] * r["n_steps"] / r["wall_time_s"], ",.0f")] for r in paper])]
     met = all(r["wall_time_s"] <= TARGET_S for r in paper)
-    out += ["", f"The target is {'met by every run' if met else 'not met by every run'} (one run at a time). "
-            "The speed comes from the data layout, not from different arithmetic (so the results moved by round-off "
-            "only, the reproducibility table above): every pair sum is computed one cache-sized block of pairs at a "
-            "time (`refsph.neighbours.PairBlocks`), two threads take the blocks (NumPy and SciPy release the GIL in "
-            "their array loops; the blocks, and with them the numbers, do not depend on the thread count), ESPH's "
-            "pair arithmetic reads one-dimensional arrays and evaluates the kernel and its gradient in one "
-            "branch-free pass with a smaller Verlet skin, and TLSPH's artificial viscosity is two sparse products "
-            "instead of gathered tensors. `benchmarks/pair_blocks.py` measures what each step buys.", ""]
+    return out + ["", P("cost_end", met="met by every run" if met else "not met by every run"), ""]
 
-    # work-precision
+
+def _report_coarse(P, ok) -> list[str]:
+    """Work-precision: the coarse runs against the paper's resolution."""
     wp = sorted([r for r in ok if r.get("vs_paper")], key=lambda r: (r["method"], r["feed_mm"], -r["dp_mm"]))
-    if wp:
-        pct = lambda v: _v(v, "+.1f", 100.0)  # noqa: E731
-        out += ["## Coarser runs against the paper's resolution", "",
-                "Each coarser run against the paper-resolution run of the same method and feed: relative "
-                "differences [%] and the share of its cost.", ""]
-        out.append(_md_table(
-            ["run", "dp [mm]", "reference", "wall [min]", "wall share", "CPU share", "Fc [%]", "Ft [%]", "chip [%]"],
-            [[r["name"], _v(r["dp_mm"], ".4g"), d["ref"], _v(r["wall_time_s"], ".1f", 1 / 60),
-              _v(d["wall_time_ratio"], ".0%"), _v(d.get("time_ratio"), ".0%"), pct(d["cutting_force_rel"]),
-              pct(d["thrust_force_rel"]), pct(d["chip_thickness_rel"])] for r in wp for d in [r["vs_paper"]]]))
-        out += ["", "The coarse runs cost a small share of a paper-resolution run and get the cutting force within "
-                f"{_v(max(abs(r['vs_paper']['cutting_force_rel']) for r in wp), '.0%')}. What they miss is the bands "
-                "(too few particles across a band) and the chip's finer shape; the thrust, which depends on the "
-                "contact under the clearance face, moves most.", "",
-                _fig("08_cutting_work_precision.png", "work-precision"), ""]
-    return "\n".join(out)
+    if not wp:
+        return []
+    out = [P("coarse"), "", _md_table(
+        ["run", "dp [mm]", "reference", "wall [min]", "wall share", "CPU share", "Fc [%]", "Ft [%]", "chip [%]"],
+        [[r["name"], _v(r["dp_mm"], ".4g"), d["ref"], _v(r["wall_time_s"], ".1f", 1 / 60),
+          _v(d["wall_time_ratio"], ".0%"), _v(d.get("time_ratio"), ".0%"), _pct(d["cutting_force_rel"]),
+          _pct(d["thrust_force_rel"]), _pct(d["chip_thickness_rel"])] for r in wp for d in [r["vs_paper"]]])]
+    return out + ["", P("coarse_end", fc=_v(max(abs(r["vs_paper"]["cutting_force_rel"]) for r in wp), ".0%"),
+                        figure=_fig("08_cutting_work_precision.png", "work-precision")), ""]
 
 
 def main(argv=None):
     global RUNS
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--jobs", type=int, default=1, help="runs at a time (default 1)")
-    ap.add_argument("--plot-only", action="store_true", help="no runs: JSON, figures and table from earlier runs")
-    ap.add_argument("--only", default=None, help="run only the jobs whose name contains this string")
-    ap.add_argument("--runs", default=None, help=f"folder of the run folders (default {RUNS.relative_to(ROOT)})")
-    ap.add_argument("--rerun-of", default=None, metavar="DIR",
-                    help="folder of the same paper runs made by other code (e.g. an earlier commit): store how far "
-                         "each measurement moved (vs_rerun)")
-    ap.add_argument("--rerun-label", default="", help="what made the runs of --rerun-of (stored with them)")
-    ap.add_argument("--strain-figure", type=float, default=None, metavar="FEED_MM",
-                    help="only draw figures/08_cutting_strain_fFEED.png from the paper runs of that feed (mm) in the "
-                         "run folders (nothing else is written)")
-    ap.add_argument("--report", action="store_true",
-                    help=f"only write {OUT_REPORT.relative_to(ROOT)} from {OUT_JSON.relative_to(ROOT)} (runs nothing, "
-                         "changes neither the JSON nor the figures)")
-    args = ap.parse_args(argv)
+    args = _parser().parse_args(argv)
     if args.report:
         OUT_REPORT.write_text(report(json.loads(OUT_JSON.read_text())))
         print(f"wrote {OUT_REPORT.relative_to(ROOT)}")
+        return
+    if args.json_figures:
+        import matplotlib
+        matplotlib.use("Agg")
+        work_precision_figure(json.loads(OUT_JSON.read_text()))
         return
     if args.runs is not None:
         RUNS = Path(args.runs).resolve()
@@ -722,9 +660,10 @@ def main(argv=None):
         return
     jobs = [j for j in job_list() if args.only is None or args.only in j["name"]]
     if not args.plot_only:
-        from refsph.neighbours import threads_per_job      # all cores for --jobs 1, one each for --jobs 2
-        with ProcessPoolExecutor(max_workers=args.jobs, max_tasks_per_child=1) as ex:
-            list(ex.map(run_job, [dict(j, threads=threads_per_job(args.jobs)) for j in jobs]))
+        threads = study.threads_per_job(args.jobs)       # all cores for --jobs 1, one each for --jobs 2
+        for name, done in study.execute(run_job, {j["name"]: (dict(j, threads=threads),) for j in jobs}, args.jobs):
+            if done != name:
+                print(f"{name}: {done['status']}", flush=True)
     done = [j for j in job_list() if (RUNS / j["name"] / "summary.json").exists()]
     records = add_differences([record(j) for j in done])
     if args.rerun_of is not None:
@@ -737,6 +676,24 @@ def main(argv=None):
     write_json(records)
     print(table(records))
     plots(records)
+
+
+def _parser():
+    ap = study.parser(__doc__, "jobs", "plot_only", "only")
+    ap.add_argument("--runs", default=None, help=f"folder of the run folders (default {RUNS.relative_to(ROOT)})")
+    ap.add_argument("--rerun-of", default=None, metavar="DIR",
+                    help="folder of the same paper runs made by other code (e.g. an earlier commit): store how far "
+                         "each measurement moved (vs_rerun)")
+    ap.add_argument("--rerun-label", default="", help="what made the runs of --rerun-of (stored with them)")
+    ap.add_argument("--strain-figure", type=float, default=None, metavar="FEED_MM",
+                    help="only draw figures/08_cutting_strain_fFEED.png from the paper runs of that feed (mm) in the "
+                         "run folders (nothing else is written)")
+    ap.add_argument("--json-figures", action="store_true",
+                    help="only redraw the figures made from the committed JSON alone "
+                         "(figures/08_cutting_work_precision.png)")
+    return study.add_flags(ap, "report", report=dict(
+        help=f"only write {OUT_REPORT.relative_to(ROOT)} from {OUT_JSON.relative_to(ROOT)} (runs nothing, "
+             "changes neither the JSON nor the figures)"))
 
 
 if __name__ == "__main__":

@@ -23,16 +23,19 @@ with its status) and benchmarks/lammps_crosscheck_report.md (the table, the comp
 """
 from __future__ import annotations
 
-import argparse
 import json
 import platform
 import subprocess
 import sys
 import time
-from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
-import numpy as np
+sys.path.insert(0, str(Path(__file__).resolve().parent))      # benchmarks/study.py, however this file is loaded
+import study  # noqa: E402
+
+study.pin_threads()
+
+import numpy as np  # noqa: E402
 
 ROOT = Path(__file__).resolve().parent.parent
 DECKS = ROOT / "benchmarks" / "lammps"
@@ -40,6 +43,7 @@ RUNS = ROOT / "runs" / "benchmarks" / "lammps"
 OUT_JSON = ROOT / "benchmarks" / "lammps_crosscheck.json"
 REPORT = ROOT / "benchmarks" / "lammps_crosscheck_report.md"
 TOLERANCES = DECKS / "tolerances.json"
+STORE = study.RunStore(OUT_JSON, section="cases")      # {"cases": {name: record}, "comparisons", "timing", "machine"}
 REST_WINDOW_US = 30.0
 
 TAYLOR_OPTIONS = ["--option", "symmetry=false", "--option", "heating=false", "--option", "layout=lattice"]
@@ -96,7 +100,7 @@ def taylor_measures(t, L_centres, D_centres, dx):
 
 # ----------------------------------------------------------------------------- the two codes
 def run_lammps_case(name, scene, settings, out):
-    from refsph import lammps
+    from refsph.crosscheck import lammps
     deck, defaults = DECK[scene]
     variables = dict(defaults, **settings, tag="run")
     wall = lammps.finished_run(out / "lammps", variables)         # a finished LAMMPS run is converted, not rerun
@@ -172,12 +176,11 @@ def run_case(name):
 
 # ----------------------------------------------------------------------------- driver and report
 def load_results() -> dict:
-    return json.loads(OUT_JSON.read_text()) if OUT_JSON.exists() else dict(cases={})
+    return STORE.load()
 
 
-def save_results(res: dict) -> None:
-    res["machine"] = dict(platform=platform.platform(), python=platform.python_version())
-    OUT_JSON.write_text(json.dumps(res, indent=1, sort_keys=True) + "\n")
+def machine() -> dict:
+    return dict(platform=platform.platform(), python=platform.python_version())
 
 
 TIMED = ("taylor-lammps-h3", "taylor-refsph")
@@ -211,48 +214,55 @@ def compare_pair(ref_case: str, test_case: str) -> tuple[int, str]:
 
 
 def main(argv=None):
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--only", nargs="*", default=None, help="cases to run (default: all not yet done)")
-    ap.add_argument("--jobs", type=int, default=1, help="cases at a time (default 1)")
+    ap = study.parser(__doc__, "only", "jobs", only=dict(nargs="*", help="cases to run (default: all not yet done)"),
+                      jobs=dict(help="cases at a time (default 1)"))
     ap.add_argument("--redo", action="store_true", help="run the cases again even if they are done")
     ap.add_argument("--timing", action="store_true",
                     help="time LAMMPS and refsph on the Taylor bar one after the other, nothing else running")
-    ap.add_argument("--report", action="store_true", help="write the report from the committed JSON only")
+    study.add_flags(ap, "report", report=dict(help="write the report from the committed JSON only"))
     args = ap.parse_args(argv)
     if args.report:
         REPORT.write_text(report(load_results()))
         print(f"wrote {REPORT}")
         return 0
-    from refsph import lammps
-    res = load_results()
     if args.timing:
-        res["timing"] = clean_timing()
-        save_results(res)
-        REPORT.write_text(report(res))
-        print(f"wrote {OUT_JSON} and {REPORT}")
-        return 0
-    todo = [n for n in (args.only or CASES) if args.redo or res["cases"].get(n, {}).get("status") != "ok"]
-    if lammps.find_lmp() is None:
-        print(lammps.INSTALL_HINT)
-        todo = [n for n in todo if CASES[n][0] == "refsph" and (RUNS / CASES[n][3] / "particles.npz").exists()]
-    lammps_first = sorted(todo, key=lambda n: CASES[n][0] != "lammps")
-    for wave in ([n for n in lammps_first if CASES[n][0] == "lammps"], [n for n in lammps_first
-                                                                        if CASES[n][0] == "refsph"]):
-        with ProcessPoolExecutor(max_workers=max(1, args.jobs)) as pool:
-            for rec in pool.map(run_case, wave):
-                res["cases"][rec["name"]] = rec
-                print(f"{rec['name']:24s} {rec['status'][:70]}  {rec.get('wall_time_s', float('nan')):8.1f} s",
-                      flush=True)
-                save_results(res)
-    res["comparisons"] = {}
-    for a, b in PAIRS:
-        if all(res["cases"].get(n, {}).get("status") == "ok" for n in (a, b)):
-            rc, table = compare_pair(a, b)
-            res["comparisons"][f"{a} vs {b}"] = dict(exit_code=rc, table=table)
-    save_results(res)
+        res = STORE.set(timing=clean_timing(), machine=machine())
+    else:
+        sweep(args.only or list(CASES), args.redo, args.jobs)
+        done = STORE.load()
+        res = STORE.set(comparisons=comparisons(done["cases"], done.get("comparisons", {})), machine=machine())
     REPORT.write_text(report(res))
     print(f"wrote {OUT_JSON} and {REPORT}")
     return 0
+
+
+def sweep(names: list, redo: bool, jobs: int) -> None:
+    """The cases not yet done (all of ``names`` with ``redo``): the LAMMPS ones first (they write the particles)."""
+    from refsph.crosscheck import lammps
+    todo = STORE.pending(names, redo=names if redo else (), retry_failed=True)
+    if lammps.find_lmp() is None:
+        print(lammps.INSTALL_HINT)
+        todo = [n for n in todo if CASES[n][0] == "refsph" and (RUNS / CASES[n][3] / "particles.npz").exists()]
+    for code in ("lammps", "refsph"):
+        wave = {n: (n,) for n in todo if CASES[n][0] == code}
+        for name, rec in study.execute(run_case, wave, jobs):
+            STORE.commit(name, rec)
+            STORE.set(machine=machine())
+            print(f"{name:24s} {rec['status'][:70]}  {rec.get('wall_time_s', float('nan')):8.1f} s", flush=True)
+
+
+def comparisons(cases: dict, old: dict) -> dict:
+    """``refsph compare`` of each pair of PAIRS whose cases are both done; where their run folders are gone, the
+    comparison ``old`` holds (made with them) is kept."""
+    out = {}
+    for a, b in PAIRS:
+        if all(cases.get(n, {}).get("status") == "ok" for n in (a, b)):
+            if all((RUNS / n / "run").exists() for n in (a, b)):
+                rc, table = compare_pair(a, b)
+                out[f"{a} vs {b}"] = dict(exit_code=rc, table=table)
+            elif f"{a} vs {b}" in old:
+                out[f"{a} vs {b}"] = old[f"{a} vs {b}"]
+    return out
 
 
 def _row(c, keys):
@@ -268,11 +278,8 @@ def _row(c, keys):
 
 def report(res: dict) -> str:
     cases = res.get("cases", {})
-    lines = ["# refsph against LAMMPS-SMD", "",
-             "Made by `python benchmarks/lammps_crosscheck.py` (`--report` redraws this page from "
-             "`benchmarks/lammps_crosscheck.json`). The explanation of every difference is in "
-             "chapter 09 (`chapters/09_cross_check.py`) and the README section "
-             "\"Cross-checking against LAMMPS-SMD\".", ""]
+    P = study.Page("lammps_crosscheck_report")      # the prose: benchmarks/templates/lammps_crosscheck_report.md
+    lines = [P("head"), ""]
     for scene, keys in (("bar", ("wave_speed_m_s", "ke_peak_ratio")),
                         ("taylor", ("final_length_mm", "final_diameter_mm", "max_plastic_strain"))):
         lines += [f"## {scene}", "", "| case | code | settings | " + " | ".join(keys) +
@@ -283,14 +290,13 @@ def report(res: dict) -> str:
     for pair, cmp in res.get("comparisons", {}).items():
         lines += [f"### `refsph compare` {pair} (exit {cmp['exit_code']})", "", "```", cmp["table"], "```", ""]
     if res.get("timing"):
-        lines += ["## One core, nothing else running (`--timing`)", "",
-                  "| run | particles | steps | wall [s] | s per step |", "|---|---|---|---|---|"]
+        lines += [P("timing")]
         lines += [f"| {n} | {t['n_particles']} | {t['n_steps']} | {t['wall_time_s']:.0f} | {t['s_per_step']:.3f} |"
                   for n, t in res["timing"].items()]
         lines.append("")
     missing = [n for n in CASES if cases.get(n, {}).get("status") != "ok"]
     if missing:
-        lines += ["Still to run (or failed): " + ", ".join(missing), ""]
+        lines += [P("missing", missing=", ".join(missing)), ""]
     return "\n".join(lines)
 
 

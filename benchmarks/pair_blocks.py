@@ -19,16 +19,17 @@ being under 30 minutes. Output: a table and ``benchmarks/pair_blocks.json``.
 """
 from __future__ import annotations
 
-import os
+import sys
+from pathlib import Path
 
-for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "BLIS_NUM_THREADS",
-             "VECLIB_MAXIMUM_THREADS", "NUMEXPR_NUM_THREADS"):
-    os.environ[_var] = "1"      # BLAS is not used in the steps; refsph's own threads are Numerics.threads
+sys.path.insert(0, str(Path(__file__).resolve().parent))      # benchmarks/study.py, however this file is loaded
+import study  # noqa: E402
+
+study.pin_threads()      # BLAS is not used in the steps; refsph's own threads are Numerics.threads
 
 import argparse  # noqa: E402
 import dataclasses  # noqa: E402
 import time  # noqa: E402
-from pathlib import Path  # noqa: E402
 
 import numpy as np  # noqa: E402
 

@@ -28,19 +28,15 @@ its heap has grown already); with --jobs 2 two runs share the machine's two core
 """
 from __future__ import annotations
 
-import os
+import json
+import sys
+import time
+from pathlib import Path
 
-# one core per run: pin the BLAS / OpenMP thread pools before NumPy is imported (inherited by the workers)
-for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "BLIS_NUM_THREADS",
-             "VECLIB_MAXIMUM_THREADS", "NUMEXPR_NUM_THREADS"):
-    os.environ[_var] = "1"
+sys.path.insert(0, str(Path(__file__).resolve().parent))      # benchmarks/study.py, however this file is loaded
+import study  # noqa: E402
 
-import argparse  # noqa: E402
-import json  # noqa: E402
-import sys  # noqa: E402
-import time  # noqa: E402
-from concurrent.futures import ProcessPoolExecutor  # noqa: E402
-from pathlib import Path  # noqa: E402
+study.pin_threads()         # one core per run: BLAS / OpenMP pools at one thread (inherited by the workers)
 
 import numpy as np  # noqa: E402
 
@@ -220,17 +216,25 @@ def _moving_average(y, k):
 def plots(records, json_only: bool = False):
     """The benchmark's figures; ``json_only``: only those drawn from the records alone (the work-precision plot)."""
     import matplotlib
-    import matplotlib.ticker
     matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    from refsph.io import load_snapshot
-
     FIG.mkdir(exist_ok=True)
-    colors = dict(esph="C0", tlsph="C3")
     conv = {m: sorted([r for r in records if r["name"].startswith("conv-") and r["method"] == m],
                       key=lambda r: -r["dp_mm"]) for m in METHODS}
+    _plot_work_precision(records, conv)
+    if json_only:                                       # the rest needs the run folders
+        return
+    _plot_resolution(conv)
+    _plot_force(conv)
 
-    # work-precision: difference to the finest run of the same method against wall time
+
+COLORS = dict(esph="C0", tlsph="C3")
+
+
+def _plot_work_precision(records, conv):
+    """Difference to the finest run of the same method against wall time."""
+    import matplotlib.ticker
+    import matplotlib.pyplot as plt
+    colors = COLORS
     plain = matplotlib.ticker.FuncFormatter(lambda v, _: f"{v:g}" if f"{v:.0e}"[0] in "1235" else "")
     fig, axs = plt.subplots(2, 2, figsize=(11, 8.5), layout="constrained")
     for ax, key, label in ((axs[0, 0], "force_mean_rel", "mean tool force, 2nd half"),
@@ -267,10 +271,12 @@ def plots(records, json_only: bool = False):
                  "dp = 0.00667 mm)", fontsize=11)
     fig.savefig(FIG / "07_pressing_work_precision.png", dpi=120)
     plt.close(fig)
-    if json_only:                                       # the rest needs the run folders
-        return
 
-    # Fig. 10 analogue: final plastic strain at the four spacings
+
+def _plot_resolution(conv):
+    """Fig. 10 analogue: final plastic strain at the four spacings."""
+    import matplotlib.pyplot as plt
+    from refsph.io import load_snapshot
     ncol = max(len(conv[m]) for m in METHODS)
     fig = plt.figure(figsize=(3.3 * ncol + 1.0, 6.6))
     axs = fig.subplots(2, ncol, squeeze=False, gridspec_kw=dict(left=0.05, right=0.9, bottom=0.08, top=0.86,
@@ -306,7 +312,10 @@ def plots(records, json_only: bool = False):
     fig.savefig(FIG / "07_pressing_resolution.png", dpi=130)
     plt.close(fig)
 
-    # tool force against time
+
+def _plot_force(conv):
+    """Tool force against time."""
+    import matplotlib.pyplot as plt
     fig, axs = plt.subplots(1, 2, figsize=(12, 4.2), constrained_layout=True, sharey=True)
     for ax, m in zip(axs, METHODS):
         for k, r in enumerate(conv[m]):
@@ -332,66 +341,57 @@ def _pct(x, signed=True) -> str:
     return f"{100 * x:+.1f} %" if signed else f"{100 * x:.1f} %"
 
 
-def _md_table(head, rows) -> str:
-    """A markdown table (no '|' may occur inside a cell)."""
-    cells = [head] + rows
-    assert not any("|" in c for row in cells for c in row), "a '|' inside a table cell"
-    out = ["| " + " | ".join(head) + " |", "|" + "|".join("---:" if k else ":---" for k in range(len(head))) + "|"]
-    out += ["| " + " | ".join(row) + " |" for row in rows]
-    return "\n".join(out)
+def _aligned(head, rows) -> str:
+    """A markdown table, the first column left-aligned, the others right."""
+    return study.md_table(head, rows, align=True)
 
 
 def _fig(name, caption) -> str:
     return f"![{caption}](../figures/{name})" if (FIG / name).exists() else f"(figure `figures/{name}` not there)"
 
 
+def _join(xs) -> str:
+    return ", ".join(f"{x:g}" for x in xs)
+
+
+def _um(r) -> str:
+    return f"{1e3 * r['dp_nominal_mm']:.3g}"
+
+
 def report(records) -> str:
-    """benchmarks/pressing_report.md from the records of benchmarks/pressing.json (runs nothing)."""
-    by = {r["name"]: r for r in records}
+    """benchmarks/pressing_report.md from the records of benchmarks/pressing.json (runs nothing); the prose is
+    benchmarks/templates/pressing_report.md."""
+    P = study.Page("pressing_report")
     conv = sorted([r for r in records if r["name"].startswith("conv-")], key=lambda r: (r["method"], -r["dp_mm"]))
     conv_m = {m: [r for r in conv if r["method"] == m] for m in METHODS}
-    kps = {r["name"]: 1e-3 * r["n_particles"] * r["n_steps"] / r["wall_time_s"] for r in records}
-    um = lambda r: f"{1e3 * r['dp_nominal_mm']:.3g}"                                         # noqa: E731
-    dt_label = lambda r: "CFL 0.3" if r["dt_mode"] == "cfl" else f"fixed {r['dt_s']:.0e} s"  # noqa: E731
-    travel = sorted({round(r["tool_travel_mm"], 6) for r in records})
-    t_end = sorted({round(r["t_final_us"], 6) for r in records})
-    speed = sorted({round(r["tool_travel_mm"] / r["t_final_us"] * 1e3) for r in records})          # mm/us -> m/s
-    h_dp = sorted({round(r["h_mm"] / r["dp_mm"], 3) for r in records})
-    n_bins = sorted({len(r["tool_force_history_ns_MN_per_m"]) for r in records})
-    kp_default = sorted({r["contact_Kp"] for r in conv if r["contact_Kp"] is not None})
-    join = lambda xs: ", ".join(f"{x:g}" for x in xs)                                          # noqa: E731
-    L = []
-    L += ["# Metal pressing benchmark (Section 3.2 of Islam, Bansal & Peng)", "",
-          f"Generated by `python benchmarks/pressing.py --report` from `benchmarks/pressing.json` ({len(records)} "
-          "runs); do not edit by hand. The lesson is chapter 07 (`chapters/07_pressing.py`); this report holds the "
-          "resolution study, the sensitivity to the time step and to the pinball factor, and the cost.", "",
-          "The paper shows contour plots only (Figs. 7-10), no numbers, so nothing here is compared with the paper: "
-          "each method is compared with **its own finest run**. A difference to the finest run measures "
-          "convergence, not accuracy.", ""]
+    L = [P("head", n_runs=len(records)), ""]
+    L += _report_runs(P, records)
+    L += _report_resolution(P, records, conv, conv_m)
+    L += _report_convergence(P, records, conv_m)
+    L += _report_cost(P, records, conv, conv_m)
+    L += _report_sensitivity(P, records, conv)
+    L += [P("snapshots"), ""]
+    return "\n".join(L)
 
-    L += ["## What was run", "",
-          "The scene `refsph.scenes.pressing`: the paper's AISI 4340 block in 2D plane strain, its left column "
-          f"clamped, pressed by a rigid tool moving at {join(speed)} m/s; tool travel {join(travel)} mm "
-          f"(t = {join(t_end)} us). Both methods at the four spacings of the paper's Fig. 10 with h = {join(h_dp)} dp "
-          "and the CFL step "
-          "(`conv-*`); at one spacing also the paper's fixed time step (`dt1e-10-*`) and TLSPH with other pinball "
-          "scaling factors K_p (`kp*`). Each run is one fresh process; `python benchmarks/pressing.py --help` and "
-          "`benchmarks/README.md` say how the wall times were taken.", ""]
-    L += [_md_table(["run", "method", "dp [um]", "particles", "steps", "time step", "K_p", "wall [s]", "status"],
-                    [[r["name"], r["method"].upper(), um(r), f"{r['n_particles']}", f"{r['n_steps']}", dt_label(r),
+
+def _report_runs(P, records) -> list[str]:
+    dt_label = lambda r: "CFL 0.3" if r["dt_mode"] == "cfl" else f"fixed {r['dt_s']:.0e} s"  # noqa: E731
+    L = [P("what", speed=_join(sorted({round(r["tool_travel_mm"] / r["t_final_us"] * 1e3) for r in records})),
+           travel=_join(sorted({round(r["tool_travel_mm"], 6) for r in records})),
+           t_end=_join(sorted({round(r["t_final_us"], 6) for r in records})),
+           h_dp=_join(sorted({round(r["h_mm"] / r["dp_mm"], 3) for r in records}))), ""]
+    L += [_aligned(["run", "method", "dp [um]", "particles", "steps", "time step", "K_p", "wall [s]", "status"],
+                    [[r["name"], r["method"].upper(), _um(r), f"{r['n_particles']}", f"{r['n_steps']}", dt_label(r),
                       "-" if r["contact_Kp"] is None else f"{r['contact_Kp']:g}", f"{r['wall_time_s']:.1f}",
                       r["status"]] for r in records]), ""]
+    return L
 
-    L += ["## The resolution study (the paper's Fig. 10)", "",
-          "Forces are of the block on the tool and on the clamp per metre of thickness (MN/m = kN per mm): the "
-          f"mean over the second half of the run, and the peak of the {join(n_bins)}-bin history. The line is the "
-          "plastic strain along the row of particles that started at mid-height (the paper's Fig. 8): its peak, "
-          "where the peak is, and the peak's width at half its height (how wide the shear bands are where they "
-          "cross). eps p99 and eps max: the 99th percentile and the maximum of the plastic strain in the block. "
-          "gap: the smallest block-tool distance in spacings (1: the faces touch).", ""]
-    L += [_md_table(["run", "dp [um]", "F mean", "clamp", "F peak", "line peak", "at x [mm]", "width [mm]",
+
+def _report_resolution(P, records, conv, conv_m) -> list[str]:
+    L = [P("resolution", n_bins=_join(sorted({len(r["tool_force_history_ns_MN_per_m"]) for r in records}))), ""]
+    L += [_aligned(["run", "dp [um]", "F mean", "clamp", "F peak", "line peak", "at x [mm]", "width [mm]",
                      "eps p99", "eps max", "T max [K]", "gap/dp"],
-                    [[r["name"], um(r), f"{r['tool_force_mean_MN_per_m']:.3f}",
+                    [[r["name"], _um(r), f"{r['tool_force_mean_MN_per_m']:.3f}",
                       f"{-r['clamp_force_mean_MN_per_m']:.3f}", f"{r['tool_force_peak_MN_per_m']:.2f}",
                       f"{r['line_peak']:.3f}", f"{r['line_peak_x_mm']:.2f}", f"{r['line_peak_width_mm']:.3f}",
                       f"{r['plastic_strain_p99']:.3f}", f"{r['max_plastic_strain']:.2f}",
@@ -400,28 +400,17 @@ def report(records) -> str:
           _fig("07_pressing_force.png", "tool force against time at the four spacings"), ""]
     fine = {m: conv_m[m][-1] for m in METHODS if conv_m[m]}
     coarse = {m: conv_m[m][0] for m in METHODS if conv_m[m]}
-    width = ", ".join(f"{m.upper()} from {coarse[m]['line_peak_width_mm']:.3f} to {fine[m]['line_peak_width_mm']:.3f}"
-                      f" mm" for m in fine)
-    L += ["How to read them. As in the paper, the shear bands become narrower and more distinct as the spacing "
-          f"shrinks (the width of the line's peak falls: {width}), while the overall shape (how far the block "
-          "spreads, where the bands cross) does not change. The tool force has nearly the same impact peak, ringing "
-          "and mean level at every spacing. The peak of TLSPH's binned force is not a physical number: the pinball "
-          "force comes in impulses one step long, so the peak of a bin depends on how many steps fall into it, "
-          "that is on dp and dt; compare mean forces.", "",
-          "The maximum plastic strain is a corner value. It sits in the few particles where the block's corners "
-          "meet the tool's edges, where the strain has no finite limit as the spacing shrinks: the maximum grows "
-          "on refinement (" + ", ".join(f"{m.upper()} from {coarse[m]['max_plastic_strain']:.2f} to "
-                                        f"{fine[m]['max_plastic_strain']:.2f}" for m in fine)
-          + "), the 99th percentile settles (" + ", ".join(f"{m.upper()} {coarse[m]['plastic_strain_p99']:.3f} to "
-                                                            f"{fine[m]['plastic_strain_p99']:.3f}" for m in fine)
-          + "). So does the maximum temperature, which follows the corner strain. ESPH lets the block's particles "
-          "come closer to the tool's than one spacing (the tool's particles are only SPH neighbours; nothing "
-          "forbids overlap), while the pinball holds TLSPH's gap near one spacing.", ""]
 
-    L += ["## Convergence: each method against its own finest run (work-precision)", "",
-          "Relative differences to the finest `conv` run of the same method (`vs_finest` in the JSON): the mean "
-          "tool force, the peak of the line, the L2 difference of the two lines on a common x grid, the width of "
-          "the line's peak.", ""]
+    def change(key, fmt, sep, unit=""):
+        return ", ".join(f"{m.upper()}{sep}{format(coarse[m][key], fmt)} to {format(fine[m][key], fmt)}{unit}"
+                         for m in fine)
+    return L + [P("how_to_read", width=change("line_peak_width_mm", ".3f", " from ", " mm"),
+                  max_growth=change("max_plastic_strain", ".2f", " from "),
+                  p99=change("plastic_strain_p99", ".3f", " ")), ""]
+
+
+def _report_convergence(P, records, conv_m) -> list[str]:
+    L = [P("convergence"), ""]
     rows = []
     for r in records:
         d = r.get("vs_finest")
@@ -429,23 +418,17 @@ def report(records) -> str:
             continue
         rows.append([r["name"], d["ref"], f"{r['wall_time_s']:.1f}", _pct(d["force_mean_rel"]),
                      _pct(d["line_peak_rel"]), _pct(d["line_L2_rel"], False), _pct(d["line_width_rel"])])
-    L += [_md_table(["run", "against", "wall [s]", "F mean", "line peak", "line L2", "width"], rows), ""]
+    L += [_aligned(["run", "against", "wall [s]", "F mean", "line peak", "line L2", "width"], rows), ""]
     L += [_fig("07_pressing_work_precision.png", "work-precision: difference to the finest run against wall time"), ""]
-    worst_f = {m: max(abs(r["vs_finest"]["force_mean_rel"]) for r in conv_m[m][:-1]) for m in fine}
-    L += ["The mean force is within " + ", ".join(f"{100 * worst_f[m]:.1f} % ({m.upper()})" for m in worst_f)
-          + " of the finest run already at the coarsest spacing, and its differences need not fall steadily: "
-          "they are of the size of the force's ringing, not a discretisation error. The strain along the line "
-          "converges more slowly, because the bands it crosses get narrower and taller as the spacing shrinks; for "
-          "TLSPH not even monotonically.", ""]
+    worst_f = {m: max(abs(r["vs_finest"]["force_mean_rel"]) for r in conv_m[m][:-1]) for m in METHODS if conv_m[m]}
+    return L + [P("force_within", worst=", ".join(f"{100 * worst_f[m]:.1f} % ({m.upper()})" for m in worst_f)), ""]
 
-    L += ["## Cost", "",
-          "Particles grow as dp^-2 and steps (CFL) as dp^-1, so the wall time should grow as dp^-3. The cost per "
-          "particle-step (thousand particle-steps per second) is the other half of the story.", ""]
-    rows = []
-    for r in conv:
-        rows.append([r["name"], f"{r['n_particles']}", f"{r['n_steps']}", f"{r['wall_time_s']:.1f}",
-                     f"{kps[r['name']]:.0f}"])
-    L += [_md_table(["run", "particles", "steps", "wall [s]", "k particle-steps/s"], rows), ""]
+
+def _report_cost(P, records, conv, conv_m) -> list[str]:
+    kps = {r["name"]: 1e-3 * r["n_particles"] * r["n_steps"] / r["wall_time_s"] for r in records}
+    rows = [[r["name"], f"{r['n_particles']}", f"{r['n_steps']}", f"{r['wall_time_s']:.1f}", f"{kps[r['name']]:.0f}"]
+            for r in conv]
+    L = [P("cost"), "", _aligned(["run", "particles", "steps", "wall [s]", "k particle-steps/s"], rows), ""]
     fits = []
     for m in METHODS:
         rs = conv_m[m]
@@ -453,30 +436,19 @@ def report(records) -> str:
             k = np.polyfit(np.log([r["dp_mm"] for r in rs]), np.log([r["wall_time_s"] for r in rs]), 1)[0]
             fits.append(f"{m.upper()} wall ~ dp^{k:.1f}")
     ratio = np.mean([kps[a["name"]] / kps[b["name"]] for a, b in zip(conv_m["tlsph"], conv_m["esph"])])
-    L += ["Fitted over the four spacings: " + ", ".join(fits) + ". TLSPH does on average "
-          f"{ratio:.1f} times as many particle-steps per second as ESPH: ESPH's Verlet list holds more pairs, and "
-          "its kernels are evaluated anew at every rate evaluation, while TLSPH's live in the reference "
-          "configuration. The wall times are those of the machine and code that wrote the JSON: compare ratios, "
-          "not seconds.", ""]
+    return L + [P("cost_fit", fits=", ".join(fits), ratio=f"{ratio:.1f}"), ""]
 
-    for title, prefix, text in (
-            ("The time step: CFL against the paper's fixed step", "dt1e-10-",
-             "The paper's fixed step is smaller than the CFL step, and costs that many more steps. ESPH's results "
-             "hardly move: the CFL step is small enough. TLSPH's strain line moves by several per cent, because "
-             "the time step enters its contact law: the first branch of the pinball force, "
-             "$K_p m_i \\dot p_d/\\Delta t$ (Eq. 34), is $n$ times stiffer with an $n$ times smaller step."),
-            ("The pinball scaling factor K_p (TLSPH)", "kp",
-             "The paper gives no K_p (\"chosen through numerical experiment\"); refsph uses "
-             f"{join(kp_default)}. Changing it "
-             "changes the same stiffness as the time step does, and moves the strain line by a similar amount, "
-             "while the mean force hardly moves and the deepest pinball penetration falls as K_p grows. So "
-             "TLSPH's strain field near the band crossing depends on the contact law about as much as on the last "
-             "refinement step.")):
+
+def _report_sensitivity(P, records, conv) -> list[str]:
+    """The time step and the pinball factor: each run against its conv run (vs_base)."""
+    by = {r["name"]: r for r in records}
+    kp_default = _join(sorted({r["contact_Kp"] for r in conv if r["contact_Kp"] is not None}))
+    L = []
+    for prefix, title, text in (("dt1e-10-", "dt1e-10-", "dt1e-10-_text"), ("kp", "kp", "kp_text")):
         sens = [r for r in records if r["name"].startswith(prefix)]
         if not sens:
             continue
-        L += [f"## {title}", "", "Each run against the `conv` run of the same method and spacing (`vs_base` in "
-              "the JSON).", ""]
+        L += [P(title), "", P("vs_base"), ""]
         rows = []
         for r in sens:
             d = r["vs_base"]
@@ -487,28 +459,17 @@ def report(records) -> str:
                          _pct(d["force_mean_rel"]), _pct(d["line_peak_rel"]), _pct(d["line_L2_rel"], False),
                          _pct(d["line_width_rel"]),
                          "-" if pen is None else f"{pen:.3f} / {pen_b:.3f}"])
-        L += [_md_table(["run", "against", "steps", "wall ratio", "F mean", "line peak", "line L2", "width",
-                         "penetration/dp"], rows), "", text, ""]
-
-    L += ["## Seen in the snapshots, not in the JSON", "",
-          "Two observations from the final snapshots of these runs are not in the JSON and are described in words "
-          "only. Away from the tool, TLSPH's particle rows stay more regular than ESPH's, whose rows slip past each "
-          "other (the streaks in ESPH's panels of the resolution figure), as the paper says. And TLSPH's pinball "
-          "force with K_p > 1 amplifies round-off: the test is symmetric about mid-height, ESPH keeps that symmetry "
-          "to round-off, TLSPH does not (chapter 07 measures it at its own spacing).", ""]
-    return "\n".join(L)
+        L += [_aligned(["run", "against", "steps", "wall ratio", "F mean", "line peak", "line L2", "width",
+                         "penetration/dp"], rows), "", P(text, kp_default=kp_default), ""]
+    return L
 
 
 def main(argv=None):
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--jobs", type=int, default=1, help="runs at a time (default 1)")
-    ap.add_argument("--plot-only", action="store_true", help="no runs: JSON, figures and table from earlier runs")
-    ap.add_argument("--only", default=None, help="run only the jobs whose name contains this string")
-    ap.add_argument("--json-figures", action="store_true",
-                    help="only redraw the figures made from the committed JSON alone "
-                         "(figures/07_pressing_work_precision.png)")
-    ap.add_argument("--report", action="store_true",
-                    help=f"no runs: write {OUT_REPORT.name} from the committed {OUT_JSON.name} (nothing else)")
+    ap = study.parser(__doc__, "jobs", "plot_only", "only", "json_figures", "report",
+                      json_figures=dict(help="only redraw the figures made from the committed JSON alone "
+                                             "(figures/07_pressing_work_precision.png)"),
+                      report=dict(help=f"no runs: write {OUT_REPORT.name} from the committed {OUT_JSON.name} "
+                                       "(nothing else)"))
     args = ap.parse_args(argv)
     if args.json_figures:
         plots(json.loads(OUT_JSON.read_text()), json_only=True)
@@ -520,13 +481,14 @@ def main(argv=None):
     jobs = job_list()
     todo = [j for j in jobs if args.only is None or args.only in j["name"]]
     if not args.plot_only:
-        from refsph.neighbours import threads_per_job      # all cores for --jobs 1, one each for --jobs 2
         todo.sort(key=lambda j: (j["dp"], j["dt"] is None))      # longest first
-        # a fresh process for every run: a worker that ran a large run before starts the next one with a grown
-        # heap and runs it faster (glibc returns freed memory to the OS only at the top of the heap), so reused
-        # workers would make the wall times depend on the order of the runs
-        with ProcessPoolExecutor(max_workers=args.jobs, max_tasks_per_child=1) as ex:
-            list(ex.map(run_job, [dict(j, threads=threads_per_job(args.jobs)) for j in todo]))
+        # a fresh process for every run (study.execute): a worker that ran a large run before starts the next one
+        # with a grown heap and runs it faster (glibc returns freed memory to the OS only at the top of the heap),
+        # so reused workers would make the wall times depend on the order of the runs
+        threads = study.threads_per_job(args.jobs)       # all cores for --jobs 1, one each for --jobs 2
+        for name, done in study.execute(run_job, {j["name"]: (dict(j, threads=threads),) for j in todo}, args.jobs):
+            if done != name:
+                print(f"{name}: {done['status']}", flush=True)
     have = [j for j in jobs if (RUNS / j["name"] / "summary.json").exists()]
     records = add_differences([record(j) for j in have])
     write_json(records)

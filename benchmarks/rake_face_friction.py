@@ -21,7 +21,12 @@ import math
 import sys
 from pathlib import Path
 
-import numpy as np
+sys.path.insert(0, str(Path(__file__).resolve().parent))      # benchmarks/study.py, however this file is loaded
+import study  # noqa: E402
+
+study.pin_threads()
+
+import numpy as np  # noqa: E402
 
 OUT_JSON = Path(__file__).resolve().parent / "rake_face_friction.json"
 
@@ -60,9 +65,13 @@ def measure(options: dict) -> dict:
                 mu_law=float(np.nanmean(a[:, 4])), force_ratio=res.summary["metrics"]["force_ratio"])
 
 
-def main() -> int:
+def main(argv=None) -> int:
+    ap = study.parser(__doc__)
+    ap.add_argument("--json", type=Path, default=OUT_JSON, help="where to write the result (default: "
+                                                                  "rake_face_friction.json)")
+    path = ap.parse_args(argv).json
     out = measure(dict(case=1, length=1.2e-3, travel=4.0))
-    OUT_JSON.write_text(json.dumps(out, indent=1) + "\n")
+    path.write_text(json.dumps(out, indent=1) + "\n")
     print(json.dumps(out, indent=1))
     return 0
 

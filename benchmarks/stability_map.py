@@ -24,19 +24,22 @@ warning applies; tests/test_hard_cases.py checks them against this map.
 """
 from __future__ import annotations
 
-import argparse
-import json
 import sys
 import time
-from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
-import numpy as np
+sys.path.insert(0, str(Path(__file__).resolve().parent))      # benchmarks/study.py, however this file is loaded
+import study  # noqa: E402
+
+study.pin_threads()
+
+import numpy as np  # noqa: E402
 
 ROOT = Path(__file__).resolve().parent.parent
 OUT_JSON = ROOT / "benchmarks" / "stability_map.json"
 REPORT = ROOT / "benchmarks" / "stability_map_report.md"
 FIGURE = ROOT / "figures" / "10_stability_map.png"
+STORE = study.RunStore(OUT_JSON, good=lambda rec: "survived" in rec)   # a run that failed to run has no verdict
 
 CASES = ("bar", "spinning", "rings", "taylor2x", "pressing10x")
 COMMON = {"baseline": {}, "beta 0": dict(beta1=0.0, beta2=0.0), "beta 0.5": dict(beta1=0.5, beta2=0.5),
@@ -107,19 +110,10 @@ def keys() -> list[str]:
     return [f"{c}|{m}|{v}" for c in CASES for m in VARIANTS for v in VARIANTS[m]]
 
 
-def load() -> dict:
-    return json.loads(OUT_JSON.read_text()) if OUT_JSON.exists() else dict(runs={})
-
-
-def save(res: dict) -> None:
-    OUT_JSON.write_text(json.dumps(res, indent=1, sort_keys=True, default=float) + "\n")
-
-
 def report(res: dict) -> str:
     runs = res["runs"]
-    lines = ["# The stability map", "", "Made by `python benchmarks/stability_map.py` (module text: the cases, the "
-             "settings, what survived means). Each cell: survived (yes) or failed (NO), the case's accuracy number, "
-             "the wall time of the run on one core.", ""]
+    P = study.Page("stability_map_report")          # the prose: benchmarks/templates/stability_map_report.md
+    lines = [P("head"), ""]
     for method in VARIANTS:
         lines += [f"## {method.upper()}", "", "| setting | " + " | ".join(CASES) + " |",
                   "|---|" + "---|" * len(CASES)]
@@ -127,15 +121,15 @@ def report(res: dict) -> str:
             cells = []
             for c in CASES:
                 r = runs.get(f"{c}|{method}|{v}")
-                if r is None:
+                if r is None or not STORE.good(r):
                     cells.append("(to run)")
                     continue
                 acc = "" if not np.isfinite(r["accuracy"]) else f" {r['accuracy']:.3g}"
                 cells.append(f"{'yes' if r['survived'] else 'NO'}{acc} ({r['wall_time_s']:.0f} s)")
             lines.append(f"| {v} | " + " | ".join(cells) + " |")
         lines.append("")
-    done = [r["wall_time_s"] for r in runs.values()]
-    lines += [f"{len(done)} of {len(keys())} runs done, {sum(done) / 60:.1f} CPU-minutes in all.", ""]
+    done = [r["wall_time_s"] for r in runs.values() if STORE.good(r)]
+    lines += [P("total", done=len(done), all=len(keys()), minutes=f"{sum(done) / 60:.1f}"), ""]
     return "\n".join(lines)
 
 
@@ -150,7 +144,7 @@ def figure(res: dict) -> None:
         for i, v in enumerate(vs):
             for j, c in enumerate(CASES):
                 r = res["runs"].get(f"{c}|{method}|{v}")
-                if r is not None:
+                if r is not None and STORE.good(r):
                     grid[i, j] = 1.0 if r["survived"] else 0.0
                     ax.text(j, i, "yes" if r["survived"] else "NO", ha="center", va="center", fontsize=9)
         ax.imshow(grid, cmap="RdYlGn", vmin=-0.3, vmax=1.3, aspect="auto")
@@ -161,21 +155,19 @@ def figure(res: dict) -> None:
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--jobs", type=int, default=1)
-    ap.add_argument("--only", nargs="*", default=None, help="cases to run (default: all)")
-    ap.add_argument("--report", action="store_true", help="table and figure from the committed JSON only")
+    ap = study.parser(__doc__, "jobs", "only", "report",
+                      only=dict(nargs="*", help="cases to run (default: all)"),
+                      report=dict(help="table and figure from the committed JSON only"))
     args = ap.parse_args(argv)
-    res = load()
     if not args.report:
-        todo = [k for k in keys() if k not in res["runs"] and (args.only is None or k.split("|")[0] in args.only)]
-        print(f"{len(todo)} runs to do ({len(res['runs'])} done)", flush=True)
-        with ProcessPoolExecutor(max_workers=max(1, args.jobs)) as pool:
-            for k, rec in enumerate(pool.map(run_one, todo)):
-                res["runs"][rec["key"]] = rec
-                save(res)
-                print(f"[{k + 1}/{len(todo)}] {rec['key']:40s} {'survived' if rec['survived'] else 'FAILED':9s} "
-                      f"{rec['accuracy']:.4g} {rec['wall_time_s']:6.1f} s", flush=True)
+        todo = [k for k in STORE.pending(keys(), retry_failed=True)
+                if args.only is None or k.split("|")[0] in args.only]
+        print(f"{len(todo)} runs to do ({len(STORE.records())} done)", flush=True)
+        for k, (key, rec) in enumerate(study.execute(run_one, {key: (key,) for key in todo}, args.jobs)):
+            STORE.commit(key, rec)
+            print(f"[{k + 1}/{len(todo)}] {key:40s} {'survived' if rec.get('survived') else 'FAILED':9s} "
+                  f"{rec.get('accuracy', float('nan')):.4g} {rec.get('wall_time_s', float('nan')):6.1f} s", flush=True)
+    res = STORE.load()
     REPORT.write_text(report(res))
     figure(res)
     print(f"wrote {OUT_JSON}, {REPORT}, {FIGURE}")

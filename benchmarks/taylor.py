@@ -16,18 +16,22 @@ rest time, peaks, wall time, particle count, steps) and the figures
   figures/06_taylor_length_history.png   length against time (cf. the paper's Fig. 3)
   figures/06_taylor_sections.png         plastic strain and temperature on the section at 15 and 30 us (Figs. 4-5)
   benchmarks/taylor_report.md            (--report) the study as a report, every table number from taylor.json
-Wall times are single-core (each run is one process); with --jobs 2 two runs share the machine's two cores.
+Wall times are single-core (each run is a fresh process, study.execute); with --jobs 2 two runs share the machine's
+two cores.
 """
 from __future__ import annotations
 
-import argparse
 import json
 import sys
 import time
-from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
-import numpy as np
+sys.path.insert(0, str(Path(__file__).resolve().parent))      # benchmarks/study.py, however this file is loaded
+import study  # noqa: E402
+
+study.pin_threads()
+
+import numpy as np  # noqa: E402
 
 ROOT = Path(__file__).resolve().parent.parent
 RUNS = ROOT / "runs" / "benchmarks" / "taylor"
@@ -88,17 +92,25 @@ def plots(records, json_only: bool = False):
     """The benchmark's figures; ``json_only``: only those drawn from the records alone (the work-precision plot)."""
     import matplotlib
     matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    from refsph.io import load_run, load_snapshot
-    from refsph.paper_data import TAYLOR_RESULTS
-
     FIG.mkdir(exist_ok=True)
+    _plot_work_precision(records)
+    if json_only:                                       # the rest needs the run folders
+        return
+    _plot_length_history(records)
+    _plot_sections()
+
+
+COLORS = dict(esph="C0", tlsph="C3")
+
+
+def _plot_work_precision(records):
+    """Error against wall time."""
+    import matplotlib.pyplot as plt
+    from refsph.paper_data import TAYLOR_RESULTS
     Lexp = TAYLOR_RESULTS["final_length_mm"]["experiment"]
     Dexp = TAYLOR_RESULTS["final_diameter_mm"]["experiment"]
     conv = [r for r in records if r["name"].startswith("conv-")]
-    colors = dict(esph="C0", tlsph="C3")
-
-    # work-precision: error against wall time
+    colors = COLORS
     fig, axs = plt.subplots(1, 2, figsize=(10, 4))
     for ax, key, ref, label in ((axs[0], "final_length_mm", Lexp, "length"),
                                 (axs[1], "final_diameter_mm", Dexp, "diameter")):
@@ -121,10 +133,14 @@ def plots(records, json_only: bool = False):
     fig.tight_layout()
     fig.savefig(FIG / "06_taylor_work_precision.png", dpi=120)
     plt.close(fig)
-    if json_only:                                       # the rest needs the run folders
-        return
 
-    # length against time (Fig. 3)
+
+def _plot_length_history(records):
+    """Length against time (Fig. 3)."""
+    import matplotlib.pyplot as plt
+    from refsph.io import load_run
+    from refsph.paper_data import TAYLOR_RESULTS
+    Lexp, colors = TAYLOR_RESULTS["final_length_mm"]["experiment"], COLORS
     fig, ax = plt.subplots(figsize=(6, 4))
     for r in records:
         if r["dp_mm"] != 0.5 or not r["name"].startswith(("conv-", "dt1e-8-")):
@@ -144,7 +160,11 @@ def plots(records, json_only: bool = False):
     fig.savefig(FIG / "06_taylor_length_history.png", dpi=120)
     plt.close(fig)
 
-    # sections at 15 and 30 us (Figs. 4-5): the particles next to the symmetry plane y = 0, mirrored to x < 0
+
+def _plot_sections():
+    """Sections at 15 and 30 us (Figs. 4-5): the particles next to the symmetry plane y = 0, mirrored to x < 0."""
+    import matplotlib.pyplot as plt
+    from refsph.io import load_run, load_snapshot
     fig, axs = plt.subplots(2, 4, figsize=(12, 7), sharey=True)
     for col, (m, tt) in enumerate([(m, tt) for m in METHODS for tt in (15e-6, 30e-6)]):
         _, snaps = load_run(RUNS / f"conv-{m}-0.5mm")
@@ -184,99 +204,87 @@ def table(records) -> str:
     return "\n".join(lines)
 
 
+PAGE = "taylor_report"          # the page's prose: benchmarks/templates/taylor_report.md
+
+
+def _errors():
+    """(error of L, error of D) against the experiment [%], as functions of a record."""
+    from refsph.paper_data import TAYLOR_RESULTS as REF
+    Lx, Dx = REF["final_length_mm"]["experiment"], REF["final_diameter_mm"]["experiment"]
+    return (lambda r: 100 * (r["final_length_mm"] / Lx - 1)), (lambda r: 100 * (r["final_diameter_mm"] / Dx - 1))
+
+
+def _run_table(rows) -> list[str]:
+    eL, eD = _errors()
+    lines = ["| run | method | dp [mm] | dt | T_m [K] | L [mm] | L vs exp. | D [mm] | D vs exp. "
+             "| L oscillation [mm] | at rest from [µs] | max plastic strain | max T [K] |", "|---" * 13 + "|"]
+    for r in rows:
+        dt = f"{r['dt_s']:.0e} s" if r.get("dt_s") else "CFL"
+        lines.append(f"| `{r['name']}` | {r['method'].upper()} | {r['dp_mm']:g} | {dt} | {r['T_melt_K']:.0f} | "
+                     f"{r['final_length_mm']:.2f} | {eL(r):+.1f} % | {r['final_diameter_mm']:.2f} | "
+                     f"{eD(r):+.1f} % | {r['length_oscillation_mm']:.3f} | {r['rest_time_us']:.1f} | "
+                     f"{r['max_plastic_strain']:.2f} | {r['max_temperature_K']:.0f} |")
+    return lines
+
+
 def report(records) -> str:
     """The study as a markdown report, from the benchmark records only (taylor.json): nothing is run or redrawn.
-    The reference values (experiment, LS-DYNA, the paper's SPH) are the paper's, from refsph.paper_data."""
-    from refsph.paper_data import TAYLOR_RESULTS as REF
-
-    by = {r["name"]: r for r in records}
-    Lx, Dx = REF["final_length_mm"]["experiment"], REF["final_diameter_mm"]["experiment"]
-
-    def eL(r):
-        return 100 * (r["final_length_mm"] / Lx - 1)
-
-    def eD(r):
-        return 100 * (r["final_diameter_mm"] / Dx - 1)
-
+    The reference values (experiment, LS-DYNA, the paper's SPH) are the paper's, from refsph.paper_data; the prose
+    is benchmarks/templates/taylor_report.md."""
+    P = study.Page(PAGE)
     conv = sorted([r for r in records if r["name"].startswith("conv-")], key=lambda r: (r["method"], -r["dp_mm"]))
-    first = conv[0]
-    out = ["# Taylor impact benchmark (Islam, Bansal & Peng, Section 3.1)", "",
-           "Written by `python benchmarks/taylor.py --report` from `benchmarks/taylor.json` (the committed records of "
-           "`python benchmarks/taylor.py --jobs 2`); edit the script, not this file. The lesson is chapter 06, "
-           "`chapters/06_taylor.py`; this report holds the study behind it.", "",
-           "## What was run", "",
-           f"The 3D quarter cylinder (symmetry planes x = 0 and y = 0, rigid frictionless wall at z = 0), 4340 steel "
-           f"at 181 m/s, with both methods, each run to t = {first['end_time_us']:.0f} µs. Unless a run says "
-           f"otherwise: the time step from the CFL condition with Courant number {first['courant']:g}, "
-           f"T_m = {first['T_melt_K']:.0f} K as Table 1 prints it, and Table 2's numerics (artificial viscosity "
-           f"beta1 = {first['numerics']['beta1']:g}, beta2 = {first['numerics']['beta2']:g}; ESPH artificial pressure "
-           f"gamma = {first['numerics']['gamma']:g}; TLSPH reference update when the Green-Lagrange strain exceeds "
-           f"{first['numerics']['ref_update_strain']:g}). Four groups of runs:", "",
-           "* `conv-*`: convergence in the particle spacing dp;",
-           "* `tmelt1793-*`: T_m = 1793 K, the usual value for 4340 (Table 1's 1293 K is almost certainly a typo);",
-           "* `dt1e-8-*`: the paper's fixed time step instead of the CFL step;",
-           "* `sens-*`: one numerical choice changed at a time, at dp = 0.75 mm.", "",
-           "The final length L is the mean over the last 30 µs (the bar rings in its free axial mode after it has "
-           "left the wall; the oscillation is the half range over that window); the diameter D is that of the foot, "
-           "measured as the outermost particle centre plus half a spacing. The reference values are the paper's "
-           "(`refsph.paper_data.TAYLOR_RESULTS`):", "",
-           "| | experiment | LS-DYNA | paper ESPH | paper TLSPH |", "|---|---|---|---|---|"]
+    out = _report_head(P, conv[0]) + ["", P("convergence"), ""] + _run_table(conv) + [""]
+    out += _report_convergence(P, conv)
+    out += _report_variants(P, {r["name"]: r for r in records})
+    out += _report_sensitivity(P, records)
+    out += _report_cost(P, records, conv) + ["", P("figures")]
+    return "\n".join(out) + "\n"
+
+
+def _report_head(P, first) -> list[str]:
+    from refsph.paper_data import TAYLOR_RESULTS as REF
+    nm = first["numerics"]
+    out = P.lines("head", end_us=f"{first['end_time_us']:.0f}", courant=f"{first['courant']:g}",
+                  T_melt=f"{first['T_melt_K']:.0f}", beta1=f"{nm['beta1']:g}", beta2=f"{nm['beta2']:g}",
+                  gamma=f"{nm['gamma']:g}", ref_update=f"{nm['ref_update_strain']:g}")
+    out += ["", "| | experiment | LS-DYNA | paper ESPH | paper TLSPH |", "|---|---|---|---|---|"]
     for key, label in (("final_length_mm", "final length [mm]"), ("final_diameter_mm", "final diameter [mm]")):
         out.append(f"| {label} | " + " | ".join(f"{REF[key][k]:.2f}" for k in
                                                  ("experiment", "ls_dyna", "paper_esph", "paper_tlsph")) + " |")
+    return out
 
-    def table(rows):
-        lines = ["| run | method | dp [mm] | dt | T_m [K] | L [mm] | L vs exp. | D [mm] | D vs exp. "
-                 "| L oscillation [mm] | at rest from [µs] | max plastic strain | max T [K] |", "|---" * 13 + "|"]
-        for r in rows:
-            dt = f"{r['dt_s']:.0e} s" if r.get("dt_s") else "CFL"
-            lines.append(f"| `{r['name']}` | {r['method'].upper()} | {r['dp_mm']:g} | {dt} | {r['T_melt_K']:.0f} | "
-                         f"{r['final_length_mm']:.2f} | {eL(r):+.1f} % | {r['final_diameter_mm']:.2f} | "
-                         f"{eD(r):+.1f} % | {r['length_oscillation_mm']:.3f} | {r['rest_time_us']:.1f} | "
-                         f"{r['max_plastic_strain']:.2f} | {r['max_temperature_K']:.0f} |")
-        return lines
 
-    out += ["", "## Convergence in the spacing", ""] + table(conv) + [""]
+def _report_convergence(P, conv) -> list[str]:
+    from refsph.paper_data import TAYLOR_RESULTS as REF
+    eL, eD = _errors()
+    out = []
     for m in METHODS:
         rs = [r for r in conv if r["method"] == m]
         a, b = rs[0], rs[-1]
         errD = [abs(eD(r)) for r in rs]
         trend = ("falls at every refinement" if all(x > y for x, y in zip(errD, errD[1:]))
                  else "does not fall steadily")
-        out.append(f"* **{m.upper()}**: from dp = {a['dp_mm']:g} to {b['dp_mm']:g} mm the final length changes by "
-                   f"{b['final_length_mm'] - a['final_length_mm']:+.2f} mm and the diameter by "
-                   f"{b['final_diameter_mm'] - a['final_diameter_mm']:+.2f} mm; the error of the diameter "
-                   f"{trend} ({errD[0]:.1f} % to {errD[-1]:.1f} %), that of the length lies between "
-                   f"{min(abs(eL(r)) for r in rs):.1f} % and {max(abs(eL(r)) for r in rs):.1f} %.")
-    out += ["", "Against the project's targets (final length within 2 %, diameter within 5 % of the experiment, at the "
-            "paper's spacing 0.5 mm and finer):", ""]
+        out.append(P("convergence_of_method", method=m.upper(), dp_a=f"{a['dp_mm']:g}", dp_b=f"{b['dp_mm']:g}",
+                     dL=f"{b['final_length_mm'] - a['final_length_mm']:+.2f}",
+                     dD=f"{b['final_diameter_mm'] - a['final_diameter_mm']:+.2f}", trend=trend,
+                     err_a=f"{errD[0]:.1f}", err_b=f"{errD[-1]:.1f}", errL_min=f"{min(abs(eL(r)) for r in rs):.1f}",
+                     errL_max=f"{max(abs(eL(r)) for r in rs):.1f}"))
+    out += ["", P("targets"), ""]
     for r in conv:
         if r["dp_mm"] <= 0.5:
-            out.append(f"* {r['method'].upper()}, dp = {r['dp_mm']:g} mm: length {eL(r):+.1f} % "
-                       f"({'met' if abs(eL(r)) < 2 else 'missed'}), diameter {eD(r):+.1f} % "
-                       f"({'met' if abs(eD(r)) < 5 else 'missed'}).")
+            out.append(P("target", method=r["method"].upper(), dp=f"{r['dp_mm']:g}", eL=f"{eL(r):+.1f}",
+                         L_met="met" if abs(eL(r)) < 2 else "missed", eD=f"{eD(r):+.1f}",
+                         D_met="met" if abs(eD(r)) < 5 else "missed"))
     pE, pT = (REF["final_diameter_mm"][k] for k in ("paper_esph", "paper_tlsph"))
     fine = {m: [r for r in conv if r["method"] == m][-1] for m in METHODS}
     gap = 100 * (fine["esph"]["final_diameter_mm"] / fine["tlsph"]["final_diameter_mm"] - 1)
-    out += ["", "A missed target is reported, not tuned away. TLSPH is the stiffer of the two methods here: a longer "
-            "bar and a narrower foot, approaching the experiment as the spacing shrinks. The paper's two methods "
-            f"agree on the diameter to {100 * abs(pT / pE - 1):.1f} %; at the finest spacing refsph's differ by "
-            f"{gap:.1f} %. The sensitivity runs below test the obvious suspects one at a time. What remains is the "
-            "formulation: refsph's TLSPH is kernel-gradient corrected (chapter 3; without the correction a free "
-            "surface does not stay at rest) and keeps the neighbours of the undeformed bar, which smooths the strain "
-            "over the reference support; that error shrinks with the spacing. The wall is the same for both methods.",
-            "", "![Error of the final length and diameter against wall time](../figures/06_taylor_work_precision.png)",
-            "", "Error of the final length and diameter against the wall time of the run, one point per spacing "
-            "(`figures/06_taylor_work_precision.png`): the cost of accuracy, with the paper's and LS-DYNA's errors "
-            "and the targets as lines."]
+    return out + ["", P("convergence_end", paper_gap=f"{100 * abs(pT / pE - 1):.1f}", gap=f"{gap:.1f}")]
 
-    for title, prefix, intro in (
-            ("The melting temperature", "tmelt1793-",
-             "Table 1 prints T_m = 1293 K; 1793 K is the usual value for 4340. It enters through the thermal "
-             "softening factor 1 - T*^m, which matters only where the bar gets hot, in the centre of the foot."),
-            ("The time step", "dt1e-8-",
-             "The paper fixes dt = 1e-8 s, several times below the CFL step. A smaller step also shrinks the lag of "
-             "the explicit return map, which uses the yield stress at the start of each step.")):
+
+def _report_variants(P, by) -> list[str]:
+    """The melting temperature and the time step: each against the default run of its method at 0.5 mm."""
+    out = []
+    for prefix in ("tmelt1793-", "dt1e-8-"):
         rows, notes = [], []
         for m in METHODS:
             base, other = by.get(f"conv-{m}-0.5mm"), by.get(f"{prefix}{m}-0.5mm")
@@ -285,24 +293,23 @@ def report(records) -> str:
             rows += [base, other]
             cost = ""
             if prefix == "dt1e-8-":
-                cost = (f"; {other['n_steps'] / base['n_steps']:.1f} times the steps, "
-                        f"{other['wall_time_s'] / base['wall_time_s']:.1f} times the wall time")
-            notes.append(f"* {m.upper()}: L {other['final_length_mm'] - base['final_length_mm']:+.3f} mm, "
-                         f"D {other['final_diameter_mm'] - base['final_diameter_mm']:+.3f} mm against the default"
-                         f"{cost}.")
-        out += ["", f"## {title}", "", intro, ""] + table(rows) + [""] + notes
+                cost = P("cost_of_dt", steps=f"{other['n_steps'] / base['n_steps']:.1f}",
+                         wall=f"{other['wall_time_s'] / base['wall_time_s']:.1f}")
+            notes.append(P("against_default", method=m.upper(),
+                           dL=f"{other['final_length_mm'] - base['final_length_mm']:+.3f}",
+                           dD=f"{other['final_diameter_mm'] - base['final_diameter_mm']:+.3f}", cost=cost))
+        out += ["", P(prefix), ""] + _run_table(rows) + [""] + notes
+    return out
 
+
+def _report_sensitivity(P, records) -> list[str]:
+    by = {r["name"]: r for r in records}
     sens = [r for r in records if r["name"].startswith("sens-")]
-    what = {"beta0.5": "artificial viscosity beta1 = beta2 = 0.5 (Table 2: 1.5)",
-            "refupdate0.1": "TLSPH reference update at a strain of 0.1 (default 0.5)",
-            "gamma0": "ESPH without artificial pressure (Table 2: gamma = 0.3)"}
-    out += ["", "## Sensitivity to numerical choices", "",
-            "Each run changes one choice that the paper fixes or leaves open, at dp = 0.75 mm, and is compared with "
-            "the default run of its method at the same spacing (`conv-*-0.75mm` in the convergence table).", "",
-            "| run | what changed | dL [mm] | dD [mm] | L [mm] | D [mm] |", "|---|---|---|---|---|---|"]
+    out = ["", P("sensitivity")]
     for r in sens:
         base = by[f"conv-{r['method']}-0.75mm"]
-        out.append(f"| `{r['name']}` | {what.get(r['name'].split('-')[1], r['name'])} | "
+        what = r["name"].split("-")[1]
+        out.append(f"| `{r['name']}` | {P(what) if what in P.sections else r['name']} | "
                    f"{r['final_length_mm'] - base['final_length_mm']:+.3f} | "
                    f"{r['final_diameter_mm'] - base['final_diameter_mm']:+.3f} | {r['final_length_mm']:.2f} | "
                    f"{r['final_diameter_mm']:.2f} |")
@@ -313,16 +320,15 @@ def report(records) -> str:
         gap_low = beta["esph"]["final_diameter_mm"] - beta["tlsph"]["final_diameter_mm"]
         others = max(abs(r["final_diameter_mm"] - by[f"conv-{r['method']}-0.75mm"]["final_diameter_mm"])
                      for r in sens if not r["name"].startswith("sens-beta"))
-        out += ["", f"Lowering the artificial viscosity widens the foot of both methods (ESPH {dD['esph']:+.2f} mm, "
-                f"TLSPH {dD['tlsph']:+.2f} mm). The gap between the two methods' diameters "
-                f"{'grows' if abs(gap_low) > abs(gap) else 'shrinks'} from {gap:.2f} mm to {gap_low:.2f} mm, so the "
-                f"viscosity {'does not explain' if abs(gap_low) > 0.5 * abs(gap) else 'explains much of'} the gap. "
-                f"The other changes move the diameter by at most {others:.2f} mm."]
+        out += ["", P("viscosity", dD_esph=f"{dD['esph']:+.2f}", dD_tlsph=f"{dD['tlsph']:+.2f}",
+                      grows="grows" if abs(gap_low) > abs(gap) else "shrinks", gap=f"{gap:.2f}",
+                      gap_low=f"{gap_low:.2f}", others=f"{others:.2f}",
+                      explains="does not explain" if abs(gap_low) > 0.5 * abs(gap) else "explains much of")]
+    return out
 
-    out += ["", "## Cost", "",
-            "Wall times as recorded in the JSON, one process per run (with `--jobs 2` two runs shared the machine's "
-            "two cores). Particle counts are of the quarter model; ghosts are the mirror images at the end of the run.",
-            "", "| run | dp [mm] | particles | ghosts | steps | wall time [s] |", "|---|---|---|---|---|---|"]
+
+def _report_cost(P, records, conv) -> list[str]:
+    out = ["", P("cost")]
     for r in records:
         out.append(f"| `{r['name']}` | {r['dp_mm']:g} | {r['n_particles']} | {r['n_ghosts']} | {r['n_steps']} | "
                    f"{r['wall_time_s']:.0f} |")
@@ -332,30 +338,20 @@ def report(records) -> str:
         logdp = np.log([r["dp_mm"] for r in rs])
         k_wall, k_n, k_steps = (-np.polyfit(logdp, np.log([r[key] for r in rs]), 1)[0]
                                 for key in ("wall_time_s", "n_particles", "n_steps"))
-        out.append(f"* {m.upper()}: the wall time grows about as dp^-{k_wall:.1f} over the convergence runs (particles "
-                   f"as dp^-{k_n:.1f}, steps as dp^-{k_steps:.1f}).")
-
-    out += ["", "## Figures", "",
-            "![Length against time at dp = 0.5 mm](../figures/06_taylor_length_history.png)", "",
-            "The length against time at dp = 0.5 mm, CFL step and fixed step (`figures/06_taylor_length_history.png`; "
-            "cf. the paper's Fig. 3).", "",
-            "![Plastic strain and temperature on the section through the axis](../figures/06_taylor_sections.png)", "",
-            "Plastic strain and temperature on the section through the axis at 15 and 30 µs, dp = 0.5 mm "
-            "(`figures/06_taylor_sections.png`; cf. the paper's Figs. 4-5)."]
-    return "\n".join(out) + "\n"
+        out.append(P("cost_fit", method=m.upper(), k_wall=f"{k_wall:.1f}", k_n=f"{k_n:.1f}",
+                     k_steps=f"{k_steps:.1f}"))
+    return out
 
 
 def main(argv=None):
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--jobs", type=int, default=1, help="runs at a time (default 1)")
-    ap.add_argument("--plot-only", action="store_true", help="no runs: figures and table from earlier runs")
-    ap.add_argument("--only", default=None, help="run only the jobs whose name contains this string")
+    ap = study.parser(__doc__, "jobs", "plot_only", "only",
+                      plot_only=dict(help="no runs: figures and table from earlier runs"))
     ap.add_argument("--finest", type=float, default=None, help="an extra, finer spacing [m] for the convergence study")
-    ap.add_argument("--json-figures", action="store_true",
-                    help="only redraw the figures made from the committed JSON alone "
-                         "(figures/06_taylor_work_precision.png)")
-    ap.add_argument("--report", action="store_true",
-                    help="no runs: write benchmarks/taylor_report.md from the committed benchmarks/taylor.json only")
+    study.add_flags(ap, "json_figures", "report",
+                    json_figures=dict(help="only redraw the figures made from the committed JSON alone "
+                                           "(figures/06_taylor_work_precision.png)"),
+                    report=dict(help="no runs: write benchmarks/taylor_report.md from the committed "
+                                     "benchmarks/taylor.json only"))
     args = ap.parse_args(argv)
     if args.json_figures:
         plots(json.loads(OUT_JSON.read_text()), json_only=True)
@@ -368,10 +364,12 @@ def main(argv=None):
     if args.only:
         jobs = [j for j in jobs if args.only in j["name"]]
     if not args.plot_only:
-        from refsph.neighbours import threads_per_job      # all cores for --jobs 1, one each for --jobs 2
         jobs.sort(key=lambda j: (j["dp"], j["dt"] is None))       # longest first
-        with ProcessPoolExecutor(max_workers=args.jobs) as ex:
-            list(ex.map(run_job, [dict(j, threads=threads_per_job(args.jobs)) for j in jobs]))
+        # each run in a fresh process: its wall time is the work-precision plot's work (study.execute)
+        threads = study.threads_per_job(args.jobs)       # all cores for --jobs 1, one each for --jobs 2
+        for name, done in study.execute(run_job, {j["name"]: (dict(j, threads=threads),) for j in jobs}, args.jobs):
+            if done != name:
+                print(f"{name}: {done['status']}", flush=True)
     # every run that exists (the 0.375 mm ones too, if an earlier call made them with --finest)
     names = [j["name"] for j in job_list(args.finest or 0.375e-3) if (RUNS / j["name"] / "summary.json").exists()]
     records = [record(n) for n in names]

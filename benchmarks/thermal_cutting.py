@@ -25,14 +25,18 @@ The dask path needs ``pip install -e '.[dask]'`` on the client and every worker 
 """
 from __future__ import annotations
 
-import argparse
 import json
 import math
 import sys
 import time
 from pathlib import Path
 
-import numpy as np
+sys.path.insert(0, str(Path(__file__).resolve().parent))      # benchmarks/study.py, however this file is loaded
+import study  # noqa: E402
+
+study.pin_threads()
+
+import numpy as np  # noqa: E402
 
 ROOT = Path(__file__).resolve().parent.parent
 OUT_JSON = ROOT / "benchmarks" / "thermal_cutting.json"
@@ -96,39 +100,13 @@ def _thin(a, n: int = 100) -> list:
     return [[float(v) if np.isfinite(v) else None for v in row] for row in a[idx]]
 
 
+def store(path: Path = OUT_JSON) -> study.RunStore:
+    """The records (``{"runs": {key: record}}``): locked, atomic, shared by sweeps on the same file."""
+    return study.RunStore(path)
+
+
 def load(path: Path = OUT_JSON) -> dict:
-    return json.loads(path.read_text()) if path.exists() else dict(runs={})
-
-
-def save(res: dict, path: Path = OUT_JSON) -> None:
-    """Merge ``res``'s records into the file (under a lock: two sweeps may share it) and write it atomically."""
-    import fcntl
-    with open(path.with_suffix(".lock"), "w") as lock:
-        fcntl.flock(lock, fcntl.LOCK_EX)
-        merged = load(path)
-        merged["runs"].update(res["runs"])
-        tmp = path.with_suffix(".tmp")
-        tmp.write_text(json.dumps(merged, indent=1, sort_keys=True, default=float) + "\n")
-        tmp.replace(path)
-
-
-def _execute(todo: dict, n_jobs: int, scheduler: str | None, quick: bool = False):
-    """Yield records as runs finish: local processes, or a dask.distributed cluster at ``scheduler``."""
-    if scheduler:
-        try:
-            from dask.distributed import Client, as_completed
-        except ImportError:
-            raise SystemExit("--scheduler needs dask.distributed: pip install -e '.[dask]'") from None
-        client = Client(scheduler)
-        futures = [client.submit(run_case, k, o, quick, key=f"refsph-{k}", pure=False) for k, o in todo.items()]
-        for f in as_completed(futures):
-            yield f.result()
-        return
-    from concurrent.futures import ProcessPoolExecutor, as_completed
-    with ProcessPoolExecutor(max_workers=max(1, n_jobs)) as pool:
-        futures = [pool.submit(run_case, k, o, quick) for k, o in todo.items()]
-        for f in as_completed(futures):
-            yield f.result()
+    return store(path).load()
 
 
 # ----------------------------------------------------------------------------- the comparison
@@ -207,29 +185,9 @@ def _f(v, fmt: str) -> str:
 
 
 def report(res: dict) -> str:
-    rows = comparison(res)
-    lines = ["# Thermomechanical cutting against the measured 18 cuts", "",
-             "Made by `python benchmarks/thermal_cutting.py` from `benchmarks/thermal_cutting.json` (the module text "
-             "says how each number is taken; chapter 11 explains the model). refsph: TLSPH, dx = t_u / 5, mass "
-             "scaling to 1 % of A, 8 t_u of cut, means over its second half. *Measured* values are recovered from "
-             "the paper's printed predictions and errors (not printed themselves). SPH, PFEM: the paper's "
-             "Appendix B. Errors: 100 |x - measured| / measured, as the paper gives them.", "",
-             "## Temperatures and the force ratio", "",
-             "| case | material | vc [m/min] | tu [mm] | status | T_RF refsph | (hottest) | measured | SPH | PFEM | "
-             "T_FCS refsph | measured | SPH | PFEM | Fp/Fc refsph | measured | SPH | PFEM |",
-             "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
-    for r in rows:
-        lines.append(
-            f"| {r['case']} | {r['material']} | {r['vc']:.0f} | {r['tu']:.2f} | {r['status']} | "
-            f"{_f(r['TRF'], '.0f')} ({_f(r['TRF_err'], '.0f')} %) | {_f(r['TRFmax'], '.0f')} | {r['TRF_exp']:.0f} | "
-            f"{r['TRF_sph']:.0f} ({r['TRF_sph_err']:.0f} %) | {r['TRF_pfem']:.0f} ({r['TRF_pfem_err']:.0f} %) | "
-            f"{_f(r['TFCS'], '.0f')} ({_f(r['TFCS_err'], '.0f')} %) | {r['TFCS_exp']:.0f} | "
-            f"{r['TFCS_sph']:.0f} ({r['TFCS_sph_err']:.0f} %) | {r['TFCS_pfem']:.0f} ({r['TFCS_pfem_err']:.0f} %) | "
-            f"{_f(r['ratio'], '.2f')} ({_f(r['ratio_err'], '.0f')} %) | {r['ratio_exp']:.2f} | "
-            f"{r['ratio_sph']:.2f} ({r['ratio_sph_err']:.0f} %) | "
-            f"{r['ratio_pfem']:.2f} ({r['ratio_pfem_err']:.0f} %) |")
-    lines += ["", "## Mean errors (percent; over the cases that ran)", "",
-              "| material | quantity | refsph | paper SPH | paper PFEM | cases run |", "|---|---|---|---|---|---|"]
+    """The page, from the records alone; its prose is benchmarks/templates/thermal_cutting_report.md."""
+    P, rows = study.Page("thermal_cutting_report"), comparison(res)
+    lines = [P("head")] + [_case_line(r) for r in rows] + ["", P("mean_errors")]
     for mat in ("AISI1045", "Ti6Al4V"):
         sel = [r for r in rows if r["material"] == mat]
         ran = [r for r in sel if r["status"] == "ok"]
@@ -237,27 +195,32 @@ def report(res: dict) -> str:
             lines.append(f"| {mat} | {name} | {_f(_mean(sel, f'{q}_err'), '.1f')} | {_mean(sel, f'{q}_sph_err'):.1f} "
                          f"| {_mean(sel, f'{q}_pfem_err'):.1f} | {len(ran)} of {len(sel)} |")
         lines.append(f"| {mat} | T_RF, hottest contact particle | {_f(_mean(sel, 'TRFmax_err'), '.1f')} | | | |")
-    lines += ["", "## Forces, chip and the width of cut", "",
-              "The paper does not state the width of cut b. refsph's forces are per mm of width; 'b for Fc' is the "
-              "width at which refsph's Fc equals the measured one (a constant b across the cases means the trends "
-              "agree).", "",
-              "| case | Fc [N/mm] | Fp [N/mm] | measured Fc, Fp [N] | b for Fc [mm] | chip [mm] | contact [mm] | "
-              "heat balance residual | wall [s] |", "|---|---|---|---|---|---|---|---|---|"]
+    lines += ["", P("forces")]
     for r in rows:
         lines.append(f"| {r['case']} | {_f(r['Fc_N_per_mm'], '.1f')} | {_f(r['Fp_N_per_mm'], '.1f')} | "
                      f"{r['Fc_exp']:.0f}, {r['Fp_exp']:.0f} | {_f(r['width_mm'], '.2f')} | {_f(r['chip_mm'], '.3f')} | "
                      f"{_f(r['contact_mm'], '.3f')} | {_f(r['heat_residual'], '.1e')} | {_f(r['wall_s'], '.0f')} |")
-    lines += ["", "## Trends", "", "| material | Fc rises with t_u (refsph / measured) | T_RF rises with v_c "
-              "(refsph / measured) |", "|---|---|---|"]
+    lines += ["", P("trends")]
     yes = {True: "yes", False: "no", None: "-"}
     for mat, t in trends(rows).items():
         lines.append(f"| {mat} | {yes[t['Fc_rises_with_tu']]} / {yes[t['Fc_exp_rises_with_tu']]} | "
                      f"{yes[t['TRF_rises_with_vc']]} / {yes[t['TRF_exp_rises_with_vc']]} |")
     lines += _study_lines(res)
     done = [r for r in res["runs"].values() if r.get("wall_time_s")]
-    lines += ["", f"{len(done)} runs recorded, {sum(r['wall_time_s'] for r in done) / 60:.1f} CPU-minutes in all "
-              f"(one core each).", ""]
+    lines += ["", P("total", n=len(done), minutes=f"{sum(r['wall_time_s'] for r in done) / 60:.1f}"), ""]
     return "\n".join(lines)
+
+
+def _case_line(r: dict) -> str:
+    """A case's row of the temperatures and force ratio."""
+    return (f"| {r['case']} | {r['material']} | {r['vc']:.0f} | {r['tu']:.2f} | {r['status']} | "
+            f"{_f(r['TRF'], '.0f')} ({_f(r['TRF_err'], '.0f')} %) | {_f(r['TRFmax'], '.0f')} | {r['TRF_exp']:.0f} | "
+            f"{r['TRF_sph']:.0f} ({r['TRF_sph_err']:.0f} %) | {r['TRF_pfem']:.0f} ({r['TRF_pfem_err']:.0f} %) | "
+            f"{_f(r['TFCS'], '.0f')} ({_f(r['TFCS_err'], '.0f')} %) | {r['TFCS_exp']:.0f} | "
+            f"{r['TFCS_sph']:.0f} ({r['TFCS_sph_err']:.0f} %) | {r['TFCS_pfem']:.0f} ({r['TFCS_pfem_err']:.0f} %) | "
+            f"{_f(r['ratio'], '.2f')} ({_f(r['ratio_err'], '.0f')} %) | {r['ratio_exp']:.2f} | "
+            f"{r['ratio_sph']:.2f} ({r['ratio_sph_err']:.0f} %) | "
+            f"{r['ratio_pfem']:.2f} ({r['ratio_pfem_err']:.0f} %) |")
 
 
 def _row(cells) -> str:
@@ -299,7 +262,7 @@ def _study_lines(res: dict) -> list[str]:
     for title, member, order, columns in STUDIES:
         lines += ["", f"## {title}", "", "| run | " + " | ".join(c[0] for c in columns) + " |",
                   "|---" * (len(columns) + 1) + "|"]
-        values = {k: _case1_values(runs[k]) for k in runs if member(k)}
+        values = {k: _case1_values(runs[k]) for k in runs if member(k) and "dp" in runs[k]}   # not a crashed run
         for k in sorted(values, key=lambda k: values[k].get(order) or 0.0):
             lines.append(f"| {k} " + _row((values[k].get(key), fmt) for _, key, fmt in columns))
     return lines
@@ -347,34 +310,12 @@ def figures(res: dict) -> None:
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--jobs", type=int, default=2, help="local processes (default 2)")
-    ap.add_argument("--scheduler", default=None, help="address of a dask.distributed scheduler (tcp://host:port)")
-    ap.add_argument("--only", type=int, nargs="*", default=None, help="case numbers to run (default: all 18)")
-    ap.add_argument("--scaling", action="store_true", help="the mass-scaling study on case 1")
-    ap.add_argument("--detector", action="store_true", help="case 1 with the alpha-shape detector")
-    ap.add_argument("--resolution", action="store_true", help="case 1 at other resolutions")
-    ap.add_argument("--redo", nargs="*", default=(), help="keys to run again (e.g. 'case 3')")
-    ap.add_argument("--report", action="store_true", help="table and figures from the committed JSON only")
-    ap.add_argument("--quick", action="store_true", help="quick short cuts (a try-out; give --json elsewhere)")
-    ap.add_argument("--json", type=Path, default=OUT_JSON, help="the records (default: the committed JSON)")
-    args = ap.parse_args(argv)
+    args = _parser().parse_args(argv)
     if args.quick and args.json == OUT_JSON:
-        ap.error("--quick writes try-out records: give them their own --json file")
-    res = load(args.json)
+        _parser().error("--quick writes try-out records: give them their own --json file")
     if not args.report:
-        todo = {k: o for k, o in jobs(args.scaling, args.detector, args.only, args.resolution).items()
-                if k not in res["runs"] or k in args.redo}
-        print(f"{len(todo)} runs to do ({len(res['runs'])} recorded)", flush=True)
-        t0 = time.perf_counter()
-        for k, rec in enumerate(_execute(todo, args.jobs, args.scheduler, args.quick)):
-            res["runs"][rec["key"]] = rec
-            save(res, args.json)
-            m = rec["metrics"]
-            print(f"[{k + 1}/{len(todo)}] {rec['key']:16s} {rec['status']:6s} Fp/Fc {_f(m.get('force_ratio'), '.2f')} "
-                  f"T_RF {_f(m.get('rake_face_temperature_K'), '.0f')} K, {_f(rec['wall_time_s'], '.0f')} s "
-                  f"({(time.perf_counter() - t0) / 60:.1f} min elapsed)", flush=True)
-        res = load(args.json)                             # with what another sweep on the same file added
+        sweep(store(args.json), jobs(args.scaling, args.detector, args.only, args.resolution), args)
+    res = load(args.json)                                 # with what another sweep on the same file added
     if args.json != OUT_JSON:
         print(report(res))
         print(f"wrote {args.json}")
@@ -383,6 +324,33 @@ def main(argv=None) -> int:
     figures(res)
     print(f"wrote {OUT_JSON}, {REPORT}, figures/11_thermal_cutting_*.png")
     return 0
+
+
+def _parser():
+    ap = study.parser(__doc__, "jobs", "scheduler", "only", jobs=dict(default=2, help="local processes (default 2)"),
+                      only=dict(type=int, nargs="*", help="case numbers to run (default: all 18)"))
+    ap.add_argument("--scaling", action="store_true", help="the mass-scaling study on case 1")
+    ap.add_argument("--detector", action="store_true", help="case 1 with the alpha-shape detector")
+    ap.add_argument("--resolution", action="store_true", help="case 1 at other resolutions")
+    ap.add_argument("--redo", nargs="*", default=(), help="keys to run again (e.g. 'case 3')")
+    study.add_flags(ap, "report", "quick", report=dict(help="table and figures from the committed JSON only"),
+                    quick=dict(help="quick short cuts (a try-out; give --json elsewhere)"))
+    ap.add_argument("--json", type=Path, default=OUT_JSON, help="the records (default: the committed JSON)")
+    return ap
+
+
+def sweep(runs: study.RunStore, todo: dict, args) -> None:
+    """Run the keys of ``todo`` not yet recorded (or in ``--redo``), each record stored as it comes."""
+    todo = {k: todo[k] for k in runs.pending(todo, redo=args.redo)}
+    print(f"{len(todo)} runs to do ({len(runs.records())} recorded)", flush=True)
+    t0 = time.perf_counter()
+    tasks = {k: (k, o, args.quick) for k, o in todo.items()}
+    for k, (key, rec) in enumerate(study.execute(run_case, tasks, args.jobs, args.scheduler)):
+        runs.commit(key, rec)
+        m = rec.get("metrics", {})
+        print(f"[{k + 1}/{len(todo)}] {key:16s} {rec['status']:6s} Fp/Fc {_f(m.get('force_ratio'), '.2f')} "
+              f"T_RF {_f(m.get('rake_face_temperature_K'), '.0f')} K, {_f(rec.get('wall_time_s'), '.0f')} s "
+              f"({(time.perf_counter() - t0) / 60:.1f} min elapsed)", flush=True)
 
 
 if __name__ == "__main__":

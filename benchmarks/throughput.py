@@ -29,17 +29,19 @@ Usage:  python benchmarks/throughput.py [--sizes 100 200] [--steps N] [--repeats
 from __future__ import annotations
 
 import os
+import sys
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))      # benchmarks/study.py, however this file is loaded
+import study  # noqa: E402
 
 # one core: pin the BLAS / OpenMP thread pools before NumPy is imported (scipy.sparse is single-threaded)
-for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "BLIS_NUM_THREADS",
-             "VECLIB_MAXIMUM_THREADS", "NUMEXPR_NUM_THREADS"):
-    os.environ[_var] = "1"
+study.pin_threads()
 
 import argparse  # noqa: E402
 import json  # noqa: E402
 import platform  # noqa: E402
 import time  # noqa: E402
-from pathlib import Path  # noqa: E402
 
 import numpy as np  # noqa: E402
 import scipy  # noqa: E402
@@ -63,6 +65,17 @@ def block_setup(n_side: int, dp: float = 1.0e-4, v_rms: float = 1.0, seed: int =
     return Setup(state=state, material=mat, dp=dp, numerics=Numerics(threads=1), t_end=1.0, n_snapshots=0)
 
 
+def _step_function(integrator: str, solver):
+    """``step(state, solver, dt) -> state`` as a run steps: one stepper object for the whole run where refsph has
+    them (``refsph.integrate.make_stepper``: the leapfrog keeps its force between steps), else the step function."""
+    import refsph.integrate
+    make = getattr(refsph.integrate, "make_stepper", None)
+    if make is None:
+        return STEPPERS[integrator]
+    stepper = make(integrator, solver)
+    return lambda state, solver, dt: stepper.step(state, solver, dt).state
+
+
 def half_pairs_within_support(setup: Setup) -> int:
     """Half pairs (i < j) with |x_i - x_j| < 2h: the pairs with a non-zero kernel."""
     x = setup.state.x
@@ -73,8 +86,8 @@ def half_pairs_within_support(setup: Setup) -> int:
 
 def time_method(method: str, setup: Setup, steps: int, repeats: int, integrator: str = "predictor_corrector") -> dict:
     """Best-of-``repeats`` wall (and CPU) time of ``steps`` steps of ``integrator``, after one warm-up step."""
-    step = STEPPERS[integrator]
     solver = make_solver(method, setup)
+    step = _step_function(integrator, solver)
     state = setup.state.copy()
     dt = cfl_time_step(state, setup.material, setup.h, setup.numerics.courant)
     t0 = time.perf_counter()
@@ -142,15 +155,11 @@ def main(argv=None) -> list[dict]:
 
 
 def integrator_study(courants=(0.1, 0.2, 0.3, 0.45, 0.6)) -> list[dict]:
-    """Error against work of both steppers on the quick 2D TLSPH bar (module text)."""
-    from refsph.simulate import run
+    """Error against work of both steppers on the quick 2D TLSPH bar (module text); each run is timed in a fresh
+    process of its own (study.timed_in_subprocess), so no earlier run's heap or caches enter its wall time."""
 
     def amplitude(integrator, courant):
-        t0 = time.perf_counter()
-        res = run("bar", "tlsph", dim=2, quick=True, progress=False,
-                  numerics=dict(threads=1, integrator=integrator, courant=courant))
-        h = np.asarray(res.summary["metrics"]["amplitude_history"])
-        return h, time.perf_counter() - t0, res.summary["n_steps"]
+        return study.timed_in_subprocess(bar_amplitude, integrator, courant)
 
     ref, _, _ = amplitude("leapfrog", 0.025)
     print(f"\n{'integrator':19s} {'courant':>7s} {'steps':>6s} {'wall s':>7s} {'amplitude error':>15s}")
@@ -162,6 +171,16 @@ def integrator_study(courants=(0.1, 0.2, 0.3, 0.45, 0.6)) -> list[dict]:
             out.append(dict(integrator=integrator, courant=c, steps=steps, wall_s=wall, amplitude_error=err))
             print(f"{integrator:19s} {c:7.3f} {steps:6d} {wall:7.2f} {err:15.3e}", flush=True)
     return out
+
+
+def bar_amplitude(integrator: str, courant: float):
+    """(amplitude history, wall time, steps) of the quick 2D TLSPH bar with one stepper at one Courant number."""
+    from refsph.simulate import run
+    t0 = time.perf_counter()
+    res = run("bar", "tlsph", dim=2, quick=True, progress=False,
+              numerics=dict(threads=1, integrator=integrator, courant=courant))
+    h = np.asarray(res.summary["metrics"]["amplitude_history"])
+    return h, time.perf_counter() - t0, res.summary["n_steps"]
 
 
 def software() -> dict:

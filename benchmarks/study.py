@@ -1,0 +1,245 @@
+"""The scaffold every study in benchmarks/ stands on: one way to pin threads, store runs, run them, time them, write
+tables and pages, and parse the common flags.
+
+    import study                    # benchmarks/study.py (a script puts its own folder on sys.path first)
+    study.pin_threads()             # before NumPy is imported: BLAS / OpenMP pools at one thread
+    import numpy as np
+
+* ``pin_threads()``: the BLAS / OpenMP / NumExpr thread pools at one thread, through the environment (read when
+  NumPy is imported, and inherited by every worker process) and, where NumPy is already imported and threadpoolctl
+  is installed, through threadpoolctl. refsph's own pair-sum threads are ``Numerics.threads``: ``threads_per_job``.
+* ``RunStore``: a keyed, locked, atomic, resumable store of run records in one JSON file
+  (``{section: {key: record}}`` plus whatever else the study keeps there). Every write merges under an exclusive
+  ``fcntl`` lock (``<file>.lock``, ignored by git) and replaces the file atomically (a ``.tmp`` then
+  ``os.replace``), so two sweeps may share a file and a killed sweep leaves it whole. A finished key is skipped by
+  the next sweep; a failed run is recorded as failed but never replaces a good record of the same key (it goes to
+  the ``failed`` section then).
+* ``execute()``: runs ``fn(*args)`` for each key, each in a fresh process (``max_tasks_per_child=1``, spawned: no
+  heap or caches from an earlier run, so a wall time is a cold start's), ``jobs`` at a time, or on a
+  dask.distributed cluster (``--scheduler ADDRESS``; dask is imported only then), and yields ``(key, result)`` as
+  runs finish. A run that raises yields a failed record instead of stopping the sweep.
+* ``md_table()``, ``fmt()``: markdown tables and cells.
+* ``Page``: the prose of a report page, in ``benchmarks/templates/<name>.md``, sections marked ``@@ name``,
+  filled with ``string.Template`` (``$name``; a literal dollar is ``$$``).
+* ``parser()``: the argparse skeleton with the flags the studies share (``--jobs``, ``--only``, ``--quick``,
+  ``--scheduler``, ``--report``, ``--json-figures``, ``--plot-only``, ``--json``).
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import os
+import string
+import sys
+from pathlib import Path
+
+HERE = Path(__file__).resolve().parent
+ROOT = HERE.parent
+TEMPLATES = HERE / "templates"
+THREAD_VARS = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "BLIS_NUM_THREADS",
+               "VECLIB_MAXIMUM_THREADS", "NUMEXPR_NUM_THREADS")
+
+
+# ----------------------------------------------------------------------------- threads
+def pin_threads(n: int = 1) -> None:
+    """BLAS / OpenMP / NumExpr pools at ``n`` threads: environment variables (call this before NumPy is imported;
+    worker processes inherit them) and, if NumPy is already loaded and threadpoolctl is installed, threadpoolctl."""
+    for var in THREAD_VARS:
+        os.environ[var] = str(n)
+    if "numpy" in sys.modules:
+        try:
+            from threadpoolctl import threadpool_limits
+        except ImportError:
+            return
+        threadpool_limits(n)
+
+
+def threads_per_job(jobs: int) -> int:
+    """refsph's pair-sum threads for a run when ``jobs`` run at a time (all cores for one job, one each for more)."""
+    from refsph.neighbours import threads_per_job as per_job
+    return per_job(jobs)
+
+
+# ----------------------------------------------------------------------------- the run store
+def _is_good(rec: dict) -> bool:
+    return rec.get("status") == "ok"
+
+
+class RunStore:
+    """Records by key in ``path`` (module text). ``good(record)`` says whether a record is a good one (default:
+    status "ok"); ``dump`` turns the document into the file's text."""
+
+    def __init__(self, path: Path, section: str = "runs", good=_is_good, dump=None):
+        self.path, self.section, self.good = Path(path), section, good
+        self.dump = dump or (lambda doc: json.dumps(doc, indent=1, sort_keys=True, default=float) + "\n")
+
+    def load(self) -> dict:
+        """The whole document (``{section: {}}`` if there is no file yet)."""
+        doc = json.loads(self.path.read_text()) if self.path.exists() else {}
+        doc.setdefault(self.section, {})
+        return doc
+
+    def records(self) -> dict:
+        return self.load()[self.section]
+
+    def pending(self, keys, redo=(), retry_failed: bool = False) -> list:
+        """The keys still to run: not recorded (or recorded failed, with ``retry_failed``), and those in ``redo``."""
+        have = self.records()
+        return [k for k in keys if k in redo or k not in have or (retry_failed and not self.good(have[k]))]
+
+    def update(self, change) -> dict:
+        """Under the lock: load, ``change(doc)`` in place, write atomically; the document written."""
+        import fcntl
+        self.path.parent.mkdir(parents=True, exist_ok=True)
+        with open(self.path.with_suffix(".lock"), "w") as lock:
+            fcntl.flock(lock, fcntl.LOCK_EX)
+            doc = self.load()
+            change(doc)
+            tmp = self.path.with_suffix(".tmp")
+            tmp.write_text(self.dump(doc))
+            os.replace(tmp, self.path)
+        return doc
+
+    def commit(self, key: str, rec: dict) -> bool:
+        """Store ``rec`` under ``key``; a failed record does not replace a good one (it is kept under ``failed``).
+        True if it went into the section."""
+        kept = []
+
+        def change(doc):
+            old = doc[self.section].get(key)
+            if old is not None and self.good(old) and not self.good(rec):
+                doc.setdefault("failed", {})[key] = rec
+                return
+            doc[self.section][key] = rec
+            kept.append(key)
+        self.update(change)
+        return bool(kept)
+
+    def set(self, **fields) -> dict:
+        """Store top-level fields of the document beside the records (e.g. a machine description)."""
+        return self.update(lambda doc: doc.update(fields))
+
+
+# ----------------------------------------------------------------------------- running
+def failed_record(key, error: BaseException) -> dict:
+    return dict(key=key, status=f"failed: {type(error).__name__}: {error}"[:600])
+
+
+def execute(fn, tasks: dict, jobs: int = 1, scheduler: str | None = None, fresh: bool = True):
+    """Yield ``(key, fn(*tasks[key]))`` as the runs finish (``tasks``: key -> argument tuple). Local processes,
+    ``jobs`` at a time, each run in a fresh (spawned) process if ``fresh``; or a dask.distributed cluster at
+    ``scheduler``. A run that raises yields ``failed_record(key, error)``."""
+    if not tasks:
+        return
+    if scheduler:
+        yield from _execute_dask(fn, tasks, scheduler)
+        return
+    from concurrent.futures import ProcessPoolExecutor, as_completed
+    options = dict(max_tasks_per_child=1) if fresh else {}
+    with ProcessPoolExecutor(max_workers=max(1, jobs), **options) as pool:
+        futures = {pool.submit(fn, *args): key for key, args in tasks.items()}
+        for f in as_completed(futures):
+            yield futures[f], _result(f, futures[f])
+
+
+def _result(future, key):
+    try:
+        return future.result()
+    except Exception as e:                                   # recorded, so that the other runs go on
+        return failed_record(key, e)
+
+
+def _execute_dask(fn, tasks: dict, scheduler: str):
+    try:
+        from dask.distributed import Client, as_completed
+    except ImportError:
+        raise SystemExit("--scheduler needs dask.distributed: pip install -e '.[dask]'") from None
+    with Client(scheduler) as client:
+        futures = {client.submit(fn, *args, key=f"refsph-{key}", pure=False): key for key, args in tasks.items()}
+        for f in as_completed(futures):
+            yield futures[f], _result(f, futures[f])
+
+
+def run_all(fn, tasks: dict, jobs: int = 1, fresh: bool = True) -> list:
+    """Every run's result, in the order of ``tasks`` (fresh processes, ``jobs`` at a time)."""
+    done = dict(execute(fn, tasks, jobs, fresh=fresh))
+    return [done[k] for k in tasks]
+
+
+def timed_in_subprocess(fn, *args):
+    """``fn(*args)`` in a fresh process of its own (for one timing that no earlier work in this process may
+    pollute); its result."""
+    return run_all(fn, {"run": args}, jobs=1)[0]
+
+
+# ----------------------------------------------------------------------------- markdown
+def fmt(v, spec: str, scale: float = 1.0, missing: str = "-") -> str:
+    """A table cell: ``missing`` for None, a non-finite float, or something that is not a number."""
+    if v is None or isinstance(v, (str, dict, list)) or (isinstance(v, float) and not math.isfinite(v)):
+        return missing
+    return format(v * scale if scale != 1.0 else v, spec)
+
+
+def md_table(head, rows, align: bool = False) -> str:
+    """A markdown table; ``align``: the first column left, the others right (no '|' may be inside a cell then)."""
+    if align:
+        assert not any("|" in c for row in [head] + list(rows) for c in row), "a '|' inside a table cell"
+        rule = "|" + "|".join("---:" if k else ":---" for k in range(len(head))) + "|"
+    else:
+        rule = "|" + "|".join("---" for _ in head) + "|"
+    return "\n".join(["| " + " | ".join(head) + " |", rule] + ["| " + " | ".join(str(c) for c in row) + " |"
+                                                               for row in rows])
+
+
+class Page:
+    """The prose of a report page: ``templates/<name>.md``, sections opened by a line ``@@ section``; a section is
+    the text up to the next marker without its leading and trailing blank lines, filled with ``string.Template``
+    (``$name`` or ``${name}``; ``$$`` is a dollar sign)."""
+
+    def __init__(self, name: str):
+        self.name, self.sections, current = name, {}, None
+        for line in (TEMPLATES / f"{name}.md").read_text(encoding="utf-8").split("\n"):
+            if line.startswith("@@ "):
+                current = line[3:].strip()
+                self.sections[current] = []
+            elif current is not None:
+                self.sections[current].append(line)
+        self.sections = {k: "\n".join(v).strip("\n") for k, v in self.sections.items()}
+
+    def __call__(self, section: str, **values) -> str:
+        return string.Template(self.sections[section]).substitute(values)
+
+    def lines(self, section: str, **values) -> list[str]:
+        """The filled section as a list of lines."""
+        return self(section, **values).split("\n")
+
+
+# ----------------------------------------------------------------------------- the command line
+FLAGS = {
+    "jobs": (("--jobs",), dict(type=int, default=1, help="runs at a time, each in a fresh process (default 1)")),
+    "only": (("--only",), dict(default=None, help="run only the jobs whose name contains this string")),
+    "quick": (("--quick",), dict(action="store_true", help="quick runs (a try-out)")),
+    "scheduler": (("--scheduler",), dict(default=None, metavar="ADDRESS",
+                                         help="address of a dask.distributed scheduler (tcp://host:port)")),
+    "report": (("--report",), dict(action="store_true", help="no runs: the page from the committed JSON only")),
+    "json_figures": (("--json-figures",), dict(action="store_true",
+                                               help="only redraw the figures made from the committed JSON alone")),
+    "plot_only": (("--plot-only",), dict(action="store_true",
+                                         help="no runs: JSON, figures and table from earlier runs")),
+}
+
+
+def parser(doc: str, *flags: str, **overrides) -> argparse.ArgumentParser:
+    """The study's argparse parser: the module text as help, the common ``flags`` (keys of FLAGS, in that
+    order), each with ``overrides[flag]`` (a dict of argparse keywords) applied."""
+    ap = argparse.ArgumentParser(description=doc, formatter_class=argparse.RawDescriptionHelpFormatter)
+    return add_flags(ap, *flags, **overrides)
+
+
+def add_flags(ap: argparse.ArgumentParser, *flags: str, **overrides) -> argparse.ArgumentParser:
+    """Add the common ``flags`` to ``ap`` (after a study's own, to keep an order of flags the help shows)."""
+    for flag in flags:
+        names, kw = FLAGS[flag]
+        ap.add_argument(*names, **dict(kw, **overrides.get(flag, {})))
+    return ap

@@ -1,0 +1,124 @@
+"""benchmarks/ stands on one scaffold (benchmarks/study.py): every study script pins its thread pools with
+``study.pin_threads()`` before NumPy (or refsph) is imported, runs its processes through ``study`` rather than a pool
+of its own, writes no markdown-table helper or thread variable of its own, and keeps every function under 80 lines
+(the rule tests/test_architecture.py applies to refsph/)."""
+import ast
+import json
+from pathlib import Path
+
+import pytest
+
+BENCH = Path(__file__).resolve().parent.parent / "benchmarks"
+SCAFFOLD = "study.py"
+SCRIPTS = sorted(p for p in BENCH.glob("*.py") if p.name != SCAFFOLD)
+MAX_LINES = 80
+HEAVY = ("numpy", "scipy", "refsph", "matplotlib")
+
+
+def long_functions(path: Path) -> list[str]:
+    """'name (N lines)' for each function of the file with MAX_LINES lines or more."""
+    tree = ast.parse(path.read_text())
+    return [f"{n.name} ({n.end_lineno - n.lineno + 1} lines)" for n in ast.walk(tree)
+            if isinstance(n, (ast.FunctionDef, ast.AsyncFunctionDef)) and n.end_lineno - n.lineno + 1 >= MAX_LINES]
+
+
+def _imports(node) -> list[str]:
+    if isinstance(node, ast.Import):
+        return [a.name for a in node.names]
+    if isinstance(node, ast.ImportFrom) and node.module and node.level == 0:
+        return [node.module]
+    return []
+
+
+def pinning_problem(path: Path) -> str | None:
+    """None if the script calls study.pin_threads() at module level before any heavy import, else what is wrong."""
+    tree = ast.parse(path.read_text())
+    for node in tree.body:
+        if isinstance(node, ast.Expr) and isinstance(node.value, ast.Call):
+            f = node.value.func
+            if isinstance(f, ast.Attribute) and f.attr == "pin_threads" and getattr(f.value, "id", None) == "study":
+                return None
+        heavy = [m for m in _imports(node) if m.split(".")[0] in HEAVY]
+        if heavy:
+            return f"imports {heavy[0]} (line {node.lineno}) before study.pin_threads()"
+    return "never calls study.pin_threads() at module level"
+
+
+def copied_scaffolding(path: Path) -> list[str]:
+    """Scaffolding the script writes itself instead of taking it from study.py."""
+    text = path.read_text()
+    found = [s for s in ("OMP_NUM_THREADS", "def _md_table", "def md_table", "ProcessPoolExecutor", "fcntl")
+             if s in text]
+    return found
+
+
+def test_there_are_scripts():
+    assert len(SCRIPTS) >= 10 and (BENCH / SCAFFOLD).exists()
+
+
+@pytest.mark.parametrize("path", SCRIPTS + [BENCH / SCAFFOLD], ids=lambda p: p.name)
+def test_no_function_of_80_lines(path):
+    assert long_functions(path) == [], f"{path.name}: functions of {MAX_LINES} lines or more"
+
+
+@pytest.mark.parametrize("path", SCRIPTS, ids=lambda p: p.name)
+def test_every_study_pins_its_threads_with_the_scaffold(path):
+    assert pinning_problem(path) is None, f"{path.name}: {pinning_problem(path)}"
+
+
+@pytest.mark.parametrize("path", SCRIPTS, ids=lambda p: p.name)
+def test_no_copied_scaffolding(path):
+    assert copied_scaffolding(path) == [], f"{path.name} writes its own {copied_scaffolding(path)}: use study.py"
+
+
+def test_the_checks_can_fail(tmp_path):
+    """Each check finds what it is for in a script that has it."""
+    bad = tmp_path / "bad.py"
+    body = "\n".join(f"    x{k} = {k}" for k in range(MAX_LINES))
+    bad.write_text(f"import numpy as np\nimport study\nstudy.pin_threads()\n\n\ndef f():\n{body}\n"
+                   "import os\nos.environ['OMP_NUM_THREADS'] = '1'\n")
+    assert long_functions(bad) == [f"f ({MAX_LINES + 1} lines)"]
+    assert pinning_problem(bad).startswith("imports numpy")
+    assert copied_scaffolding(bad) == ["OMP_NUM_THREADS"]
+    bad.write_text("import json\n")
+    assert pinning_problem(bad) == "never calls study.pin_threads() at module level"
+
+
+def _study():
+    import sys
+    if str(BENCH) not in sys.path:
+        sys.path.insert(0, str(BENCH))
+    import study
+    return study
+
+
+def test_run_store_keeps_good_records_and_reads_the_committed_format(tmp_path):
+    """A failed run never replaces a good record; a rerun skips what is recorded; the committed records load."""
+    study = _study()
+    committed = study.RunStore(BENCH / "thermal_cutting.json")
+    assert committed.load()["runs"]["case 1"]["status"] == "ok"
+    assert committed.pending(["case 1", "case 99"]) == ["case 99"]
+    store = study.RunStore(tmp_path / "runs.json")
+    assert store.commit("a", dict(status="ok", value=1.0))
+    assert not store.commit("a", dict(status="failed: RuntimeError: boom"))
+    doc = json.loads((tmp_path / "runs.json").read_text())
+    assert doc["runs"]["a"] == dict(status="ok", value=1.0) and doc["failed"]["a"]["status"].startswith("failed")
+    assert store.commit("b", dict(status="failed: x")) and store.pending(["a", "b", "c"]) == ["c"]
+    assert store.pending(["a", "b", "c"], retry_failed=True) == ["b", "c"]
+    assert store.pending(["a"], redo=["a"]) == ["a"]
+    assert not list(tmp_path.glob("*.tmp"))                       # written atomically: no temporary file left
+
+
+def test_execute_runs_each_task_and_records_a_crash():
+    """Fresh processes: every task's result comes back under its key; a task that raises gives a failed record."""
+    import math
+    out = dict(_study().execute(math.sqrt, {"four": (4.0,), "minus one": (-1.0,)}, jobs=2))
+    assert out["four"] == 2.0
+    assert out["minus one"]["status"].startswith("failed: ValueError")
+
+
+def test_page_fills_its_sections():
+    page = _study().Page("taylor_report")
+    assert page("cost_of_dt", steps="3.7", wall="5.2") == "; 3.7 times the steps, 5.2 times the wall time"
+    with pytest.raises(KeyError):
+        page("cost_of_dt", steps="3.7")

@@ -46,8 +46,8 @@ from scipy import integrate, special
 
 from refsph.kernels import get_kernel
 from refsph.neighbours import find_pairs, pair_count_per_particle, scatter_add
-from refsph.plots import colorbar, particle_field
-from refsph.notebook import chapter
+from refsph.teaching.plots import colorbar, particle_field
+from refsph.teaching.notebook import chapter
 ch = chapter("01_kernel")
 
 # %% [markdown]

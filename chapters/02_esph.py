@@ -38,11 +38,11 @@ from refsph.esph import ESPHParams, esph_rates, velocity_gradient
 from refsph.kernels import get_kernel
 from refsph.material import jaumann_deviatoric_rate, von_mises
 from refsph.neighbours import PairSum, find_pairs
-from refsph.plots import colorbar, particle_field
+from refsph.teaching.plots import colorbar, particle_field
 from refsph.scenes import aisi4340_material, lattice
 from refsph.simulate import run
 from refsph.state import State
-from refsph.notebook import chapter
+from refsph.teaching.notebook import chapter
 ch = chapter("02_esph")
 
 # %% [markdown]

@@ -33,13 +33,13 @@ import math
 import matplotlib.pyplot as plt
 import numpy as np
 from refsph.kernels import get_kernel
-from refsph.plots import colorbar, particle_field
+from refsph.teaching.plots import colorbar, particle_field
 from refsph.scenes import aisi4340_material, get_scene, lattice
 from refsph.simulate import SimulationError, run
 from refsph.state import make_state
 from refsph.tensor import det
 from refsph.tlsph import ReferenceOperator, TLSPHParams, green_lagrange_norm, reference_update, tlsph_rates
-from refsph.notebook import chapter
+from refsph.teaching.notebook import chapter
 ch = chapter("03_tlsph")
 
 # %%

@@ -35,12 +35,12 @@ from dataclasses import replace
 import matplotlib.pyplot as plt
 import numpy as np
 from scipy.integrate import solve_ivp
-from refsph.material_point import material_point
+from refsph.teaching.material_point import material_point
 from refsph.plasticity import (JohnsonCook, ModifiedJohnsonCook, equivalent_strain_rate, plastic_strain_increment,
                                radial_return, yield_stress)
 from refsph.strength import plastic_update
 from refsph.scenes.taylor import taylor_johnson_cook, taylor_material
-from refsph.notebook import chapter
+from refsph.teaching.notebook import chapter
 ch = chapter("04_johnson_cook")
 
 # %%
@@ -220,7 +220,7 @@ N_RANDOM = 400
 for name, jc_k, G_k in (("4340 (Table 1)", jc, mat.G), ("1045 (modified J-C)", jc_1045, mat_1045.G)):
     for d in (3, 2):
         S, S_zz, eps_p, T, rho, eps_dot = random_trial_states(N_RANDOM, d, jc_k, seed=10 * d + len(name))
-        S_n, S_zz_n, deps, dw, dT = plastic_update(S, S_zz, eps_p, T, rho, eps_dot, jc_k, G_k, heating=True)
+        S_n, S_zz_n, deps, dw, dT = plastic_update(S, S_zz, eps_p, T, rho, eps_dot, jc_k, G_k)
         cf, _, _, svm_trial = radial_return(S, S_zz, yield_stress(jc_k, eps_p, eps_dot, T))
         ref = [plain_return_map(S[i].tolist(), float(S_zz[i]), float(eps_p[i]), float(T[i]), float(rho[i]),
                                 float(eps_dot[i]), jc_k, G_k) for i in range(N_RANDOM)]
@@ -250,7 +250,7 @@ for name, jc_k, G_k in (("4340 (Table 1)", jc, mat.G), ("1045 (modified J-C)", j
 #
 # A material point in simple shear, $\mathbf l = \dot\gamma\,\mathbf e_x\otimes\mathbf e_y$, integrated like a
 # particle in `refsph` (predictor–corrector: a half step with its own return map, then the full step; see
-# `refsph.material_point`), with the plain return map. The one switch is the rate fed into Eq. (26):
+# `refsph.teaching.material_point`), with the plain return map. The one switch is the rate fed into Eq. (26):
 # `"total"` (refsph), the equivalent total rate of the step; or `"plastic"`, the previous step's plastic rate
 # $\Delta\bar\epsilon_p^{\,k-1}/\Delta t$.
 
@@ -287,7 +287,7 @@ mp = material_point(mat, jc, [[0, gd, 0], [0, 0, 0], [0, 0, 0]], 1e-8, 300, T0, 
 assert np.allclose(chk["svm"], mp["sigma_vm"], rtol=1e-12, atol=1e-6)
 assert np.allclose(chk["eps_p"], mp["eps_p"], rtol=1e-12, atol=1e-18)
 assert np.allclose(chk["tau"], mp["S"][:, 0, 1], rtol=1e-12, atol=1e-6)
-print("plain shear loop ('total') == refsph.material_point over 300 steps")
+print("plain shear loop ('total') == refsph.teaching.material_point over 300 steps")
 
 # %% [markdown]
 # The two choices at an equivalent rate of $10^4$ /s, with three time steps around the paper's $10^{-8}$ s:

@@ -42,7 +42,7 @@ from refsph.contact import CoulombFriction, PinballContact, pinball_contact
 from refsph.scenes import Numerics, Setup, aisi4340_material, lattice
 from refsph.simulate import simulate
 from refsph.state import concatenate_states, make_state
-from refsph.notebook import chapter
+from refsph.teaching.notebook import chapter
 ch = chapter("05_contact")
 
 # %% [markdown]

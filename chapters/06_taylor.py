@@ -38,10 +38,10 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from refsph.paper_data import TAYLOR_GEOMETRY, TAYLOR_RESULTS, TAYLOR_TABLE1, TAYLOR_TABLE2
-from refsph.plots import colorbar, particle_field
+from refsph.teaching.plots import colorbar, particle_field
 from refsph.scenes.taylor import bar_diameter, bar_length, taylor_johnson_cook, taylor_material, taylor_particles
 from refsph.simulate import run
-from refsph.notebook import chapter
+from refsph.teaching.notebook import chapter
 ch = chapter("06_taylor")
 
 # %% [markdown]

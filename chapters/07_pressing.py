@@ -38,11 +38,11 @@ from refsph.boundaries import RigidBody
 from refsph.contact import PinballContact, pinball_contact
 from refsph.paper_data import PRESSING_GEOMETRY, PRESSING_RESOLUTIONS_M, PRESSING_TABLE4
 from refsph.plasticity import yield_stress
-from refsph.plots import colorbar, particle_field
+from refsph.teaching.plots import colorbar, particle_field
 from refsph.scenes import aisi4340_johnson_cook, aisi4340_material, get_scene
 from refsph.scenes.pressing import pressing_particles, pressing_table
 from refsph.simulate import run, simulate
-from refsph.notebook import chapter
+from refsph.teaching.notebook import chapter
 ch = chapter("07_pressing")
 
 # %% [markdown]
@@ -494,9 +494,11 @@ print(f"K_p = {K_P:g}: deepest pinball penetration {pen:.3f} dp after 0.05 mm of
 # lower? Are the shear bands stronger or weaker?
 
 # %% tags=["exercise"]
+import dataclasses
+
 HEATING = True     # <- change this to False (isothermal: no heating by plastic work, Eq. 28) and run again
 st = scene.setup(2, DP, True)
-st.heating = HEATING
+st.strength = dataclasses.replace(st.strength, heating=HEATING)   # the law's own switch
 r = simulate(st, "esph", scene=scene, progress=False) if not HEATING else res["esph"]   # True: the chapter's run
 for label, s, mt in (("chapter, heating", res["esph"].state, res["esph"].summary["metrics"]),
                      (f"heating = {HEATING}", r.state, r.summary["metrics"])):

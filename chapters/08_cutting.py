@@ -37,11 +37,11 @@ import statistics
 import matplotlib.pyplot as plt
 import numpy as np
 from refsph.paper_data import CUTTING_GEOMETRY, CUTTING_TABLE5
-from refsph.plots import colorbar, particle_field
+from refsph.teaching.plots import colorbar, particle_field
 from refsph.scenes.cutting import (SCENE, BAND_REL_PROMINENCE, STEADY_FROM, chip_thickness, cutting_particles,
                                    lattice_shape, shear_bands)
 from refsph.simulate import SimulationError, run
-from refsph.notebook import chapter, repository_root
+from refsph.teaching.notebook import chapter, repository_root
 ch = chapter("08_cutting")
 
 # %% [markdown]

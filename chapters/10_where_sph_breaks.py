@@ -32,8 +32,8 @@
 import json
 import matplotlib.pyplot as plt
 import numpy as np
-from refsph.notebook import chapter, repository_root
-from refsph.plots import particle_field
+from refsph.teaching.notebook import chapter, repository_root
+from refsph.teaching.plots import particle_field
 from refsph.simulate import SimulationError, run
 ch = chapter("10_where_sph_breaks")
 

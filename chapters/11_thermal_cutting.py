@@ -31,8 +31,8 @@
 import json
 import matplotlib.pyplot as plt
 import numpy as np
-from refsph.notebook import chapter, repository_root
-from refsph.plots import particle_field
+from refsph.teaching.notebook import chapter, repository_root
+from refsph.teaching.plots import particle_field
 ch = chapter("11_thermal_cutting")
 
 # %% [markdown]
@@ -173,7 +173,7 @@ plt.show()
 # $s$; refsph picks $s$ so that $s\rho v_c^2$ stays at 1 % of the yield stress $A$ (4 % in quick mode).
 
 # %%
-from refsph.plots import colorbar
+from refsph.teaching.plots import colorbar
 
 m = res.summary["metrics"]
 fig, axes = plt.subplots(1, 2, figsize=(13, 3.8), constrained_layout=True)
@@ -195,9 +195,12 @@ print(f"Fp/Fc {m['force_ratio']:.2f} (measured {meas['force_ratio']:.2f}),  Fc {
 print(f"chip {m['chip_thickness_mm']:.3f} mm thick, contact length {m['contact_length_mm']:.3f} mm")
 
 # %% [markdown]
-# Every joule is accounted for. The run keeps a ledger (`summary.json`, `heat_balance`): the plastic heat the
-# return map adds, the frictional heat the contact makes, the heat lost at the surface and the heat the held
-# faces take out. What is made must be what is stored plus what left:
+# Every joule is accounted for. The run's heat flow (`refsph.thermal.HeatFlow`, the physics the run loop steps
+# after the mechanics) keeps a ledger (`summary.json`, `heat_balance`): the plastic heat, counted from the plastic
+# work alone ($\chi \sum_i m_i \Delta W_{p,i} / \rho_i$, Eq. (28) summed), the frictional heat the contact makes,
+# the heat lost at the surface and the heat the held faces take out. The heat stored is counted from the
+# temperatures ($\sum_i m_i c_p (T_i - T_{i,0})$), so a heating with the wrong $\chi$ or $c_p$ would not balance
+# (`tests/test_thermal_cutting.py` checks that it does not). What is made must be what is stored plus what left:
 
 # %%
 hb = res.summary["heat_balance"]
@@ -262,7 +265,9 @@ for title in ("## Mass scaling", "## Surface detector"):
 #
 # ### Exercise 1 — Switch the heat flow off
 #
-# Predict, then run the quick cut with `conduction=False` (the adiabatic model of chapter 8, friction still on).
+# Predict, then run the quick cut with `conduction=False` (the adiabatic model of chapter 8: no conduction and no
+# frictional heat, friction itself still on; in a Setup of one's own the two are separate switches,
+# `Setup.thermal` and `Setup.friction_heat`).
 # Is the rake face hotter or colder? Why?
 #
 # ### Exercise 2 — Who gets the frictional heat?

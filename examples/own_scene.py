@@ -9,7 +9,7 @@ from refsph.simulate import simulate
 from refsph.state import concatenate_states, make_state
 
 dp, R, V = 25e-6, 0.2e-3, 50.0                       # spacing, roller radius [m], rolling speed [m/s]
-mat, jc = aisi4340_material(), aisi4340_johnson_cook(eps_dot_0=1.0)
+mat, jc = aisi4340_material(), aisi4340_johnson_cook(eps_dot_0=1.0, heating=False)
 plate = make_state(lattice([1.5e-3, 0.3e-3], dp), [0.0, 0.0], mat.rho0, dp * dp, T0=jc.T_room)
 centre = np.array([0.3e-3, 0.3e-3 + R + 0.5 * dp])    # the roller starts half a spacing above the plate
 phi = np.linspace(0.0, 2 * np.pi, round(2 * np.pi * R / dp), endpoint=False)
@@ -17,7 +17,7 @@ ring = centre + (R - 0.5 * dp) * np.stack([np.cos(phi), np.sin(phi)], axis=1)
 roller = RigidBody("roller", 1, velocity=(V, -0.05 * V), angular_velocity=-V / R, centre=tuple(centre))
 tool = make_state(ring, roller.velocity_at(ring), mat.rho0, dp * dp, T0=jc.T_room, body=np.ones(len(ring)))
 setup = Setup(state=concatenate_states(plate, tool), material=mat, dp=dp, t_end=16e-6, n_snapshots=4,
-              numerics=Numerics(beta1=0.5, beta2=0.5), strength=jc, heating=False, rigid=(roller,),
+              numerics=Numerics(beta1=0.5, beta2=0.5), strength=jc, rigid=(roller,),
               clamps=(Clamp("base", np.flatnonzero(plate.x[:, 1] < dp)),),
               friction=CoulombFriction(mu0=0.3, q=1.0, T_room=jc.T_room, T_melt=jc.T_melt))
 n = plate.n

@@ -51,7 +51,7 @@ import numpy as np
 
 from .state import Rates, State
 
-__all__ = ["MirrorPlanes", "Ghosts", "RigidWall", "RigidBody", "Clamp", "Constraints"]
+__all__ = ["MirrorPlanes", "Ghosts", "RigidWall", "RigidBody", "Clamp", "Constraints", "ReactionLog"]
 
 
 @dataclass(frozen=True)
@@ -252,6 +252,36 @@ class RigidBody:
                                                           else x.mean(axis=0)), dtype=float)
         return np.asarray(self.velocity) + self.spin(x - c)
 
+    def start(self, state: State, rows: slice) -> tuple | None:
+        """What the closed-form motion needs of the body's rows at the start (None for a body that only
+        translates: its velocity is all): (t0, c0, x - c0); ValueError if the rows do not move with the body."""
+        x = state.x[rows]
+        if not self.rotates:
+            start, ok = None, np.all(state.v[rows] == np.asarray(self.velocity))
+        else:
+            c0 = np.asarray(self.centre) if self.centre is not None else x.mean(axis=0)
+            start, v = (state.t, c0, x - c0), self.velocity_at(x, c0)
+            ok = np.allclose(state.v[rows], v, rtol=1e-12, atol=1e-12 * np.max(np.abs(v)))
+        if not ok:
+            raise ValueError(f"rigid body {self.name!r}: its particles must start with its velocity "
+                             f"{self.velocity}" + (" turning at " + str(self.angular_velocity) + " rad/s (give them "
+                                                   "RigidBody.velocity_at(x))" if self.rotates else ""))
+        return start
+
+    def place(self, state: State, rows: slice, start: tuple | None, t: float) -> None:
+        """Put the body's ``rows`` of ``state`` where its motion has them at time ``t`` (in place; ``start`` from
+        :meth:`start`): a translating body's velocity reset to V (no drift from round-off), a turning body placed
+        by the closed form c(t) + R(omega (t - t0)) (x(t0) - c0) with v = V + omega x r."""
+        if start is None:
+            state.v[rows] = np.asarray(self.velocity)
+            return
+        t0, c0, r0 = start
+        s = t - t0
+        c = c0 + np.asarray(self.velocity) * s
+        r = r0 @ self.rotation(s, state.dim).T
+        state.x[rows] = c + r
+        state.v[rows] = np.asarray(self.velocity) + self.spin(r)
+
     def rotation(self, t: float, d: int) -> np.ndarray:
         """R(omega t), (d, d): 2D rotation by omega t; 3D Rodrigues' formula about omega / |omega|."""
         w = self._omega3()
@@ -284,9 +314,71 @@ class Clamp:
         return dict(name=self.name, n_particles=int(len(self.index)))
 
 
+class ReactionLog:
+    """The force the rest of the system exerts on each rigid body and clamp (``names``), every step: one row per
+    step at the step's midpoint t (the time of the rates that moved it), with dt and d components per name, and the
+    impulse of each so far."""
+
+    def __init__(self, names: list[str]):
+        self.names = list(names)
+        self.dim: int | None = None
+        self.last: list[np.ndarray] | None = None           # force on each body / clamp, last evaluation
+        self.rows: list[list[float]] = []                   # per step: t_mid, dt, then d components per name
+        self.impulse = [0.0 for _ in self.names]
+
+    def keep(self, forces: list[np.ndarray]) -> None:
+        """The forces of the latest rate evaluation (the step's, once it ends)."""
+        self.last = forces
+
+    def close_step(self, t_mid: float, dt: float) -> None:
+        """The step that just ended moved with the kept forces: log them and add their impulse."""
+        if self.last is None:
+            return
+        self.rows.append([t_mid, dt] + [float(c) for f in self.last for c in f])
+        for k, f in enumerate(self.last):
+            self.impulse[k] = self.impulse[k] + f * dt
+
+    def _table(self) -> np.ndarray:
+        return np.asarray(self.rows, dtype=float).reshape(-1, 2 + (self.dim or 1) * len(self.names))
+
+    def checkpoint(self) -> dict:
+        """The log, the impulses and the last kept forces (a leapfrog restarted with its kept force evaluates no
+        force before its first step ends, so the step is logged with these)."""
+        d = self.dim or 1
+        ck = dict(reaction_log=self._table(),
+                  reaction_impulse=np.array([np.atleast_1d(i) * np.ones(d) for i in self.impulse],
+                                            dtype=float).reshape(len(self.impulse), d))
+        if self.last is not None:
+            ck["reaction_last"] = np.array(self.last, dtype=float)
+        return ck
+
+    def restore(self, ck: dict) -> None:
+        self.last = [np.array(f) for f in ck["reaction_last"]] if "reaction_last" in ck else None
+        self.rows = [list(row) for row in np.asarray(ck["reaction_log"], dtype=float)]
+        self.impulse = [np.array(row) for row in ck["reaction_impulse"]]
+        if not self.rows:                                       # before the first step: the scalar start value
+            self.impulse = [0.0 for _ in self.impulse]
+
+    def history(self) -> dict:
+        """{'t': (n_steps,), 'dt': (n_steps,), name: (n_steps, d) force on that rigid body / clamp} (N; 2D: N per
+        metre of thickness); dt is the step's size, so sum(F dt) is the impulse."""
+        if not self.names or self.dim is None:
+            return {}
+        d, log = self.dim, self._table()
+        out = {"t": log[:, 0], "dt": log[:, 1]}
+        for k, name in enumerate(self.names):
+            out[name] = log[:, 2 + k * d: 2 + (k + 1) * d]
+        return out
+
+    def diagnostics(self) -> dict:
+        # impulse the rest of the system gave each rigid body / clamp, N s (2D: N s/m); note the sign
+        # convention differs from wall_impulse, which is the impulse the wall gave the model
+        return {name: [float(c) for c in np.atleast_1d(imp)] for name, imp in zip(self.names, self.impulse)}
+
+
 class Constraints:
-    """The prescribed motions of a run and what they cost: rigid walls, rigid bodies and clamps, and the reaction
-    log (the force the rest of the system exerts on each rigid body and clamp, every step).
+    """The prescribed motions of a run: rigid walls, rigid bodies and clamps, and what they cost (the reaction log,
+    :class:`ReactionLog`; the walls' impulses).
 
     A solver owns one and calls it at three points of every stage of a step:
 
@@ -294,16 +386,16 @@ class Constraints:
     * :meth:`constrain` on the rates: the force on each body / clamp is kept (sum m dv/dt over its rows of the
       unconstrained rates; pairs inside one body cancel), then rigid rows get dv/dt = 0 and no stress rate and
       clamped rows dx/dt = dv/dt = 0;
-    * :meth:`apply` on the state the stage produced: walls (a unilateral constraint), the exact rigid motion (no
-      drift from round-off: a translating body's velocity is reset to V, a turning body is placed by its closed
-      form), clamps back in place; on the final stage, the step's forces go into the log.
+    * :meth:`apply` on the state the stage produced: walls (a unilateral constraint), each rigid body placed by its
+      own motion (:meth:`RigidBody.place`), clamps back in place; on the final stage, the step's forces go into
+      the log.
     """
 
     def __init__(self, walls=(), rigid=(), clamps=(), mirror: MirrorPlanes | None = None):
         self.walls = tuple(walls or ())
         self.rigid = tuple(rigid or ())
         self.clamps = tuple(clamps or ())
-        names = self.reaction_names
+        names = [b.name for b in self.rigid] + [c.name for c in self.clamps]
         if len(set(names)) != len(names):
             raise ValueError(f"rigid bodies and clamps need distinct names, got {names}")
         for name in names:
@@ -323,27 +415,27 @@ class Constraints:
         self.deformable_bodies: list[int] = [0]  # the body ids of those rows (several: they meet by contact)
         self.dim: int | None = None
         self.rows: list[slice] = []            # the rows of each rigid body
-        self._start: list[tuple | None] = []   # per turning body: (t0, c0, x0 - c0)
-        self._reaction: list[np.ndarray] | None = None      # force on each rigid body / clamp, last evaluation
-        self.reaction_log: list[list[float]] = []           # per step: t_mid, dt, then d components per body/clamp
-        self.reaction_impulse = [0.0 for _ in names]
+        self.starts: list[tuple | None] = []   # per rigid body: RigidBody.start (None: it only translates)
+        self.log = ReactionLog(names)
 
     @property
     def reaction_names(self) -> list[str]:
         """Names of the rigid bodies and clamps, in the order of the reaction log."""
-        return [b.name for b in self.rigid] + [c.name for c in self.clamps]
+        return self.log.names
 
     def bind(self, state: State) -> None:
         """Check the state against the constraints and find the rigid rows (ValueError naming what is wrong)."""
         n = state.n
-        self.dim = state.dim
+        self.dim = self.log.dim = state.dim
         for w in self.walls:
             w.check(state.dim)
-        self.rows, self._start = [], []
+        self.rows, self.starts = [], []
         if self.rigid and state.body is None:
             raise ValueError("rigid bodies need State.body (the body id of every particle)")
         for b in self.rigid:
-            self.rows.append(self._body_rows(b, state))
+            rows = _body_rows(b, state)
+            self.rows.append(rows)
+            self.starts.append(b.start(state, rows))
         n_def = min((r.start for r in self.rows), default=n)
         if sum(r.stop - r.start for r in self.rows) != n - n_def:
             raise ValueError("rigid body particles must come after every deformable particle in the state")
@@ -352,29 +444,6 @@ class Constraints:
         for c in self.clamps:
             if c.index[-1] >= n_def:
                 raise ValueError(f"clamp {c.name!r} holds particle {c.index[-1]}, which is not a deformable one")
-
-    def _body_rows(self, b: RigidBody, state: State) -> slice:
-        b.check(state.dim)
-        idx = np.flatnonzero(state.body == b.body)
-        if len(idx) == 0:
-            raise ValueError(f"rigid body {b.name!r}: no particle has body id {b.body}")
-        if idx[-1] - idx[0] + 1 != len(idx):
-            raise ValueError(f"rigid body {b.name!r}: its particles must be consecutive rows")
-        rows = slice(int(idx[0]), int(idx[-1]) + 1)
-        x = state.x[rows]
-        if not b.rotates:
-            self._start.append(None)
-            ok = np.all(state.v[rows] == np.asarray(b.velocity))
-        else:
-            c0 = np.asarray(b.centre) if b.centre is not None else x.mean(axis=0)
-            self._start.append((state.t, c0, x - c0))
-            v = b.velocity_at(x, c0)
-            ok = np.allclose(state.v[rows], v, rtol=1e-12, atol=1e-12 * np.max(np.abs(v)))
-        if not ok:
-            raise ValueError(f"rigid body {b.name!r}: its particles must start with its velocity "
-                             f"{b.velocity}" + (" turning at " + str(b.angular_velocity) + " rad/s (give them "
-                                                "RigidBody.velocity_at(x))" if b.rotates else ""))
-        return rows
 
     def constrain(self, state: State, r: Rates, record: bool = True) -> Rates:
         """Prescribed motion on the rates (in place), after keeping the force on each body and clamp (``record``:
@@ -393,74 +462,44 @@ class Constraints:
             r.v[c.index] = 0.0
             r.x[c.index] = 0.0
         if record:
-            self._reaction = forces
+            self.log.keep(forces)
         return r
 
-    def apply(self, old: State, new: State, dt: float, final: bool, rho_floor: float | None = None) -> State:
-        """Walls, rigid motion and clamps on the state a stage produced (in place); ``rho_floor``: ESPH keeps a
-        tool's density (Eq. (10)) at or above it, so that its own pressure is never negative."""
+    def apply(self, old: State, new: State, dt: float, final: bool) -> State:
+        """Walls, rigid motion and clamps on the state a stage produced (in place)."""
         for k, wall in enumerate(self.walls):
             imp = wall.apply(new, dt)
             if final:
                 self.wall_impulse[k] += imp
-        for b, rows, start in zip(self.rigid, self.rows, self._start):
-            if start is None:
-                new.v[rows] = np.asarray(b.velocity)
-            else:
-                t0, c0, r0 = start
-                t = old.t + dt - t0
-                c = c0 + np.asarray(b.velocity) * t
-                r = r0 @ b.rotation(t, new.dim).T
-                new.x[rows] = c + r
-                new.v[rows] = np.asarray(b.velocity) + b.spin(r)
-            if rho_floor is not None:
-                new.rho[rows] = np.maximum(new.rho[rows], rho_floor)
+        for b, rows, start in zip(self.rigid, self.rows, self.starts):
+            b.place(new, rows, start, old.t + dt)
         for c in self.clamps:
             new.v[c.index] = 0.0
             new.x[c.index] = old.x[c.index]
-        if final and self._reaction is not None:
-            self.reaction_log.append([old.t + 0.5 * dt, dt] + [float(c) for f in self._reaction for c in f])
-            for k, f in enumerate(self._reaction):
-                self.reaction_impulse[k] = self.reaction_impulse[k] + f * dt
+        if final:
+            self.log.close_step(old.t + 0.5 * dt, dt)
         return new
 
     def checkpoint(self) -> dict:
         """What a restart needs besides the state: the reaction log and impulses, the start of turning bodies."""
-        d = self.dim or 1
-        ck = dict(reaction_log=np.asarray(self.reaction_log, dtype=float).reshape(-1, 2 + d * len(self.reaction_names)),
-                  wall_impulse=self.wall_impulse.copy(),
-                  reaction_impulse=np.array([np.atleast_1d(i) * np.ones(d) for i in self.reaction_impulse],
-                                            dtype=float).reshape(len(self.reaction_impulse), d))
-        for k, start in enumerate(self._start):
+        ck = dict(self.log.checkpoint(), wall_impulse=self.wall_impulse.copy())
+        for k, start in enumerate(self.starts):
             if start is not None:
                 ck[f"turning_{k}"] = np.concatenate([[start[0]], start[1], start[2].ravel()])
         return ck
 
     def restore(self, ck: dict) -> None:
         """The inverse of :meth:`checkpoint`, after :meth:`bind` on the restart state."""
-        self.reaction_log = [list(row) for row in np.asarray(ck["reaction_log"], dtype=float)]
+        self.log.restore(ck)
         self.wall_impulse = np.array(ck["wall_impulse"], dtype=float)
-        self.reaction_impulse = [np.array(row) for row in ck["reaction_impulse"]]
-        if not self.reaction_log:                               # before the first step: the scalar start value
-            self.reaction_impulse = [0.0 for _ in self.reaction_impulse]
-        for k, start in enumerate(self._start):
+        for k, start in enumerate(self.starts):
             if start is not None:
                 a, d = ck[f"turning_{k}"], self.dim
-                self._start[k] = (float(a[0]), a[1:1 + d], a[1 + d:].reshape(-1, d))
+                self.starts[k] = (float(a[0]), a[1:1 + d], a[1 + d:].reshape(-1, d))
 
     def reaction_history(self) -> dict:
-        """{'t': (n_steps,), 'dt': (n_steps,), name: (n_steps, d) force on that rigid body / clamp} (N; 2D: N per
-        metre of thickness), one row per step at the step's midpoint t (the time of the rates that moved it);
-        dt is the step's size, so sum(F dt) is the impulse."""
-        names = self.reaction_names
-        if not names or self.dim is None:
-            return {}
-        d = self.dim
-        log = np.asarray(self.reaction_log, dtype=float).reshape(-1, 2 + d * len(names))
-        out = {"t": log[:, 0], "dt": log[:, 1]}
-        for k, name in enumerate(names):
-            out[name] = log[:, 2 + k * d: 2 + (k + 1) * d]
-        return out
+        """The reaction log (:meth:`ReactionLog.history`)."""
+        return self.log.history()
 
     def diagnostics(self) -> dict:
         out = {}
@@ -468,8 +507,16 @@ class Constraints:
             # impulse of each wall on the *model* (a quarter/half of the body with symmetry planes), N s (2D: N s/m)
             out["wall_impulse"] = [float(i) for i in self.wall_impulse]
         if self.reaction_names:
-            # impulse the rest of the system gave each rigid body / clamp, N s (2D: N s/m); note the sign
-            # convention differs from wall_impulse, which is the impulse the wall gave the model
-            out["reaction_impulse"] = {name: [float(c) for c in np.atleast_1d(imp)]
-                                       for name, imp in zip(self.reaction_names, self.reaction_impulse)}
+            out["reaction_impulse"] = self.log.diagnostics()
         return out
+
+
+def _body_rows(b: RigidBody, state: State) -> slice:
+    """The rows of rigid body ``b`` (consecutive; ValueError otherwise)."""
+    b.check(state.dim)
+    idx = np.flatnonzero(state.body == b.body)
+    if len(idx) == 0:
+        raise ValueError(f"rigid body {b.name!r}: no particle has body id {b.body}")
+    if idx[-1] - idx[0] + 1 != len(idx):
+        raise ValueError(f"rigid body {b.name!r}: its particles must be consecutive rows")
+    return slice(int(idx[0]), int(idx[-1]) + 1)

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
+import subprocess
 import sys
 
 import numpy as np
@@ -30,8 +31,12 @@ def _parser() -> argparse.ArgumentParser:
     b.add_argument("--rerun", action="store_true", help="execute every chapter again (default: reuse the "
                    "executed notebooks in build/executed/ that are newer than their chapter)")
     b.add_argument("--jobs", type=int, default=2, help="chapters executed at a time (default 2)")
-    o = sub.add_parser("oracle", help="write the golden cases (inputs, refsph's outputs, tolerances) into DIR")
+    o = sub.add_parser("oracle", help="write the golden cases (inputs, refsph's outputs, tolerances) into DIR, "
+                                      "computed with NumPy's, OpenBLAS's and glibc's CPU-independent code paths "
+                                      "(refsph.crosscheck.golden; every case: a few minutes)")
     o.add_argument("dir")
+    o.add_argument("--only", nargs="+", default=None, metavar="CASE",
+                   help="write these cases only (names or patterns such as 'kernel_*'), keeping the others in DIR")
     c = sub.add_parser("compare", help="compare golden-case or run folders: TEST against REF (exit 1 if any "
                                        "quantity is outside its tolerance)")
     c.add_argument("ref")
@@ -77,14 +82,18 @@ def main(argv=None) -> int:
     if args.cmd == "book":
         return _book(args)
     if args.cmd == "oracle":
-        from .golden import write_golden_cases
-        names = write_golden_cases(args.dir)
+        from .crosscheck.golden import write_golden_cases
+        try:
+            names = write_golden_cases(args.dir, args.only)
+        except subprocess.CalledProcessError as e:
+            print(f"refsph: writing the golden cases failed ({e})", file=sys.stderr)
+            return 2
         print(f"{len(names)} golden cases in {args.dir}: {', '.join(names)}")
         return 0
     if args.cmd == "compare":
         return _compare(args)
     if args.cmd == "export":
-        from .export import export_vtk
+        from .crosscheck.export import export_vtk
         try:
             print(f"ParaView: {export_vtk(args.run_dir)}")
         except (ImportError, OSError) as e:
@@ -131,7 +140,7 @@ def _restart(args) -> int:
 def _compare(args) -> int:
     import json
 
-    from .compare import compare, format_table
+    from .crosscheck.compare import compare, format_table
     try:
         tol = json.loads(open(args.tolerances).read()) if args.tolerances else None
         rows = compare(args.ref, args.test, tol, only=args.only)
@@ -143,7 +152,7 @@ def _compare(args) -> int:
 
 
 def _book(args) -> int:
-    from .book import build_book
+    from .teaching.book import build_book
     try:
         index = build_book(quick=not args.full, reuse=not args.rerun, jobs=args.jobs)
     except Exception as e:                                  # a chapter's failing cell, a timeout, no sphinx ...

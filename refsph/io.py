@@ -47,7 +47,8 @@ from .material import eos_pressure, von_mises
 from .state import FIELD_UNITS, PLASTIC_FIELDS, State
 
 __all__ = ["save_snapshot", "load_snapshot", "state_from_snapshot", "state_from_particles", "load_run",
-           "write_json", "json_ready", "save_reactions", "load_reactions", "SNAPSHOT_UNITS"]
+           "write_json", "json_ready", "save_reactions", "load_reactions", "analyse_cutting_run",
+           "SNAPSHOT_UNITS"]
 
 SNAPSHOT_UNITS = dict(FIELD_UNITS, p="Pa", sigma_vm="Pa", F="1", id="1 (particle id)")
 
@@ -196,3 +197,21 @@ def load_reactions(path) -> dict:
         name = col.rsplit("_", 1)[0]
         out.setdefault(name, []).append(data[:, k])
     return {k: (np.stack(v, axis=1) if k not in ("t", "dt") else v) for k, v in out.items()}
+
+
+def analyse_cutting_run(directory, snapshot: int = -1) -> dict:
+    """:func:`refsph.scenes.cutting.cutting_metrics` of a cutting run folder (``refsph run cutting --out DIR``)
+    from its ``summary.json``, ``reaction_forces.csv`` and snapshot number ``snapshot`` (default: the last); the
+    forces cover the whole run. Lets a changed measurement be applied to earlier runs without running them again
+    (benchmarks/cutting.py). It lives here, not in the scene, because it reads run files: scenes only build."""
+    from .scenes.cutting import cutting_metrics      # here, not at the top: importing io stays free of the scenes
+
+    directory = Path(directory)
+    summary, snaps = load_run(directory)
+    if summary.get("scene") != "cutting":
+        raise ValueError(f"{directory} is not a cutting run (scene {summary.get('scene')!r})")
+    if not snaps:
+        raise FileNotFoundError(f"{directory} has no snapshots")
+    z = load_snapshot(snaps[snapshot])
+    return cutting_metrics(load_reactions(directory / "reaction_forces.csv"), z["x"], z["eps_p"], z["T"], z["t"],
+                           summary["scene_info"], summary["t_end"])

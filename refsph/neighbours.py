@@ -256,7 +256,7 @@ class VerletList:
         self.cutoff = float(cutoff)
         self.skin = float(skin)
         self.n_builds = 0
-        self._x_build: np.ndarray | None = None
+        self.x_build: np.ndarray | None = None
         self.I = np.zeros(0, dtype=np.intp)
         self.J = np.zeros(0, dtype=np.intp)
 
@@ -265,14 +265,14 @@ class VerletList:
         rebuild, if not ``x`` itself (e.g. the real particles, when ``x`` also holds mirror ghosts that move
         with them)."""
         self.I, self.J = find_pairs(x, self.cutoff + self.skin)
-        self._x_build = np.array(x if track is None else track, dtype=float, copy=True)
+        self.x_build = np.array(x if track is None else track, dtype=float, copy=True)
         self.n_builds += 1
         return self.I, self.J
 
     def needs_rebuild(self, x: np.ndarray) -> bool:
-        if self._x_build is None or self._x_build.shape != x.shape:
+        if self.x_build is None or self.x_build.shape != x.shape:
             return True
-        d = x - self._x_build
+        d = x - self.x_build
         return float(np.sqrt(np.max(np.einsum("ik,ik->i", d, d)))) > 0.5 * self.skin
 
     def update(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -43,7 +43,7 @@ from __future__ import annotations
 
 import math
 import numbers
-from dataclasses import dataclass, fields
+from dataclasses import dataclass, field, fields
 
 import numpy as np
 
@@ -57,9 +57,11 @@ __all__ = ["J2Plasticity", "JohnsonCook", "ModifiedJohnsonCook", "homologous_tem
 class J2Plasticity:
     """Von Mises plasticity with Wilkins' radial return (Eqs. (29)-(31)) for any flow stress: the shared part of
     every plasticity law of the strength-model seam (:mod:`refsph.strength`). A subclass gives
-    ``flow_stress(eps_p, eps_dot, T)`` [Pa] and, for the heating of Eq. (28), the attributes ``chi`` and ``cp``."""
+    ``flow_stress(eps_p, eps_dot, T)`` [Pa] and, for the heating of Eq. (28), the attributes ``chi`` and ``cp``;
+    ``heating`` (True unless the subclass says otherwise) switches that heating."""
 
     state_fields: tuple = PLASTIC_FIELDS
+    heating: bool = True
 
     def flow_stress(self, eps_p, eps_dot, T):
         raise NotImplementedError
@@ -71,7 +73,9 @@ class J2Plasticity:
         return S_n, S_zz_n, effective_plastic_strain_increment(svm, cf, G), plastic_work_increment(svm, cf, G)
 
     def heat(self, d_w_p, rho):
-        """Eq. (28): d T = chi d w_p / (rho C_p)."""
+        """Eq. (28): d T = chi d w_p / (rho C_p); zero with ``heating`` off (isothermal)."""
+        if not self.heating:
+            return np.zeros_like(d_w_p)
         return temperature_increment(d_w_p, rho, self)
 
 
@@ -80,6 +84,7 @@ class JohnsonCook(J2Plasticity):
     """Johnson-Cook constants (Eq. (25)), SI units; no defaults (Table 1 / Table 3 of the paper).
 
     A, B [Pa], n, C, m [-], eps_dot_0 [1/s], T_room, T_melt [K], cp [J/(kg K)], chi (Taylor-Quinney) [-].
+    ``heating`` (keyword, a switch, not a constant): plastic work heats the material (Eq. (28)); False: isothermal.
     """
 
     A: float
@@ -92,6 +97,7 @@ class JohnsonCook(J2Plasticity):
     T_melt: float
     cp: float
     chi: float
+    heating: bool = field(default=True, kw_only=True)
 
     def __post_init__(self):
         for name in ("A", "B", "n", "C", "m", "eps_dot_0", "T_room", "T_melt", "cp", "chi"):
@@ -108,18 +114,26 @@ class JohnsonCook(J2Plasticity):
             raise ValueError(f"T_melt ({self.T_melt!r} K) must exceed T_room ({self.T_room!r} K)")
         if not 0.0 <= self.chi <= 1.0:
             raise ValueError(f"Taylor-Quinney coefficient chi must lie in [0, 1], got {self.chi!r}")
+        if not isinstance(self.heating, (bool, np.bool_)):
+            raise ValueError(f"heating must be True or False, got {self.heating!r}")
 
     @classmethod
     def from_dict(cls, d: dict) -> "JohnsonCook":
-        """From a dict with every field named; a missing key is named in the error."""
-        names = [f.name for f in fields(cls)]
+        """From a dict with every constant named (and optionally ``heating``); a missing key is named in the
+        error."""
+        names = cls.constants()
         missing = [k for k in names if k not in d]
         if missing:
             raise ValueError(f"missing Johnson-Cook constant(s): {', '.join(missing)}")
-        unknown = sorted(set(d) - set(names))
+        unknown = sorted(set(d) - set(names) - {"heating"})
         if unknown:
             raise ValueError(f"unknown Johnson-Cook constant(s): {', '.join(unknown)}")
-        return cls(**{k: d[k] for k in names})
+        return cls(**{k: d[k] for k in names}, heating=bool(d.get("heating", True)))
+
+    @classmethod
+    def constants(cls) -> list[str]:
+        """The names of the law's material constants (its fields but the ``heating`` switch)."""
+        return [f.name for f in fields(cls) if f.name != "heating"]
 
     def hardening_strain(self, eps_p: np.ndarray) -> np.ndarray:
         """The plastic strain that enters the hardening term of Eq. (25): eps_p itself."""

@@ -4,6 +4,13 @@
 snapshot schedule (:func:`snapshot_times`), one step after another (:func:`step_or_fail`), the final record
 (metrics and ``summary.json``). ``run`` builds a registered scene first (what ``refsph run`` calls).
 
+The loop owns what a run is made of: the method (a :class:`~refsph.integrate.Solver`, or a
+:class:`~refsph.integrate.SelfAdvancing` method), its stepper (:func:`~refsph.integrate.make_stepper`, with the
+state it carries between steps), and the physics beside the mechanics (:func:`step_physics`: a list of
+:class:`~refsph.integrate.StepPhysics`, the heat flow when the setup asks for heat). Each step it takes the smallest
+of the CFL step and the physics' limits, steps the mechanics, then advances each physics in order; records,
+summaries and the restart checkpoint ask each part for its own.
+
 Nothing is lost on a crash: snapshots are written as the run goes, ``summary.json`` is written at every snapshot
 (``status: "running"``), at the end *and* on failure (``status`` says which), and a run that produces NaN/inf
 stops, reports the field, particle, step and time, and writes ``snapshots/last_good.npz`` with the last finite
@@ -12,6 +19,7 @@ state.
 from __future__ import annotations
 
 import dataclasses
+import inspect
 import json
 import os
 import sys
@@ -26,9 +34,10 @@ import numpy as np
 from . import __version__
 from .contact import PinballContact
 from .esph import ESPHParams
-from .integrate import Solver, cfl_time_step, get_stepper
+from .integrate import PARTS, SelfAdvancing, Solver, Step, StepPhysics, Stepper, cfl_time_step, make_stepper
 from .stability import warnings_for
-from .thermal import thermal_step, thermal_step_limit
+from .strength import heat_capacity, heats
+from .thermal import HeatFlow
 from .boundaries import Clamp
 from .io import json_ready, save_reactions, save_snapshot, state_from_particles, state_from_snapshot, write_json
 from .kernels import get_kernel
@@ -38,8 +47,8 @@ from .solvers import ESPHSolver, TLSPHSolver
 from .state import State
 from .tlsph import TLSPHParams
 
-__all__ = ["SimulationError", "RunResult", "RunRecord", "make_solver", "run", "simulate", "snapshot_times",
-           "step_or_fail", "provenance", "restart_run", "METHODS"]
+__all__ = ["SimulationError", "RunResult", "RunRecord", "make_solver", "step_physics", "run", "simulate",
+           "snapshot_times", "step_or_fail", "provenance", "restart_run", "METHODS"]
 
 METHODS = ("esph", "tlsph")
 CHECKPOINT = "restart.npz"          # snapshots/restart.npz: how to continue from the last snapshot (see simulate)
@@ -63,8 +72,8 @@ def make_solver(method: str, setup: Setup) -> Solver:
     threads = check_threads(nm.threads, allow_auto=True)   # (the numbers do not depend on it)
     kernel = get_kernel(nm.kernel)
     h = setup.h
-    common = dict(strength=setup.strength, heating=setup.heating, mirror=setup.mirror, walls=setup.walls,
-                  rigid=setup.rigid, clamps=setup.clamps, threads=threads)
+    common = dict(strength=setup.strength, mirror=setup.mirror, walls=setup.walls, rigid=setup.rigid,
+                  clamps=setup.clamps, threads=threads)
     if method == "esph":
         if setup.friction is not None:
             raise ValueError("friction is a law of the TLSPH pinball contact; ESPH tools act through the SPH "
@@ -91,6 +100,17 @@ def make_solver(method: str, setup: Setup) -> Solver:
     raise ValueError(f"unknown method {method!r}; choose one of {', '.join(METHODS)}")
 
 
+def step_physics(setup: Setup) -> list[StepPhysics]:
+    """The physics a run carries beside the mechanics, in the order the loop advances them: the heat flow
+    (:class:`refsph.thermal.HeatFlow`) when the setup conducts heat (``Setup.thermal``) or makes frictional heat
+    (``Setup.friction_heat``); none otherwise (the adiabatic model: the return map heats, Eq. (28))."""
+    if setup.thermal is None and setup.friction_heat is None:
+        return []
+    chi = float(getattr(setup.strength, "chi", 0.0)) if heats(setup.strength) else 0.0
+    return [HeatFlow(setup.thermal, setup.friction_heat, heat_capacity(setup.strength), chi, setup.h,
+                     get_kernel(setup.numerics.kernel), [b.body for b in setup.rigid])]
+
+
 def _deformable_bodies(setup: Setup) -> list:
     """The body ids of the setup's deformable particles (those of no rigid body)."""
     if setup.state.body is None:
@@ -99,8 +119,8 @@ def _deformable_bodies(setup: Setup) -> list:
     return sorted(set(np.unique(setup.state.body).tolist()) - rigid)
 
 
-def _validate(method, dim, dp, setup_numerics=None, t_end=None, dt=None):
-    if method not in METHODS:
+def _validate(method, dim, dp, setup_numerics=None, t_end=None, dt=None, custom: bool = False):
+    if method not in METHODS and not custom:
         raise ValueError(f"unknown method {method!r}; choose one of {', '.join(METHODS)}")
     if dim not in (2, 3):
         raise ValueError(f"dim must be 2 or 3, got {dim!r}")
@@ -155,18 +175,18 @@ def _as_dict(obj) -> dict:
 
 class RunRecord:
     """What a run leaves: ``summary`` (summary.json), ``history`` (the recorded scalars), snapshots and the
-    reaction-force CSV in ``out`` (None: nothing is written)."""
+    reaction-force CSV in ``out`` (None: nothing is written). ``parts``: the run's parts that keep records of their
+    own (:class:`RunParts`)."""
 
-    def __init__(self, setup: Setup, solver: Solver, out, dt, name: str, record: Callable | None, times,
+    def __init__(self, setup: Setup, parts: "RunParts", out, dt, name: str, record: Callable | None, times,
                  resume: dict | None = None):
-        self.setup, self.solver, self.record_fn = setup, solver, record
+        self.setup, self.parts, self.solver, self.record_fn = setup, parts, parts.solver, record
         self.out = Path(out) if out is not None else None
         self.history: dict[str, list] = {}
         self.snapshots: list[str] = []
         self.times, self.next_snap = times, 0
         self.n_steps, self.dts, self.record_every = 0, [], 1
         self.t0, self.c0 = time.perf_counter(), time.process_time()
-        self.heat = None if setup.thermal is None else dict(plastic=0.0, friction=0.0, lost=0.0, removed=0.0)
         if resume is not None:
             self._resume(resume)
         if self.out is not None:
@@ -174,7 +194,7 @@ class RunRecord:
             for old in (self.out / "snapshots").glob("*.npz"):
                 if old.name not in self.snapshots and old.name != CHECKPOINT:
                     old.unlink()
-        self.summary = self._initial_summary(setup, solver, dt, name)
+        self.summary = self._initial_summary(setup, parts.solver, dt, name)
         if resume is not None:
             self.summary["restarts"] = int(resume["run"]["restarts"]) + 1
 
@@ -187,24 +207,20 @@ class RunRecord:
         self.dts = list(np.asarray(ck["dts"], dtype=float))
         self.t0 -= float(r["wall_time_s"])
         self.c0 -= float(r["cpu_time_s"])
-        if self.heat is not None:
-            self.heat = {k: float(v) for k, v in r["heat"].items()}
 
     def checkpoint(self, snapshot: str) -> None:
         """``snapshots/restart.npz``: what :func:`simulate` needs to continue from snapshot ``snapshot`` exactly as
-        the uninterrupted run (the solver's own state, the history, the counters), written atomically."""
-        if self.out is None or not hasattr(self.solver, "checkpoint"):
+        the uninterrupted run (the parts' own states, the history, the counters), written atomically."""
+        if self.out is None:
             return
         run = dict(snapshot=snapshot, history={k: v for k, v in self.history.items() if k != "reaction"},
                    snapshots=self.snapshots, next_snap=self.next_snap, n_steps=self.n_steps,
                    record_every=self.record_every, wall_time_s=time.perf_counter() - self.t0,
-                   cpu_time_s=time.process_time() - self.c0, restarts=self.summary.get("restarts", 0),
-                   heat=self.heat)
-        arrays = {f"solver/{k}": v for k, v in self.solver.checkpoint().items()}
-        arrays.update({f"stepper/{k}": v for k, v in (getattr(self.solver, "stepper_state", None) or {}).items()})
+                   cpu_time_s=time.process_time() - self.c0, restarts=self.summary.get("restarts", 0))
         path = self.out / "snapshots" / CHECKPOINT
         tmp = path.with_name("restart.tmp.npz")
-        np.savez(tmp, run=json.dumps(json_ready(run)), dts=np.asarray(self.dts, dtype=float), **arrays)
+        np.savez(tmp, run=json.dumps(json_ready(run)), dts=np.asarray(self.dts, dtype=float),
+                 **self.parts.checkpoint())
         os.replace(tmp, path)
 
     def _initial_summary(self, setup: Setup, solver: Solver, dt, name: str) -> dict:
@@ -213,7 +229,8 @@ class RunRecord:
             scene=name, method=solver.method, dim=state.dim, dp=setup.dp, h=setup.h, n_particles=state.n,
             t_end=setup.t_end, n_steps=0, dt_mode="fixed" if dt is not None else "cfl",
             courant=setup.numerics.courant, numerics=dataclasses.asdict(setup.numerics), threads=solver.threads,
-            material=dataclasses.asdict(setup.material), strength=_as_dict(setup.strength), heating=setup.heating,
+            material=dataclasses.asdict(setup.material), strength=_as_dict(setup.strength),
+            heating=heats(setup.strength),
             boundaries=dict(symmetry_axes=list(setup.mirror.axes) if setup.mirror is not None else [],
                             walls=[dataclasses.asdict(w) for w in setup.walls],
                             rigid_bodies=[dataclasses.asdict(b) for b in setup.rigid],
@@ -221,38 +238,14 @@ class RunRecord:
                             friction=(dataclasses.asdict(setup.friction) if setup.friction is not None else None)),
             scene_info=setup.info, snapshot_times=[float(t) for t in self.times], refsph_version=__version__,
             provenance=provenance(solver.threads), status="running", metrics={},
-            **({"thermal": json_ready(dataclasses.asdict(setup.thermal))} if setup.thermal is not None else {}))
+            **{p.name: json_ready(p.describe()) for p in self.parts.physics if hasattr(p, "describe")})
 
     def record(self, state: State) -> None:
-        if self.record_fn is not None:
-            for k, val in self.record_fn(state, self.setup).items():
-                self.history.setdefault(k, []).append(val)
-        if self.heat is not None:
-            for k, val in self.heat_balance(state).items():
-                self.history.setdefault(f"heat_{k}", []).append(val)
-
-    def heat_capacity(self, state: State) -> np.ndarray:
-        """m c per row [J/K] (the conducting model's c; rigid rows that do not conduct: their cp, never heated)."""
-        rigid = [b.body for b in self.setup.rigid]
-        return state.m * self.setup.thermal.coefficients(state.body, state.n, rigid)[1]
-
-    def add_heat(self, before: State, after: State, moved: dict) -> None:
-        """Add one step to the heat ledger: the plastic heat is what the mechanical step added to the
-        temperatures (the return map, Eq. (28)); ``moved``: the heat :func:`refsph.thermal.thermal_step` moved."""
-        self.heat["plastic"] += float(np.sum(self.heat_capacity(after) * (after.T - before.T)))
-        for k in ("friction", "lost", "removed"):
-            self.heat[k] += moved[k]
-
-    def heat_balance(self, state: State) -> dict:
-        """The heat ledger [J; per metre of thickness in 2D]: made (plastic, friction), stored (sum m c (T - T0)),
-        lost (surface), removed (at fixed temperatures), and the residual made - stored - lost - removed."""
-        stored = float(np.sum(self.heat_capacity(state) * (state.T - self.setup.state.T)))
-        h = self.heat
-        made = h["plastic"] + h["friction"]
-        residual = made - stored - h["lost"] - h["removed"]
-        return dict(plastic_J=h["plastic"], friction_J=h["friction"], stored_J=stored, lost_J=h["lost"],
-                    removed_J=h["removed"], residual_J=residual,
-                    residual_rel=residual / made if made > 0 else 0.0)
+        values = self.record_fn(state, self.setup) if self.record_fn is not None else {}
+        for p in self.parts.physics:
+            values = dict(values, **p.record(state))
+        for k, val in values.items():
+            self.history.setdefault(k, []).append(val)
 
     def save(self, name: str, state: State) -> Path:
         path = self.out / "snapshots" / name
@@ -288,8 +281,8 @@ class RunRecord:
             dt_min=float(min(dts)) if dts else None, dt_max=float(max(dts)) if dts else None,
             particle_steps_per_s=state.n * self.n_steps / wall if wall > 0 else None,
             snapshots=list(self.snapshots), diagnostics=self.solver.diagnostics())
-        if self.heat is not None:
-            self.summary["heat_balance"] = self.heat_balance(state)
+        for p in self.parts.physics:
+            self.summary.update(p.summary(state))
         reactions = self.solver.reaction_history()
         if reactions:
             self.history["reaction"] = reactions
@@ -313,31 +306,60 @@ class RunRecord:
             write_json(self.out / "summary.json", self.summary)
 
 
-def step_or_fail(state: State, solver: Solver, dt: float, rec: RunRecord, step=None) -> State:
-    """One step (``step``: the stepper, default the setup's integrator), or a :class:`SimulationError` that
-    names the step, the time and (for a non-finite state) the field and particle, after writing the last good
-    state."""
-    step = step or get_stepper(rec.setup.numerics.integrator)
+@dataclass
+class RunParts:
+    """What a run is made of, each keeping its own state: the method (``solver``), its ``stepper`` and the
+    ``physics`` beside the mechanics. Their restart arrays are kept apart by prefix (``solver/``, ``stepper/``,
+    ``physics/NAME/``)."""
+
+    solver: Solver | SelfAdvancing
+    stepper: Stepper
+    physics: list
+
+    def bind(self, state: State) -> None:
+        for p in self.physics:
+            p.bind(state, self.solver)
+
+    def checkpoint(self) -> dict:
+        arrays = {f"solver/{k}": v for k, v in self.solver.checkpoint().items()}
+        arrays.update({f"stepper/{k}": v for k, v in self.stepper.checkpoint().items()})
+        for p in self.physics:
+            arrays.update({f"physics/{p.name}/{k}": v for k, v in p.checkpoint().items()})
+        return arrays
+
+    def restore(self, arrays: dict, state: State) -> None:
+        def part(prefix):
+            return {k[len(prefix):]: v for k, v in arrays.items() if k.startswith(prefix)}
+        self.solver.restore(part("solver/"), state)
+        self.stepper.restore(part("stepper/"))
+        for p in self.physics:
+            p.restore(part(f"physics/{p.name}/"))
+
+
+def step_or_fail(state: State, parts: RunParts, dt: float, rec: RunRecord) -> Step:
+    """One step of the method (its stepper), or a :class:`SimulationError` that names the step, the time and (for a
+    non-finite state) the field and particle, after writing the last good state."""
     try:
         with np.errstate(divide="ignore", invalid="ignore", over="ignore"):     # non-finite: caught below
-            new = step(state, solver, dt)
+            step = parts.stepper.step(state, parts.solver, dt)
     except ValueError as e:                                 # e.g. a particle crossed a symmetry plane
         raise rec.fail("error", f"step {rec.n_steps + 1} (t = {state.t:.6e} s) failed: {e}", state) from e
     rec.n_steps += 1
+    new = step.state
     if not (np.isfinite(new.v).all() and np.isfinite(new.x).all()):
         bad = new.first_nonfinite() or ("x/v", -1)
         raise rec.fail("nan", f"non-finite {bad[0]} at particle {bad[1]} in step {rec.n_steps} "
                               f"(t = {state.t:.6e} s -> {new.t:.6e} s)", state)
-    return new
+    return step
 
 
-def _time_step(setup: Setup, dt: float | None, state: State) -> float:
-    """The fixed dt, or the CFL step (and with heat conduction no more than its limit, refsph.thermal)."""
+def _time_step(setup: Setup, dt: float | None, state: State, physics=()) -> float:
+    """The fixed dt, or the CFL step (and no more than each physics' limit, e.g. heat conduction's)."""
     if dt is not None:
         return dt
     step = cfl_time_step(state, setup.material, setup.h, setup.numerics.courant)
-    if setup.thermal is not None:
-        step = min(step, thermal_step_limit(state, setup.thermal, setup.h, [b.body for b in setup.rigid]))
+    for p in physics:
+        step = min(step, p.step_limit(state))
     return step
 
 
@@ -365,9 +387,9 @@ class _Progress:
             self.last = now
 
 
-def _begin(setup: Setup, solver: Solver, out, dt, name: str, record, record_every, restart: bool):
+def _begin(setup: Setup, parts: RunParts, out, dt, name: str, record, record_every, restart: bool):
     """The initial record: a fresh start (the setup's state, recorded and written at t = 0), or with ``restart``
-    the checkpoint of the run folder ``out`` (its snapshot, the history and counters, the solver's own state)."""
+    the checkpoint of the run folder ``out`` (its snapshot, the history and counters, the parts' own states)."""
     if restart:
         if out is None:
             raise ValueError("restart needs the run folder (out=...)")
@@ -379,22 +401,38 @@ def _begin(setup: Setup, solver: Solver, out, dt, name: str, record, record_ever
             ck = {k: z[k] for k in z.files}
         run_ck = json.loads(str(ck["run"]))
         state = state_from_snapshot(Path(out) / "snapshots" / run_ck["snapshot"])
-        solver.restore({k[len("solver/"):]: v for k, v in ck.items() if k.startswith("solver/")}, state)
-        kept = {k[len("stepper/"):]: v for k, v in ck.items() if k.startswith("stepper/")}
-        if kept:                                            # the leapfrog's last force (refsph.integrate)
-            solver.stepper_state = kept
-        rec = RunRecord(setup, solver, out, dt, name, record, snapshot_times(setup),
+        parts.bind(setup.state)                             # (the initial temperatures of the heat ledger)
+        if run_ck.get("heat") and not any(k.startswith("physics/") for k in ck):
+            ck.update({f"physics/heat/{k}": v for k, v in run_ck["heat"].items()})   # a checkpoint before RunParts
+        parts.restore(ck, state)
+        rec = RunRecord(setup, parts, out, dt, name, record, snapshot_times(setup),
                         resume=dict(run=run_ck, dts=ck["dts"]))
         return state, rec
     state = setup.state.copy()
     state.check()
-    solver.check_state(state)
-    rec = RunRecord(setup, solver, out, dt, name, record, snapshot_times(setup))
-    rec.record_every = record_every or max(1, int(setup.t_end / _time_step(setup, dt, state) / 400))
+    parts.solver.check_state(state)
+    parts.bind(state)
+    rec = RunRecord(setup, parts, out, dt, name, record, snapshot_times(setup))
+    rec.record_every = record_every or max(1, int(setup.t_end / _time_step(setup, dt, state, parts.physics) / 400))
     _warn_fixed_dt(setup, dt, state)
     rec.record(state)
     rec.snapshot_if_due(state)
     return state, rec
+
+
+def _check_method(solver) -> None:
+    """A method of one's own is refused before the first step if its members do not fit the loop: a
+    :class:`Solver` whose ``rates`` does not take ``part`` (every stepper passes it), or neither protocol."""
+    if isinstance(solver, Solver):
+        try:
+            inspect.signature(solver.rates).bind(solver, 0.0, part=PARTS[0])
+        except TypeError as e:
+            raise TypeError(f"{type(solver).__name__}.rates must take (state, dt, part='all'): the steppers pass "
+                            f"part= (refsph.integrate.PARTS); {e}") from None
+        except ValueError:                                  # no signature to read (a builtin): trust it
+            pass
+    elif not isinstance(solver, SelfAdvancing):
+        raise TypeError(f"{type(solver).__name__} is neither a refsph.integrate.Solver nor a SelfAdvancing method")
 
 
 def simulate(setup: Setup, method: str | None = None, *, scene: Scene | None = None,
@@ -404,58 +442,40 @@ def simulate(setup: Setup, method: str | None = None, *, scene: Scene | None = N
              progress: bool = True, label: str = "", record_every: int | None = None, restart: bool = False,
              meta: dict | None = None) -> RunResult:
     """Run a prepared setup with ``method`` ('esph' | 'tlsph'), or with a ``solver`` of one's own (any
-    :class:`~refsph.integrate.Solver`, e.g. one that wraps ``make_solver(method, setup)`` to add a force).
+    :class:`~refsph.integrate.Solver`, e.g. one that wraps ``make_solver(method, setup)`` to add a force, or a
+    :class:`~refsph.integrate.SelfAdvancing` method, e.g. an implicit one).
 
     ``record(state, setup) -> dict`` of scalars is called on the initial state, every ``record_every`` steps
     (default: about 400 records per run) and on the final state; the lists it builds are the ``history``, which
     ``metrics(history, state, setup) -> dict`` turns into ``summary['metrics']``. ``scene``: take both (and the
     name) from a :class:`~refsph.scenes.Scene`. ``hook(state, solver)`` is called after every step (after the
-    solver's after-step work: TLSPH's density is that of the positions before the hook) and may return a changed
-    state (prescribed kinematics). ``dt=None``: the CFL step every step; else a fixed ``dt``.
-    ``out``: the run folder (summary.json, snapshots/, reaction_forces.csv), None: nothing written. The step before
-    each snapshot time is shortened to land on it, so snapshots are at their nominal times (to round-off).
-    With ``out``, every snapshot also writes ``snapshots/restart.npz``; ``restart=True`` continues the run in
-    ``out`` from there (same setup, solver and callbacks), and gives the same bits as the uninterrupted run.
+    solver's after-step work and the physics beside it: TLSPH's density is that of the positions before the hook)
+    and may return a changed state (prescribed kinematics). ``dt=None``: the CFL step every step; else a fixed
+    ``dt``. ``out``: the run folder (summary.json, snapshots/, reaction_forces.csv), None: nothing written. The
+    step before each snapshot time is shortened to land on it, so snapshots are at their nominal times (to
+    round-off). With ``out``, every snapshot also writes ``snapshots/restart.npz``; ``restart=True`` continues the
+    run in ``out`` from there (same setup, solver and callbacks), and gives the same bits as the uninterrupted run.
     ``meta``: extra entries for summary.json."""
     if solver is not None and method is not None and method != solver.method:
         raise ValueError(f"method {method!r} does not match the solver's ({solver.method!r}); give one of them")
     method = method if solver is None else solver.method
-    _validate(method, setup.state.dim, setup.dp, setup.numerics, setup.t_end, dt)
-    if setup.thermal is not None and setup.state.T is None:
-        raise ValueError("heat conduction (Setup.thermal) needs temperatures: make_state(..., T0=...)")
+    _validate(method, setup.state.dim, setup.dp, setup.numerics, setup.t_end, dt, custom=solver is not None)
     record = record or (scene.record if scene is not None else None)
     metrics = metrics or (scene.metrics if scene is not None else None)
     solver = solver if solver is not None else make_solver(method, setup)
-    stepper = get_stepper(setup.numerics.integrator)
+    _check_method(solver)
+    parts = RunParts(solver, make_stepper(setup.numerics.integrator, solver), step_physics(setup))
     name = scene.name if scene is not None else label
     for message in warnings_for(scene.name if scene is not None else None, method, setup.numerics):
         warnings.warn(message, UserWarning, stacklevel=2)
-    state, rec = _begin(setup, solver, out, dt, name, record, record_every, restart)
+    state, rec = _begin(setup, parts, out, dt, name, record, record_every, restart)
     rec.summary.update(meta or {})
-    record_every = rec.record_every
     show = _Progress(label or f"{name} {method} {state.dim}D", setup.t_end, progress)
-    kernel, rigid_ids = get_kernel(setup.numerics.kernel), [b.body for b in setup.rigid]
     try:
         while state.t < setup.t_end * (1 - 1e-12):
-            step_dt = _time_step(setup, dt, state)
-            rec.dts.append(step_dt)                         # the step size chosen (before any cut to land on time)
-            step_dt = min(step_dt, rec.next_output_time() - state.t)   # snapshots land on their nominal times
-            prev, state = state, step_or_fail(state, solver, step_dt, rec, stepper)
-            if setup.thermal is not None:                   # heat conduction, after the mechanical step
-                T, moved = thermal_step(state, setup.thermal, setup.h, kernel, step_dt, rigid_ids,
-                                        getattr(solver, "friction_power", None))
-                rec.add_heat(prev, state, moved)
-                state.T = T
-            if hook is not None:
-                state = hook(state, solver) or state
-                if not (np.isfinite(state.v).all() and np.isfinite(state.x).all()):
-                    raise rec.fail("nan", f"the hook made the state non-finite after step {rec.n_steps}", prev)
-            if rec.n_steps % record_every == 0:
-                with np.errstate(over="ignore", invalid="ignore"):  # near-blow-up states are caught above
-                    rec.record(state)
-            rec.snapshot_if_due(state)
-            show(rec.n_steps, state.t, step_dt)
-        if rec.n_steps % record_every != 0:
+            state = _one_step(setup, parts, rec, state, dt, hook)
+            show(rec.n_steps, state.t, rec.dts[-1])
+        if rec.n_steps % rec.record_every != 0:
             rec.record(state)
         rec.summary["status"] = "ok"
     except KeyboardInterrupt:
@@ -468,6 +488,27 @@ def simulate(setup: Setup, method: str | None = None, *, scene: Scene | None = N
     finally:
         rec.finish(state, metrics)
     return RunResult(summary=rec.summary, state=state, history=rec.history, setup=setup)
+
+
+def _one_step(setup: Setup, parts: RunParts, rec: RunRecord, state: State, dt: float | None, hook) -> State:
+    """The step size (the CFL step, the physics' limits, the next snapshot time), the mechanical step, each
+    physics after it, the hook, then the record and the snapshots that are due."""
+    step_dt = _time_step(setup, dt, state, parts.physics)
+    rec.dts.append(step_dt)                                 # the step size chosen (before any cut to land on time)
+    step_dt = min(step_dt, rec.next_output_time() - state.t)   # snapshots land on their nominal times
+    prev, step = state, step_or_fail(state, parts, step_dt, rec)
+    state = step.state
+    for p in parts.physics:                                 # heat after the mechanical step
+        state = p.advance(prev, Step(state, step.rates), step_dt)
+    if hook is not None:
+        state = hook(state, parts.solver) or state
+        if not (np.isfinite(state.v).all() and np.isfinite(state.x).all()):
+            raise rec.fail("nan", f"the hook made the state non-finite after step {rec.n_steps}", prev)
+    if rec.n_steps % rec.record_every == 0:
+        with np.errstate(over="ignore", invalid="ignore"):  # near-blow-up states are caught above
+            rec.record(state)
+    rec.snapshot_if_due(state)
+    return state
 
 
 def run(scene_name: str, method: str, *, dim: int | None = None, dp: float | None = None,

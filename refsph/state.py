@@ -141,7 +141,9 @@ class State:
 class Rates:
     """Time derivatives of the evolved fields of a :class:`State` (same shapes). ``rho`` is None where density is not
     integrated (TLSPH, Eq. (2)); ``l`` is the velocity gradient the stress rate came from (the strength model takes
-    its strain rate from it)."""
+    its strain rate from it). ``friction_power``: (N,) the friction power |f_t| |v_t| [W; 2D: W/m] each row takes
+    part in at this evaluation (the tool contact's, :mod:`refsph.contact`; None: no friction), the source of the
+    frictional heat (:class:`refsph.thermal.HeatFlow`)."""
 
     x: np.ndarray
     v: np.ndarray
@@ -149,11 +151,14 @@ class Rates:
     S: np.ndarray
     S_zz: np.ndarray
     l: np.ndarray | None = None
+    friction_power: np.ndarray | None = None
 
     def rows(self, n: int) -> "Rates":
         """The rates of the first n rows (the real particles of a real + ghost evaluation)."""
-        return Rates(x=self.x[:n], v=self.v[:n], rho=None if self.rho is None else self.rho[:n], S=self.S[:n],
-                     S_zz=self.S_zz[:n], l=None if self.l is None else self.l[:n])
+        def first(a):
+            return None if a is None else a[:n]
+        return Rates(x=self.x[:n], v=self.v[:n], rho=first(self.rho), S=self.S[:n], S_zz=self.S_zz[:n],
+                     l=first(self.l), friction_power=first(self.friction_power))
 
 
 def make_state(x: np.ndarray, v: np.ndarray, rho0: float, volume: np.ndarray | float,

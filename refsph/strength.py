@@ -8,7 +8,8 @@ A strength model is any object with
     return_map(S, S_zz, eps_p, eps_dot, T, G)     -> (S_n, S_zz_n, d_eps_p, d_w_p): the trial deviatoric stress
                                                   returned to the law's admissible set, the plastic strain and
                                                   plastic work density of the step
-    heat(d_w_p, rho)                              -> d_T, the temperature rise of that plastic work (Eq. (28))
+    heat(d_w_p, rho)                              -> d_T, the temperature rise of that plastic work (Eq. (28));
+                                                  zero for a law whose ``heating`` switch is off (isothermal)
 
 The solvers know nothing else of the law: at the end of every stage of a step they call :func:`strength_stage`,
 which calls :func:`plastic_update`, which calls the model. The laws refsph ships:
@@ -20,7 +21,9 @@ which calls :func:`plastic_update`, which calls the model. The laws refsph ships
 
 Adding a law is one class in one file: a von Mises law subclasses ``J2Plasticity`` and gives its flow stress
 ``flow_stress(eps_p, eps_dot, T)`` (and ``chi``, ``cp`` for its heating); any other law implements the three
-members above. ``tests/test_strength.py`` adds a linear-hardening law that way, in the test file alone.
+members above. Whether plastic work heats is the law's own switch (``JohnsonCook(..., heating=False)``:
+isothermal, the plastic work still accumulated), read by :func:`heats`. ``tests/test_strength.py`` adds a
+linear-hardening law that way, in the test file alone.
 """
 from __future__ import annotations
 
@@ -31,7 +34,8 @@ import numpy as np
 from .plasticity import equivalent_strain_rate
 from .state import PLASTIC_FIELDS, State
 
-__all__ = ["StrengthModel", "Elastic", "plastic_update", "strength_stage", "PLASTIC_FIELDS"]
+__all__ = ["StrengthModel", "Elastic", "plastic_update", "strength_stage", "heats", "heat_capacity",
+           "PLASTIC_FIELDS"]
 
 
 @runtime_checkable
@@ -47,9 +51,16 @@ class StrengthModel(Protocol):
 
 
 class Elastic:
-    """Hypoelastic solid (Eqs. (20)-(24) alone): the trial stress is the stress, nothing plastic happens."""
+    """Hypoelastic solid (Eqs. (20)-(24) alone): the trial stress is the stress, nothing plastic happens. ``cp``
+    [J/(kg K)]: its heat capacity, needed only when the run conducts heat (None: not given)."""
 
     state_fields: tuple = ()
+    heating = False
+
+    def __init__(self, cp: float | None = None):
+        if cp is not None and not (np.isfinite(cp) and cp > 0):
+            raise ValueError(f"Elastic(cp=...) must be a positive heat capacity [J/(kg K)], got {cp!r}")
+        self.cp = cp
 
     def return_map(self, S, S_zz, eps_p, eps_dot, T, G):
         zero = np.zeros(len(S))
@@ -59,19 +70,31 @@ class Elastic:
         return np.zeros_like(d_w_p)
 
     def __repr__(self) -> str:
-        return "Elastic()"
+        return "Elastic()" if self.cp is None else f"Elastic(cp={self.cp!r})"
+
+
+def heats(model: StrengthModel) -> bool:
+    """Whether the law turns plastic work into heat (Eq. (28)): its ``heating`` switch (False for an elastic
+    solid; True for a law that does not say)."""
+    return bool(getattr(model, "heating", True)) and bool(model.state_fields)
+
+
+def heat_capacity(model: StrengthModel) -> float | None:
+    """The law's heat capacity c_p [J/(kg K)] (None if it gives none): the one number the plastic heating
+    (Eq. (28)) and heat conduction (:mod:`refsph.thermal`) use."""
+    return getattr(model, "cp", None)
 
 
 def plastic_update(S: np.ndarray, S_zz: np.ndarray, eps_p: np.ndarray, T: np.ndarray, rho: np.ndarray,
-                   eps_dot: np.ndarray, model: StrengthModel, G: float, heating: bool = True):
+                   eps_dot: np.ndarray, model: StrengthModel, G: float):
     """One return map at the end of a step (for Johnson-Cook: Eqs. (25)-(31)).
 
     S, S_zz: trial deviatoric stress (the elastic update); eps_p, T: values at the start of the step; rho:
     density; eps_dot: equivalent strain rate of the step. The flow stress is evaluated with the start-of-step
-    eps_p and T (explicit, as in the paper). Returns (S_n, S_zz_n, d_eps_p, d_w_p, d_T); d_T is zero if
-    ``heating`` is False (isothermal: the plastic work is still accumulated)."""
+    eps_p and T (explicit, as in the paper). Returns (S_n, S_zz_n, d_eps_p, d_w_p, d_T); d_T is zero for a law
+    whose heating is off (isothermal: the plastic work is still accumulated)."""
     S_n, S_zz_n, deps, dw = model.return_map(S, S_zz, eps_p, eps_dot, T, G)
-    dT = model.heat(dw, rho) if heating else np.zeros_like(dw)
+    dT = model.heat(dw, rho)
     return S_n, S_zz_n, deps, dw, dT
 
 
@@ -84,7 +107,7 @@ def check_strength_fields(model: StrengthModel, state: State) -> None:
 
 
 def strength_stage(model: StrengthModel, old: State, new: State, l: np.ndarray, rho: np.ndarray, dt: float,
-                   final: bool, G: float, heating: bool) -> State:
+                   final: bool, G: float) -> State:
     """The return map on the state a stage of the step produced (``new``, in place), with the stage's velocity
     gradient ``l`` (its equivalent strain rate enters the flow stress) and the start-of-step plastic fields of
     ``old``. Only the final stage accumulates eps_p, W_p and T; an intermediate stage (the predictor's half
@@ -93,7 +116,7 @@ def strength_stage(model: StrengthModel, old: State, new: State, l: np.ndarray, 
         return new
     check_strength_fields(model, old)
     eps_dot = equivalent_strain_rate(l)
-    S, S_zz, deps, dw, dT = plastic_update(new.S, new.S_zz, old.eps_p, old.T, rho, eps_dot, model, G, heating)
+    S, S_zz, deps, dw, dT = plastic_update(new.S, new.S_zz, old.eps_p, old.T, rho, eps_dot, model, G)
     new.S, new.S_zz = S, S_zz
     if final and old.plastic:                  # a law without plastic fields (state_fields = ()) keeps none
         new.eps_p = old.eps_p + deps

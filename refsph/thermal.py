@@ -29,7 +29,8 @@ The sources and sinks of a cutting run (:func:`thermal_step`, one explicit step 
 * **plastic heat** chi sigma_y epsdot_p (their Eq. (5)): added by the return map of the strength model
   (:mod:`refsph.plasticity`, Eq. (28) of the first paper), as in the adiabatic runs;
 * **frictional heat** q = eta |f_fric| |v_rel| (their Eq. (7)), from the friction power of each contact pair
-  (:mod:`refsph.contact`), split by :class:`FrictionHeat`: a fraction ``chip_fraction`` to the workpiece particle
+  (:mod:`refsph.contact`; it reaches the heat flow as ``Rates.friction_power`` of the step), split by
+  :class:`FrictionHeat`: a fraction ``chip_fraction`` to the workpiece particle
   of the pair, the rest to the tool particle. The second paper does not say how it splits; the heat is made at
   the interface and conduction across it (harmonic-mean k, above) moves it to wherever the temperatures send it,
   so the split only places the source; 1/2 is the neutral choice (Blok's partition would need the contact
@@ -38,8 +39,18 @@ The sources and sinks of a cutting run (:func:`thermal_step`, one explicit step 
   (:mod:`refsph.surface`: the SPH detector or the alpha-shape);
 * **fixed temperatures** (Dirichlet rows): the heat the reset removes is counted.
 
-:func:`thermal_step` returns the heat of each kind it moved in the step, so a run can keep the balance
-plastic + friction = stored + lost + removed at fixed rows (``summary.json``'s ``heat_balance``).
+:func:`thermal_step` returns the heat of each kind it moved in the step. In a run, :class:`HeatFlow` is the
+run loop's heat physics (:class:`refsph.integrate.StepPhysics`): its step limit, its step after the mechanical one,
+and the heat ledger, which checks
+
+    plastic + friction = stored + lost + removed at fixed rows      (``summary.json``'s ``heat_balance``)
+
+with the plastic heat counted independently of the temperatures the return map changed: chi sum_i m_i dW_p,i /
+rho_i (Eq. (28) summed; W_p the plastic work density), and the stored heat sum_i m_i c_p (T_i - T_i(0)). A wrong chi
+or c_p in the heating, or heat made or lost anywhere else, shows as a residual.
+
+The heat capacity c_p of the deformable body is the strength model's (``JohnsonCook.cp``, ``Elastic(cp=...)``): one
+place for the number that both the plastic heating (Eq. (28)) and conduction (Eq. (29)) use.
 """
 from __future__ import annotations
 
@@ -52,7 +63,8 @@ from .neighbours import PairSum, find_pairs
 from .surface import surface_alpha_shape, surface_sph
 
 __all__ = ["laplacian", "conduction_rate", "thermal_time_step", "advance_at_rest", "Conduction", "SurfaceLoss",
-           "FrictionHeat", "conduct", "thermal_step", "thermal_step_limit", "free_surface", "STEFAN_BOLTZMANN"]
+           "FrictionHeat", "HeatFlow", "coefficients", "conduct", "thermal_step", "thermal_step_limit",
+           "free_surface", "STEFAN_BOLTZMANN"]
 
 
 def laplacian(f: np.ndarray, x: np.ndarray, V: np.ndarray, h: float, kernel: Kernel,
@@ -135,7 +147,8 @@ class SurfaceLoss:
 class FrictionHeat:
     """The frictional heat of the second paper's Eq. (7), q = ``eta`` |f_fric| |v_rel| (eta: the fraction of the
     friction work that becomes heat, 1 in their Table A3), a fraction ``chip_fraction`` of it into the
-    deformable particle of each contact pair, the rest into the tool particle (module text). No defaults."""
+    deformable particle of each contact pair, the rest into the tool particle (module text). No defaults.
+    ``Setup.friction_heat``; it needs no conduction (without it the heat stays where it is made)."""
 
     eta: float
     chip_fraction: float
@@ -149,45 +162,50 @@ class FrictionHeat:
 
 @dataclass(frozen=True)
 class Conduction:
-    """Heat conduction during a run (``Setup.thermal``). ``k`` [W/(m K)] and ``cp`` [J/(kg K)]: the deformable
-    bodies'; ``courant``: the factor on rho c_p h^2 / k; ``tools``: {body id: (k, cp)} of the rigid bodies that
-    conduct (the others insulate); ``fixed``: particle indices held at ``T_fixed`` [K] (a fixed surface at room
-    temperature); ``loss``: convection and radiation on the free surfaces (:class:`SurfaceLoss`; None: none);
-    ``friction_heat``: where the friction work goes (:class:`FrictionHeat`; None: friction makes no heat)."""
+    """Heat conduction during a run (``Setup.thermal``). ``k`` [W/(m K)]: the deformable bodies' conductivity (their
+    heat capacity is the strength model's ``cp``); ``courant``: the factor on rho c_p h^2 / k; ``tools``: {body id:
+    (k, cp)} of the rigid bodies that conduct (the others insulate); ``fixed``: particle indices held at
+    ``T_fixed`` [K] (a fixed surface at room temperature); ``loss``: convection and radiation on the free surfaces
+    (:class:`SurfaceLoss`; None: none)."""
 
     k: float
-    cp: float
     courant: float
     tools: dict = field(default_factory=dict)
     fixed: tuple = ()
     T_fixed: float | None = None
     loss: SurfaceLoss | None = None
-    friction_heat: FrictionHeat | None = None
 
     def __post_init__(self):
-        for name in ("k", "cp", "courant"):
+        for name in ("k", "courant"):
             v = getattr(self, name)
             if not (np.isfinite(v) and v > 0):
                 raise ValueError(f"Conduction.{name} must be positive, got {v!r}")
         if len(self.fixed) and self.T_fixed is None:
             raise ValueError("Conduction.fixed needs T_fixed (the temperature the fixed particles are held at)")
 
-    def coefficients(self, body: np.ndarray | None, n: int, rigid_ids=()) -> tuple[np.ndarray, np.ndarray]:
-        """Per-particle conductivity and heat capacity: deformable rows k, cp; the rows of a conducting tool its
-        own; the rows of the other rigid bodies ``rigid_ids`` insulate (k = 0)."""
-        k, c = np.full(n, float(self.k)), np.full(n, float(self.cp))
-        if body is not None:
-            for b, (kb, cb) in self.tools.items():
-                k[body == b], c[body == b] = kb, cb
-            k[np.isin(body, [b for b in rigid_ids if b not in self.tools])] = 0.0
-        return k, c
+
+def coefficients(model: Conduction | None, cp: float, body: np.ndarray | None, n: int,
+                 rigid_ids=()) -> tuple[np.ndarray, np.ndarray]:
+    """Per-particle conductivity and heat capacity: deformable rows ``model.k`` and ``cp`` (the strength model's);
+    the rows of a conducting tool its own; the rows of the other rigid bodies ``rigid_ids`` insulate (k = 0), as
+    does every row without conduction (``model`` None)."""
+    k, c = np.full(n, float(model.k) if model is not None else 0.0), np.full(n, float(cp))
+    if body is not None and model is not None:
+        for b, (kb, cb) in model.tools.items():
+            k[body == b], c[body == b] = kb, cb
+        k[np.isin(body, [b for b in rigid_ids if b not in model.tools])] = 0.0
+    return k, c
 
 
-def thermal_step_limit(state, model: Conduction, h: float, rigid_ids=()) -> float:
+def thermal_step_limit(state, model: Conduction, h: float, cp: float, rigid_ids=()) -> float:
     """courant * min_i rho_i c_i h^2 / k_i over the conducting particles."""
-    k, c = model.coefficients(state.body, state.n, rigid_ids)
+    k, c = coefficients(model, cp, state.body, state.n, rigid_ids)
+    return _step_limit(state.rho, k, c, h, model.courant)
+
+
+def _step_limit(rho: np.ndarray, k: np.ndarray, c: np.ndarray, h: float, courant: float) -> float:
     on = k > 0
-    return float(model.courant * np.min(state.rho[on] * c[on] * h * h / k[on])) if np.any(on) else np.inf
+    return float(courant * np.min(rho[on] * c[on] * h * h / k[on])) if np.any(on) else np.inf
 
 
 def free_surface(x: np.ndarray, V: np.ndarray, h: float, kernel: Kernel, loss: SurfaceLoss,
@@ -199,45 +217,147 @@ def free_surface(x: np.ndarray, V: np.ndarray, h: float, kernel: Kernel, loss: S
     return surface_sph(x, V, h, kernel, pairs=pairs)
 
 
-def conduct(state, model: Conduction, h: float, kernel: Kernel, dt: float, rigid_ids=()) -> np.ndarray:
+def conduct(state, model: Conduction, h: float, kernel: Kernel, dt: float, cp: float, rigid_ids=()) -> np.ndarray:
     """The temperatures after an explicit conduction step of dt (module text), fixed particles reset: the
     temperatures of :func:`thermal_step` without frictional heat."""
-    return thermal_step(state, model, h, kernel, dt, rigid_ids)[0]
+    k, c = coefficients(model, cp, state.body, state.n, rigid_ids)
+    return thermal_step(state, model, k, c, h, kernel, dt)[0]
 
 
-def thermal_step(state, model: Conduction, h: float, kernel: Kernel, dt: float, rigid_ids=(),
-                 friction_power: tuple | None = None) -> tuple[np.ndarray, dict]:
-    """One explicit step dt of Eq. (29) with the harmonic-mean conductivity between materials (module text),
-    the frictional heat (``friction_power``: (deformable rows, rigid rows) [W], as the TLSPH contact leaves it;
-    split by ``model.friction_heat``), the surface loss, then the fixed rows reset. Pairs are found in the
-    current configuration, across bodies (heat flows from the chip into a conducting tool). Returns (T, heat)
-    with heat = {'friction', 'lost', 'removed'} [J; per metre of thickness in 2D] moved in the step."""
+def thermal_step(state, model: Conduction | None, k: np.ndarray, c: np.ndarray, h: float, kernel: Kernel,
+                 dt: float, friction_heat: FrictionHeat | None = None, friction_power: np.ndarray | None = None,
+                 tool_rows: np.ndarray | None = None) -> tuple[np.ndarray, dict]:
+    """One explicit step dt of Eq. (29) with the harmonic-mean conductivity between materials (module text; ``k``,
+    ``c``: per row, :func:`coefficients`; ``model`` None: no conduction), the frictional heat (``friction_power``:
+    (N,) [W] per row, as the tool contact leaves it in ``Rates.friction_power``; split by ``friction_heat``:
+    ``chip_fraction`` to the rows not in ``tool_rows``, the rest to the tool rows), the surface loss, then the fixed
+    rows reset. Pairs are found in the current configuration, across bodies (heat flows from the chip into a
+    conducting tool). Returns (T, heat) with heat = {'friction', 'lost', 'removed'} [J; per metre of thickness in
+    2D] moved in the step."""
     n, d = state.x.shape
-    k, c = model.coefficients(state.body, n, rigid_ids)
-    I, J, fr = _pairs_and_fr(state.x, h, kernel)
-    kk = k[I] + k[J]
-    k_ij = np.divide(2.0 * k[I] * k[J], kk, out=np.zeros_like(kk), where=kk > 0)
     V = state.m / state.rho
-    q = 2.0 * k_ij * (state.T[I] - state.T[J]) * fr            # antisymmetric pair flux
     mc = state.m * c
-    dT = dt * PairSum(I, J, n).antisymmetric(q, V) / (state.rho * c)
     heat = dict(friction=0.0, lost=0.0, removed=0.0)
-    if model.friction_heat is not None and friction_power is not None and friction_power[0] is not None:
-        fh = model.friction_heat
-        Q = np.zeros(n)                                     # the heat each row receives in the step [J]
-        Pa, Pb = friction_power
-        Q[:len(Pa)] += fh.eta * fh.chip_fraction * dt * Pa
-        Q[n - len(Pb):] += fh.eta * (1.0 - fh.chip_fraction) * dt * Pb
+    dT = np.zeros(n)
+    pairs = None
+    if model is not None:
+        I, J, fr = _pairs_and_fr(state.x, h, kernel)
+        pairs = (I, J)
+        kk = k[I] + k[J]
+        k_ij = np.divide(2.0 * k[I] * k[J], kk, out=np.zeros_like(kk), where=kk > 0)
+        q = 2.0 * k_ij * (state.T[I] - state.T[J]) * fr            # antisymmetric pair flux
+        dT = dt * PairSum(I, J, n).antisymmetric(q, V) / (state.rho * c)
+    if friction_heat is not None and friction_power is not None:
+        tool = np.zeros(n, bool) if tool_rows is None else tool_rows
+        share = np.where(tool, friction_heat.eta * (1.0 - friction_heat.chip_fraction),
+                         friction_heat.eta * friction_heat.chip_fraction)
+        Q = share * dt * friction_power                             # the heat each row receives in the step [J]
         dT += Q / mc
         heat["friction"] = float(Q.sum())
-    if model.loss is not None:                              # Eq. (6) on the free surface of the conducting rows
-        on = free_surface(state.x, V, h, kernel, model.loss, (I, J)) & (k > 0)
+    if model is not None and model.loss is not None:          # Eq. (6) on the free surface of the conducting rows
+        on = free_surface(state.x, V, h, kernel, model.loss, pairs) & (k > 0)
         lost = dt * model.loss.flux(state.T[on]) * V[on] ** ((d - 1) / d)
         dT[on] -= lost / mc[on]
         heat["lost"] = float(lost.sum())
     T = state.T + dT
-    if len(model.fixed):
+    if model is not None and len(model.fixed):
         fixed = np.asarray(model.fixed)
         heat["removed"] = float(np.sum(mc[fixed] * (T[fixed] - model.T_fixed)))
         T[fixed] = model.T_fixed
     return T, heat
+
+
+LEDGER = ("plastic", "friction", "lost", "removed")
+
+
+class HeatFlow:
+    """The heat of a run as a physics the run loop steps (:class:`refsph.integrate.StepPhysics`): conduction
+    (``conduction``, or None), frictional heat (``friction_heat``, or None) and the heat ledger (module text).
+    ``cp``, ``chi``: the deformable body's heat capacity and Taylor-Quinney coefficient (the strength model's; chi
+    0 when the law does not heat); ``rigid_ids``: the rigid bodies' ids; ``h``, ``kernel``: the run's."""
+
+    name = "heat"
+
+    def __init__(self, conduction: Conduction | None, friction_heat: FrictionHeat | None, cp: float, chi: float,
+                 h: float, kernel: Kernel, rigid_ids=()):
+        if not (cp is not None and np.isfinite(cp) and cp > 0):
+            raise ValueError("heat conduction and frictional heat need the body's heat capacity: the strength "
+                             f"model's cp (JohnsonCook(cp=...), Elastic(cp=...)), got {cp!r}")
+        self.conduction, self.friction_heat, self.cp, self.chi = conduction, friction_heat, float(cp), float(chi)
+        self.h, self.kernel, self.rigid_ids = h, kernel, tuple(rigid_ids)
+        self.ledger = {k: 0.0 for k in LEDGER}
+        self.k = self.c = self.mc = self.T0 = self.tool_rows = None
+        self.rho_of_return_map = "start"
+
+    def bind(self, state, solver) -> None:
+        """Per-row k and c (constant through a run), the initial temperatures, and which density the solver's
+        return map uses (ESPH integrates rho: the end of the step's; TLSPH: the start's, Eq. (2))."""
+        if state.T is None:
+            raise ValueError("heat conduction and frictional heat need temperatures: make_state(..., T0=...)")
+        self.k, self.c = coefficients(self.conduction, self.cp, state.body, state.n, self.rigid_ids)
+        self.mc = state.m * self.c
+        self.T0 = state.T.copy()
+        self.tool_rows = None if state.body is None else np.isin(state.body, self.rigid_ids)
+        self.rho_of_return_map = "end" if "rho" in getattr(solver, "evolved", ()) else "start"
+
+    def step_limit(self, state) -> float:
+        if self.conduction is None:
+            return np.inf
+        return _step_limit(state.rho, self.k, self.c, self.h, self.conduction.courant)
+
+    def plastic_heat(self, before, after) -> float:
+        """chi sum_i m_i (W_p,i(after) - W_p,i(before)) / rho_i [J]: the plastic heat of a step (Eq. (28) summed),
+        from the plastic work alone."""
+        if self.chi == 0.0 or after.W_p is None:
+            return 0.0
+        rho = after.rho if self.rho_of_return_map == "end" else before.rho
+        return float(self.chi * np.sum(after.m * (after.W_p - before.W_p) / rho))
+
+    def advance(self, before, step, dt: float):
+        """The heat step after the mechanical one (``step``: :class:`refsph.integrate.Step`): the ledger takes the
+        plastic heat, then conduction, frictional heat, losses and fixed rows move the temperatures."""
+        after = step.state
+        self.ledger["plastic"] += self.plastic_heat(before, after)
+        power = step.rates.friction_power if step.rates is not None else None
+        T, moved = thermal_step(after, self.conduction, self.k, self.c, self.h, self.kernel, dt, self.friction_heat,
+                                power, self.tool_rows)
+        for key, val in moved.items():
+            self.ledger[key] += val
+        after.T = T
+        return after
+
+    def balance(self, state) -> dict:
+        """The heat ledger [J; per metre of thickness in 2D]: made (plastic, friction), stored (sum m c (T - T0)),
+        lost (surface), removed (at fixed temperatures), and the residual made - stored - lost - removed."""
+        stored = float(np.sum(self.mc * (state.T - self.T0)))
+        h = self.ledger
+        made = h["plastic"] + h["friction"]
+        residual = made - stored - h["lost"] - h["removed"]
+        return dict(plastic_J=h["plastic"], friction_J=h["friction"], stored_J=stored, lost_J=h["lost"],
+                    removed_J=h["removed"], residual_J=residual, residual_rel=residual / made if made > 0 else 0.0)
+
+    def record(self, state) -> dict:
+        return {f"heat_{k}": v for k, v in self.balance(state).items()}
+
+    def summary(self, state) -> dict:
+        return dict(heat_balance=self.balance(state))
+
+    def describe(self) -> dict:
+        """What summary.json says of the heat model (JSON-ready)."""
+        out = dict(cp=self.cp, chi=self.chi)
+        if self.conduction is not None:
+            c = self.conduction
+            out["conduction"] = dict(k=c.k, courant=c.courant, tools={str(b): list(v) for b, v in c.tools.items()},
+                                     n_fixed=len(c.fixed), T_fixed=c.T_fixed,
+                                     loss=None if c.loss is None else {f: getattr(c.loss, f) for f in
+                                                                       ("h_c", "emissivity", "T_ambient", "detector",
+                                                                        "alpha_radius")})
+        if self.friction_heat is not None:
+            out["friction_heat"] = dict(eta=self.friction_heat.eta, chip_fraction=self.friction_heat.chip_fraction)
+        return out
+
+    def checkpoint(self) -> dict:
+        return {k: np.float64(v) for k, v in self.ledger.items()}
+
+    def restore(self, arrays: dict) -> None:
+        self.ledger = {k: float(arrays[k]) for k in LEDGER}

@@ -1,6 +1,7 @@
 """The house rules of refsph/, checked on the source: no import cycle, no module importing another's private
-name, no function of 80 lines or more, one spelling of equation numbers, and every equation the README's code
-map claims for a module cited in that module."""
+name, no function of 80 lines or more, one spelling of equation numbers, every equation the README's code map
+claims for a module cited in that module, and the layers: every module in exactly one, the equation modules and
+the scenes importing nothing above them."""
 import ast
 import re
 from pathlib import Path
@@ -76,6 +77,51 @@ def test_no_import_cycle():
             visit(m)
 
 
+# The layers, bottom to top. The equation modules stay flat (refsph.esph is Section 2.1) and import only each
+# other; the scenes build set-ups from them; the run loop runs a scene; the tooling (crosscheck/, teaching/) sits
+# on top (of the rest only cli.py imports it, to dispatch its commands). A new flat module must be added to one
+# of the two lists by hand; a module in a folder takes the folder's layer.
+EQUATION_MODULES = {f"refsph.{m}" for m in (
+    "kernels", "esph", "tlsph", "material", "plasticity", "strength", "contact", "thermal", "surface", "neighbours",
+    "tensor", "state", "boundaries", "integrate", "stability", "paper_data")}
+RUN_LOOP_MODULES = {"refsph", "refsph.simulate", "refsph.solvers", "refsph.reference", "refsph.coupling",
+                    "refsph.cli", "refsph.io"}  # refsph: the root; reference, coupling: parts of the TLSPH solver
+FLAT_LAYERS = {"equations": EQUATION_MODULES, "run loop": RUN_LOOP_MODULES}
+FOLDER_LAYERS = {"scenes": "refsph.scenes", "crosscheck": "refsph.crosscheck", "teaching": "refsph.teaching"}
+NOT_IMPORTED_BY = {                  # layer: the layers its modules must not import (unclassified modules neither)
+    "equations": {"run loop", "scenes", "crosscheck", "teaching"},
+    "scenes": {"run loop", "crosscheck", "teaching"},
+}
+
+
+def layers_of(module: str) -> list:
+    return ([layer for layer, mods in FLAT_LAYERS.items() if module in mods]
+            + [layer for layer, pkg in FOLDER_LAYERS.items() if module == pkg or module.startswith(pkg + ".")])
+
+
+def test_every_module_in_exactly_one_layer():
+    names = {module_name(p) for p in MODULES}
+    wrong = {m: layers_of(m) for m in sorted(names) if len(layers_of(m)) != 1}
+    assert not wrong, f"modules not in exactly one layer (place a new one in EQUATION_MODULES, ...): {wrong}"
+    stale = sorted(m for mods in FLAT_LAYERS.values() for m in mods if m not in names)
+    stale += sorted(pkg for pkg in FOLDER_LAYERS.values() if pkg not in names)
+    assert not stale, f"layers name modules that do not exist: {stale}"
+
+
+@pytest.mark.parametrize("layer", sorted(NOT_IMPORTED_BY))
+def test_layer_imports_nothing_above_it(layer):
+    bad = set()
+    for p in MODULES:
+        me = module_name(p)
+        if layer not in layers_of(me):
+            continue
+        for mod, _ in imports(p):
+            theirs = layers_of(mod)
+            if not theirs or set(theirs) & NOT_IMPORTED_BY[layer]:
+                bad.add(f"{p.relative_to(ROOT)} imports {mod} ({', '.join(theirs) or 'no layer'})")
+    assert not bad, f"{layer} must not import {sorted(NOT_IMPORTED_BY[layer])}: {sorted(bad)}"
+
+
 def test_no_private_name_imported_across_modules():
     bad = [f"{module_name(p)} imports {n} from {mod}" for p in MODULES for mod, names in imports(p)
            for n in names if n.startswith("_") and not n.endswith("__") and mod != module_name(p)]
@@ -91,6 +137,40 @@ def test_functions_are_short():
                 if n >= 80:
                     long.append(f"{p.relative_to(ROOT)}:{node.lineno} {node.name} ({n} lines)")
     assert not long, long
+
+
+def test_classes_are_small():
+    """No class of ~150 lines or more (a class with one job fits on a screen or two)."""
+    big = []
+    for p in MODULES:
+        for node in ast.walk(ast.parse(p.read_text())):
+            if isinstance(node, ast.ClassDef) and node.end_lineno - node.lineno + 1 > 150:
+                n = node.end_lineno - node.lineno + 1
+                big.append(f"{p.relative_to(ROOT)}:{node.lineno} {node.name} ({n} lines)")
+    assert not big, big
+
+
+def private_attribute_uses(tree: ast.AST) -> list[tuple[int, str]]:
+    """(line, 'obj._name') for every read or write of another object's private attribute: ``x._name`` where x is
+    not ``self`` or ``cls`` (dunder names and module-level private functions called as ``module._f`` count too)."""
+    out = []
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Attribute) and node.attr.startswith("_") and not node.attr.endswith("__"):
+            owner = node.value
+            if not (isinstance(owner, ast.Name) and owner.id in ("self", "cls")):
+                out.append((node.lineno, f"{ast.unparse(owner)}.{node.attr}"))
+    return out
+
+
+def test_no_access_to_another_objects_private_attributes():
+    bad = [f"{p.relative_to(ROOT)}:{line} {what}" for p in MODULES
+           for line, what in private_attribute_uses(ast.parse(p.read_text()))]
+    assert not bad, bad
+
+
+def test_the_private_attribute_check_can_fail():
+    assert private_attribute_uses(ast.parse("def f(pairs):\n    return pairs._x_build\n")) == [(2, "pairs._x_build")]
+    assert private_attribute_uses(ast.parse("class A:\n    def f(self):\n        return self._x\n")) == []
 
 
 EQ_ANY = re.compile(r"\bEqs?\.\s*[(\d]")

@@ -1,13 +1,15 @@
 """Orthogonal cutting scene (Section 3.3): geometry, the measurements (chip thickness, shear bands) on fields
 with a known answer, coarse runs of both methods, the CLI."""
-import json
 from pathlib import Path
 
 import numpy as np
 import pytest
 
+from refsph.crosscheck.compare import format_table
+from refsph.crosscheck.golden import metric_rows
 from refsph.paper_data import CUTTING_GEOMETRY
-from refsph.scenes.cutting import analyse_run, chip_thickness, shear_bands
+from refsph.io import analyse_cutting_run
+from refsph.scenes.cutting import chip_thickness, shear_bands
 from refsph.scenes.measure import TOOL_BODY
 from refsph.scenes import get_scene
 from refsph.simulate import run
@@ -90,7 +92,7 @@ def test_no_bands_in_a_uniform_field():
     assert shear_bands(X, eps, nx, ny, dp, dp, feed, 2.0e-3)["n"] == 0
 
 
-REGRESSION = Path(__file__).parent / "regression" / "cutting_coarse.json"
+GOLDEN = Path(__file__).resolve().parent.parent / "golden"
 
 
 @pytest.fixture(scope="module")
@@ -125,23 +127,21 @@ def test_coarse_run(coarse, method):
 def test_analyse_run_matches_the_run(coarse, method):
     """Re-measuring a run folder (what benchmarks/cutting.py does) gives the run's own metrics."""
     res, out = coarse[method]
-    again = analyse_run(out)
+    again = analyse_cutting_run(out)
     for k, v in res.summary["metrics"].items():
         assert np.allclose(np.asarray(again[k], dtype=float), np.asarray(v, dtype=float), rtol=1e-6,
                            equal_nan=True), k
     with pytest.raises(FileNotFoundError):
-        analyse_run(out / "nowhere")
+        analyse_cutting_run(out / "nowhere")
 
 
 def test_coarse_regression(coarse):
-    """Same numbers as the stored run (tests/regression/make_regression.py cutting writes the file). ESPH at
-    1e-4; TLSPH's pinball switch amplifies round-off (chapter 07), so its force means at 2 %, the rest at 5 %."""
-    ref = json.loads(REGRESSION.read_text())
+    """Same numbers as the golden cases metrics_cutting_coarse_{esph,tlsph} (`refsph oracle golden/ --only
+    'metrics_cutting*'` writes them). ESPH at 1e-4; TLSPH's pinball switch amplifies round-off (chapter 07), so
+    its force means at 2 %, the rest at 5 % (case.json)."""
     for m, (res, _) in coarse.items():
-        met = res.summary["metrics"]
-        for k, v in ref[m].items():
-            tol = 1e-4 if m == "esph" else (0.02 if "force" in k else 0.05)
-            assert met[k] == pytest.approx(v, rel=tol), (m, k)
+        rows = metric_rows(GOLDEN / f"metrics_cutting_coarse_{m}", res.summary["metrics"])
+        assert len(rows) == 4 and all(r.passed for r in rows), format_table(rows)
 
 
 def test_cli_option_flags_and_numerics(tmp_path, capsys):

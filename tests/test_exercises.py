@@ -7,7 +7,7 @@ from pathlib import Path
 
 import pytest
 
-from refsph.book import chapter_files
+from refsph.teaching.book import chapter_files
 
 ROOT = Path(__file__).resolve().parent.parent
 CHAPTERS = chapter_files()

@@ -6,8 +6,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from refsph import lammps
-from refsph.compare import compare
+from refsph.crosscheck import lammps
+from refsph.crosscheck.compare import compare
 from refsph.scenes import get_scene
 from refsph.scenes.bar import period_and_wave_speed
 from refsph.scenes.taylor import lattice_cylinder
@@ -68,7 +68,7 @@ def test_compare_null_tolerance(tmp_path):
 def test_interpolation_matches_ids_exactly():
     """TEST snapshots between REF's times are interpolated particle by particle: ids are matched, not
     interpolated (0.7 * 4079 + 0.3 * 4079 is 4078.999... in floating point), whatever the row order."""
-    from refsph.compare import _at_time, _rows_of
+    from refsph.crosscheck.compare import _at_time, _rows_of
     ids = np.arange(10000)
     perm = np.random.default_rng(2).permutation(ids)
     a = dict(t=0.0, id=ids, v=ids.astype(float)[:, None] * np.ones((1, 2)))

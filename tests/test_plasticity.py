@@ -4,7 +4,7 @@ import dataclasses
 import numpy as np
 import pytest
 
-from refsph.material_point import material_point
+from refsph.teaching.material_point import material_point
 from refsph.strength import plastic_update
 from refsph.plasticity import (JohnsonCook, ModifiedJohnsonCook, effective_plastic_strain_increment,
                                equivalent_strain_rate, plastic_strain_increment, plastic_work_increment, radial_return,
@@ -158,7 +158,8 @@ def test_plastic_update_heating_switch():
     args = (S, np.zeros(1), np.zeros(1), np.full(1, 293.0), np.full(1, 7830.0), np.full(1, 1e3), JC, MAT.G)
     _, _, deps, dw, dT = plastic_update(*args)
     assert deps[0] > 0 and dT[0] == pytest.approx(0.9 * dw[0] / (7830.0 * 460.0))
-    assert plastic_update(*args, heating=False)[4][0] == 0.0
+    iso = dataclasses.replace(JC, heating=False)                  # the law's own switch
+    assert plastic_update(*args[:-2], iso, MAT.G)[4][0] == 0.0 and iso.heat(dw, np.full(1, 7830.0))[0] == 0.0
 
 
 def test_material_point_validation():

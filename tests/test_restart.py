@@ -14,7 +14,9 @@ CASES = [("taylor", "tlsph", dict(dim=2, quick=True, t_end=6e-6)),
          ("pressing", "esph", dict(quick=True, t_end=0.2e-6)),
          ("pressing", "tlsph", dict(quick=True, t_end=0.2e-6)),
          ("pressing", "tlsph", dict(quick=True, t_end=0.2e-6, numerics=dict(integrator="leapfrog"))),  # kept force
-         ("taylor", "esph", dict(dim=2, quick=True, t_end=6e-6, numerics=dict(integrator="leapfrog")))]
+         ("taylor", "esph", dict(dim=2, quick=True, t_end=6e-6, numerics=dict(integrator="leapfrog"))),
+         ("thermal_cutting", "tlsph", dict(quick=True, t_end=2e-5, numerics=dict(threads=1),     # heat flow, ledger
+                                           options=dict(case=1, length=0.5e-3, travel=1.0)))]
 
 
 def _killed(monkeypatch, scene, method, out, kw):
@@ -34,7 +36,8 @@ def _killed(monkeypatch, scene, method, out, kw):
 
 
 @pytest.mark.parametrize("scene, method, kw", CASES,
-                         ids=[f"{c[0]}-{c[1]}" + ("-leapfrog" if "numerics" in c[2] else "") for c in CASES])
+                         ids=[f"{c[0]}-{c[1]}" + ("-leapfrog" if "integrator" in c[2].get("numerics", {}) else "")
+                              for c in CASES])
 def test_restart_is_bit_for_bit(tmp_path, monkeypatch, scene, method, kw):
     whole = run(scene, method, out=tmp_path / "whole", progress=False, **kw)
     _killed(monkeypatch, scene, method, tmp_path / "cut", kw)
@@ -50,6 +53,11 @@ def test_restart_is_bit_for_bit(tmp_path, monkeypatch, scene, method, kw):
     assert again["status"] == "ok" and again["restarts"] == 1 and again["n_steps"] == whole.summary["n_steps"]
     numbers = {k: v for k, v in whole.summary["metrics"].items() if isinstance(v, (int, float))}
     assert numbers and all(again["metrics"][k] == v for k, v in numbers.items() if v == v)
+    forces = [d / "reaction_forces.csv" for d in (tmp_path / "whole", tmp_path / "cut")]
+    if forces[0].exists():                                         # every step's reaction, none lost at the restart
+        assert forces[0].read_text() == forces[1].read_text()
+    if "heat_balance" in whole.summary:                            # the heat ledger continues, not restarts
+        assert again["heat_balance"] == whole.summary["heat_balance"]
 
 
 def test_restart_input_errors(tmp_path, capsys):

@@ -1,11 +1,12 @@
 """The strength-model seam: a law the package does not ship, added here in one class, runs through the material
 point and a particle run without touching refsph; elastic and Johnson-Cook go through the same interface."""
+import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
 import pytest
 
-from refsph.material_point import material_point
+from refsph.teaching.material_point import material_point
 from refsph.plasticity import J2Plasticity, JohnsonCook, ModifiedJohnsonCook
 from refsph.scenes import aisi4340_material, get_scene
 from refsph.simulate import simulate
@@ -22,6 +23,7 @@ class LinearHardening(J2Plasticity):
     H: float
     chi: float
     cp: float
+    heating: bool = True                                            # the law's own switch (J2Plasticity.heat)
 
     def flow_stress(self, eps_p, eps_dot, T):
         return self.sigma_0 + self.H * np.asarray(eps_p, dtype=float)
@@ -66,7 +68,7 @@ def test_a_new_law_in_a_particle_run(method):
     """The pressing block with the law of this file: it yields where its flow stress says, nowhere else, and
     with heating off it stays at room temperature."""
     setup = get_scene("pressing").setup(quick=True)
-    setup.strength, setup.heating, setup.t_end = LAW, False, 0.1e-6
+    setup.strength, setup.t_end = dataclasses.replace(LAW, heating=False), 0.1e-6
     res = simulate(setup, method, progress=False)
     s, n = res.state, setup.info["n_block"]
     assert res.summary["strength"]["model"] == "LinearHardening" and res.summary["heating"] is False

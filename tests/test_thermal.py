@@ -119,6 +119,7 @@ def test_conduction_during_a_run_between_two_bodies(method):
     from refsph.scenes import Numerics, Setup, aisi4340_material
     from refsph.simulate import simulate
     from refsph.state import concatenate_states, make_state
+    from refsph.strength import Elastic
     from refsph.thermal import Conduction
     mat, dp = aisi4340_material(), 1e-4
     x = lattice([10 * dp, 10 * dp], dp)
@@ -128,7 +129,7 @@ def test_conduction_during_a_run_between_two_bodies(method):
     k, cp = 5e5, 480.0
     t_diff = (20 * dp) ** 2 * mat.rho0 * cp / k
     setup = Setup(state=st, material=mat, dp=dp, numerics=Numerics(), t_end=0.3 * t_diff, n_snapshots=1,
-                  thermal=Conduction(k=k, cp=cp, courant=0.2))
+                  strength=Elastic(cp=cp), thermal=Conduction(k=k, courant=0.2))      # c_p: the law's
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")                       # ESPH: no contact law between the bodies
         T = simulate(setup, method, progress=False).state.T
@@ -139,7 +140,10 @@ def test_conduction_during_a_run_between_two_bodies(method):
         st0 = concatenate_states(make_state(x, [0.0, 0.0], mat.rho0, dp * dp), make_state(x + [1e-3, 0], [0.0, 0.0],
                                                                                             mat.rho0, dp * dp))
         simulate(Setup(state=st0, material=mat, dp=dp, numerics=Numerics(), t_end=1e-9, n_snapshots=1,
-                       thermal=Conduction(k=k, cp=cp, courant=0.2)), method, progress=False)
+                       strength=Elastic(cp=cp), thermal=Conduction(k=k, courant=0.2)), method, progress=False)
+    with pytest.raises(ValueError, match="heat capacity"):               # conduction needs the law's c_p
+        simulate(Setup(state=st, material=mat, dp=dp, numerics=Numerics(), t_end=1e-9, n_snapshots=1,
+                       thermal=Conduction(k=k, courant=0.2)), method, progress=False)
 
 
 def test_convective_cooling_of_a_block():
@@ -156,15 +160,15 @@ def test_convective_cooling_of_a_block():
     L, h, k, cp = 10 * dp, 1.5e-4, 50.0, 480.0
     st = make_state(lattice([L, L], dp), [0.0, 0.0], mat.rho0, dp * dp, T0=600.0)
     loss = SurfaceLoss(h_c=0.1 * k / L, emissivity=0.0, T_ambient=300.0)
-    model = Conduction(k=k, cp=cp, courant=0.2, loss=loss)
+    model = Conduction(k=k, courant=0.2, loss=loss)
     V = st.m / st.rho
     area = np.sum(V[surface_sph(st.x, V, h, KERNEL)] ** 0.5)
     assert area == pytest.approx(36 * dp)
     tau = st.m.sum() * cp / (loss.h_c * area)
-    dt = thermal_step_limit(st, model, h)
+    dt = thermal_step_limit(st, model, h, cp)
     n = int(np.ceil(tau / dt))
     for _ in range(n):
-        st.T = conduct(st, model, h, KERNEL, tau / n)
+        st.T = conduct(st, model, h, KERNEL, tau / n, cp)
     theta = (st.T.mean() - 300.0) / 300.0
     assert abs(theta / np.exp(-1.0) - 1) < 0.02, theta
     hot = SurfaceLoss(h_c=0.0, emissivity=0.5, T_ambient=300.0).flux(np.array([1000.0]))

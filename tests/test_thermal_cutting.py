@@ -12,7 +12,7 @@ from refsph.scenes import get_scene
 from refsph.scenes.thermal_cutting import EDGE_RADIUS, tool_particles
 from refsph.simulate import cfl_time_step, run
 from refsph.state import make_state
-from refsph.thermal import Conduction, FrictionHeat, thermal_step
+from refsph.thermal import Conduction, FrictionHeat, coefficients, thermal_step
 
 
 def test_friction_power_is_force_times_sliding_speed_and_is_split_as_asked():
@@ -23,20 +23,22 @@ def test_friction_power_is_force_times_sliding_speed_and_is_split_as_asked():
     xa, va = np.array([[0.0, 0.9e-5]]), np.array([[3.0, -1.0]])          # approaching (p_d > 0) and sliding
     xb, vb = np.array([[0.0, 0.0]]), np.zeros((1, 2))
     fr = CoulombFriction(mu0=0.5, q=2.0, T_room=293.0, T_melt=1800.0)
-    c = pinball_contact(xa, va, np.array([m]), xb, vb, np.inf, R, 80e9, np.inf, dt,
-                        PinballContact(k=1 / 3, K_p=50.0, friction=fr), thickness=1e-5, T_a=np.array([293.0]))
-    f_t = c.a[0, 0] * m                                                   # the only x force is friction
-    assert f_t < 0 and c.friction_power_a[0] == pytest.approx(abs(f_t) * 3.0, rel=1e-12)
-    assert c.friction_power_b[0] == c.friction_power_a[0]
+    cres = pinball_contact(xa, va, np.array([m]), xb, vb, np.inf, R, 80e9, np.inf, dt,
+                           PinballContact(k=1 / 3, K_p=50.0, friction=fr), thickness=1e-5, T_a=np.array([293.0]))
+    f_t = cres.a[0, 0] * m                                                # the only x force is friction
+    assert f_t < 0 and cres.friction_power_a[0] == pytest.approx(abs(f_t) * 3.0, rel=1e-12)
+    assert cres.friction_power_b[0] == cres.friction_power_a[0]
     state = make_state(np.vstack([xa, xb]), np.zeros((2, 2)), 7800.0, 1e-10, T0=293.0, body=np.array([0, 1]))
-    model = Conduction(k=1e-30, cp=500.0, courant=0.3, tools={1: (1e-30, 15.0)},
-                       friction_heat=FrictionHeat(eta=1.0, chip_fraction=0.25))
-    T, heat = thermal_step(state, model, 1.3e-5, get_kernel("wendland"), dt, [1],
-                           (c.friction_power_a, c.friction_power_b))
-    P = c.friction_power_a[0]
-    assert heat["friction"] == pytest.approx(P * dt, rel=1e-12)
-    mc = state.m * np.array([500.0, 15.0])
-    assert (T - 293.0) * mc == pytest.approx([0.25 * P * dt, 0.75 * P * dt], rel=1e-6)
+    model = Conduction(k=1e-30, courant=0.3, tools={1: (1e-30, 15.0)})
+    k, c = coefficients(model, 500.0, state.body, state.n, [1])
+    power = np.concatenate([cres.friction_power_a, cres.friction_power_b])   # Rates.friction_power: every row
+    for conduction in (model, None):                     # frictional heat with or without conduction
+        T, heat = thermal_step(state, conduction, k, c, 1.3e-5, get_kernel("wendland"), dt,
+                               FrictionHeat(eta=1.0, chip_fraction=0.25), power, np.array([False, True]))
+        P = cres.friction_power_a[0]
+        assert heat["friction"] == pytest.approx(P * dt, rel=1e-12)
+        mc = state.m * np.array([500.0, 15.0])
+        assert (T - 293.0) * mc == pytest.approx([0.25 * P * dt, 0.75 * P * dt], rel=1e-6)
 
 
 @pytest.fixture(scope="module")
@@ -60,12 +62,42 @@ def test_heat_balance_of_a_cutting_run(short_cut):
     assert m["cutting_force_N_per_m"] > 0 and m["passive_force_N_per_m"] > 0
 
 
+@pytest.mark.parametrize("wrong", ["chi", "cp"])
+def test_the_heat_ledger_catches_a_wrong_chi_or_cp_in_the_heating(monkeypatch, wrong):
+    """The ledger counts the plastic heat from the plastic work alone (chi sum m dW_p / rho) and the stored heat from
+    the temperatures (sum m c_p (T - T0)): a heating (Eq. (28)) that used another chi or c_p than the law's leaves a
+    residual of the size of the error, where the right one balances to round-off (test above)."""
+    import dataclasses
+
+    import refsph.plasticity as plasticity
+    right = plasticity.temperature_increment
+    change = dict(chi=lambda law: dataclasses.replace(law, chi=0.8 * law.chi),
+                  cp=lambda law: dataclasses.replace(law, cp=1.25 * law.cp))[wrong]
+    monkeypatch.setattr(plasticity, "temperature_increment", lambda dw, rho, law: right(dw, rho, change(law)))
+    res = run("thermal_cutting", "tlsph", quick=True, progress=False,
+              options=dict(case=1, length=0.5e-3, travel=0.3), numerics=dict(threads=1))
+    hb = res.summary["heat_balance"]
+    assert hb["plastic_J"] > 0 and abs(hb["residual_rel"]) > 0.05, hb
+
+
+def test_frictional_heat_without_conduction():
+    """Frictional heat is its own switch (Setup.friction_heat): without conduction the heat stays where it is made,
+    and the ledger still balances."""
+    setup = get_scene("thermal_cutting").setup(quick=True, case=1, length=0.5e-3, travel=0.3)
+    setup.thermal = None
+    from refsph.simulate import simulate
+    res = simulate(setup, "tlsph", progress=False)
+    hb = res.summary["heat_balance"]
+    assert hb["friction_J"] > 0 and hb["lost_J"] == 0 and hb["removed_J"] == 0
+    assert abs(hb["residual_rel"]) < 1e-9
+
+
 def test_mass_scaling_keeps_rho_cp_and_lengthens_the_step():
     scene = get_scene("thermal_cutting")
     a = scene.setup(case=1, mass_scale=1.0, length=0.6e-3, travel=2.0)
     b = scene.setup(case=1, mass_scale=100.0, length=0.6e-3, travel=2.0)
     n = a.info["n_work"]
-    assert b.state.rho[:n] * b.thermal.cp == pytest.approx(a.state.rho[:n] * a.thermal.cp, rel=1e-12)
+    assert b.state.rho[:n] * b.strength.cp == pytest.approx(a.state.rho[:n] * a.strength.cp, rel=1e-12)
     assert b.strength.cp * b.material.rho0 == pytest.approx(a.strength.cp * a.material.rho0, rel=1e-12)
     ratio = cfl_time_step(b.state, b.material, b.h, 0.3) / cfl_time_step(a.state, a.material, a.h, 0.3)
     assert ratio == pytest.approx(10.0, rel=0.02)                       # c_L / sqrt(s), v_c << c_L

@@ -13,7 +13,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from refsph.material_point import material_point
+from refsph.teaching.material_point import material_point
 from refsph.plasticity import yield_stress
 from refsph.scenes.taylor import taylor_johnson_cook, taylor_material
 

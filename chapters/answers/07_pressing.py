@@ -9,6 +9,7 @@
   higher and the 99th percentile of the plastic strain is lower than with heating: thermal softening helps the
   strain localise.
 """
+import dataclasses
 import numpy as np
 
 from refsph.boundaries import RigidBody
@@ -59,7 +60,7 @@ def answer_2():
 
 def _pressing(heating):
     st = SCENE.setup(2, DP, True)
-    st.heating = heating
+    st.strength = dataclasses.replace(st.strength, heating=heating)
     r = simulate(st, "esph", scene=SCENE, progress=False)
     n = st.info["n_block"]
     return r.summary["metrics"], float(np.percentile(r.state.eps_p[:n], 99))

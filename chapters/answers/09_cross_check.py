@@ -15,9 +15,9 @@ from pathlib import Path
 import numpy as np
 from scipy.spatial import cKDTree
 
-from refsph.compare import compare
+from refsph.crosscheck.compare import compare
 from refsph.neighbours import check_half_pairs
-from refsph.notebook import repository_root
+from refsph.teaching.notebook import repository_root
 from refsph.simulate import run
 
 GOLDEN = repository_root() / "golden"

@@ -2,9 +2,10 @@
 runs a very short quick cut (case 1, a 0.5 mm workpiece, one t_u of cut: a few seconds; the chip has only begun)
 and compares with the same cut with everything on. Measured (this key's runs):
 
-* answer_1: without conduction the rake face's *mean* temperature is lower (363 against 429 K): refsph adds the
-  frictional heat only when heat flows (``Setup.thermal``), and that heat is made right at the rake face. But the
-  hottest particle is hotter (564 against 507 K): the heat of the shear zone stays where it is made.
+* answer_1: without conduction the rake face's *mean* temperature is lower (363 against 429 K): the scene's
+  ``conduction=false`` is the first paper's adiabatic model, so it switches the frictional heat off too
+  (``Setup.friction_heat``, its own switch in a Setup of one's own), and that heat is made right at the rake face.
+  But the hottest particle is hotter (564 against 507 K): the heat of the shear zone stays where it is made.
 * answer_2: the split of the frictional heat hardly matters: all of it into the chip raises T_RF by ~8 K over
   all of it into the tool, because conduction across the interface (harmonic-mean k) moves it on within a few
   steps; the tool stores more heat when it gets the whole share (0.70 against 0.52 J/m).

@@ -3,7 +3,9 @@
 Two kinds of folders are compared:
 
 * **golden cases** (``refsph oracle DIR``, a folder with ``index.json``): for every case of REF, every array of its
-  ``output.npz`` against the same array in TEST/<case>/output.npz, with the case's own tolerance (``case.json``);
+  ``output.npz`` against the same array in TEST/<case>/output.npz, with the case's own tolerance (``case.json``)
+  and error measure (``case.json``'s ``measure``, where a case names one for an array: the relative L2 difference,
+  or a pointwise relative error with a floor; see :func:`compare_case`);
 * **run folders** (``refsph run ... --out DIR``, a folder with ``summary.json``): the scalar metrics of
   ``summary.json`` and the snapshot fields, particles matched by ``id`` (the row where a snapshot has no ids),
   snapshots matched by time (TEST interpolated linearly in time where its snapshot times differ from REF's).
@@ -32,9 +34,9 @@ from pathlib import Path
 
 import numpy as np
 
-from .io import load_run, load_snapshot
+from ..io import load_run, load_snapshot
 
-__all__ = ["Row", "compare", "compare_cases", "compare_runs", "format_table", "DEFAULTS", "FIELDS"]
+__all__ = ["Row", "compare", "compare_case", "compare_cases", "compare_runs", "format_table", "DEFAULTS", "FIELDS"]
 
 DEFAULTS = dict(field=1e-6, metric=1e-6)
 FIELDS = ("x", "v", "rho", "S", "S_zz", "F", "eps_p", "T")
@@ -72,19 +74,45 @@ def compare_cases(ref: Path, test: Path, tolerances: dict | None = None, only=No
             raise ValueError(f"no golden case matches {' '.join(only)} (the cases: {', '.join(names)})")
         names = chosen
     for name in names:
-        case = json.loads((ref / name / "case.json").read_text())
-        with np.load(ref / name / "output.npz") as r:
-            out_ref = {k: r[k] for k in r.files}
         path = test / name / "output.npz"
         out_test = {}
         if path.exists():
             with np.load(path) as t:
                 out_test = {k: t[k] for k in t.files}
-        for k, a in out_ref.items():
-            tol = fields.get(k, case["tolerance"].get(k, DEFAULTS["field"]))
-            err = _rel(out_test[k], a) if k in out_test else float("inf")
-            rows.append(Row(f"{name}/{k}", err, tol))
+        rows += compare_case(ref / name, out_test, fields)
     return rows
+
+
+def compare_case(case_dir: Path, out_test: dict, fields: dict | None = None) -> list[Row]:
+    """The output arrays of one golden case (folder ``case_dir``) against ``out_test`` {name: array}, each with the
+    case's tolerance (``fields``: {name: tolerance} overriding it) and error measure (a missing array fails)."""
+    case_dir = Path(case_dir)
+    case = json.loads((case_dir / "case.json").read_text())
+    measure = case.get("measure", {})
+    with np.load(case_dir / "output.npz") as r:
+        out_ref = {k: r[k] for k in r.files}
+    rows = []
+    for k, a in out_ref.items():
+        tol = (fields or {}).get(k, case["tolerance"].get(k, DEFAULTS["field"]))
+        err = _error(out_test[k], a, measure.get(k)) if k in out_test else float("inf")
+        rows.append(Row(f"{case_dir.name}/{k}", err, tol))
+    return rows
+
+
+def _error(test, ref, measure: dict | None) -> float:
+    """The error of a golden case's array: max |test - ref| / max |ref| (no ``measure``), or as its case.json's
+    ``measure`` says: {"kind": "l2"}: ||test - ref|| / ||ref||; {"kind": "pointwise", "floor": f}:
+    max_i |test_i - ref_i| / (|ref_i| + f), i.e. |d_i| <= tol |ref_i| + tol f at every point."""
+    if not measure:
+        return _rel(test, ref)
+    test, ref = np.asarray(test, dtype=float), np.asarray(ref, dtype=float)
+    if test.shape != ref.shape:
+        return float("inf")
+    if measure["kind"] == "l2":
+        return float(np.linalg.norm(test - ref) / np.linalg.norm(ref))
+    if measure["kind"] == "pointwise":
+        return float(np.max(np.abs(test - ref) / (np.abs(ref) + measure["floor"])))
+    raise ValueError(f"unknown error measure {measure!r}")
 
 
 def _metric_rows(ref: dict, test: dict, tol: dict) -> list[Row]:

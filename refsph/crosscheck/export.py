@@ -13,7 +13,7 @@ from xml.sax.saxutils import escape
 
 import numpy as np
 
-from .io import load_run, load_snapshot
+from ..io import load_run, load_snapshot
 
 __all__ = ["export_vtk"]
 

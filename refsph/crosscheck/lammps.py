@@ -31,7 +31,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .io import write_json
+from ..io import write_json
 
 __all__ = ["LAMMPS_TO_SI", "LammpsNotFound", "find_lmp", "run_lammps", "read_dump", "read_dumps", "read_history",
            "snapshot_from_frame", "particles_from_frame", "write_run", "finished_run", "INSTALL_HINT"]

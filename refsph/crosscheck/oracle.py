@@ -4,7 +4,7 @@
 run computes them (walls, clamps, symmetry ghosts, the pinball contact, the constraints), and what the strength
 model's return map makes of a step of size dt:
 
-    from refsph.oracle import rates
+    from refsph.crosscheck.oracle import rates
     out = rates("runs/pressing-tlsph-2d/snapshots/snap_00005.npz", "pressing", "tlsph", quick=True)
     out["v_dot"], out["F"], out["S_returned"]
 
@@ -16,18 +16,18 @@ refused by :func:`refsph.neighbours.check_half_pairs` with a message saying so.
 **Golden cases.** ``refsph oracle DIR`` (:func:`write_golden_cases`) writes a versioned set of small cases, each a
 folder with ``input.npz``, ``output.npz`` and ``case.json`` (every array with its shape, unit and meaning, the
 equations it exercises, the tolerance another backend should meet and why). ``refsph compare REF TEST``
-(:mod:`refsph.compare`) checks another code's outputs against them.
+(:mod:`refsph.crosscheck.compare`) checks another code's outputs against them.
 """
 from __future__ import annotations
 
 
 import numpy as np
 
-from .integrate import advance, cfl_time_step
-from .io import state_from_snapshot
-from .scenes import Scene, Setup, get_scene
-from .simulate import make_solver
-from .state import State
+from ..integrate import advance, cfl_time_step
+from ..io import state_from_snapshot
+from ..scenes import Scene, Setup, get_scene
+from ..simulate import make_solver
+from ..state import State
 
 __all__ = ["rates", "state_from_snapshot"]
 

@@ -66,15 +66,18 @@ class Setup:
 
     ``state``: the particles (:func:`refsph.state.make_state`); ``material``: elastic constants; ``dp``: spacing;
     ``numerics``; ``t_end`` [s]; ``n_snapshots``: evenly spaced output times (plus ``snapshot_times`` [s]);
-    ``strength``: the strength model (:mod:`refsph.strength`; None: elastic); ``heating``: plastic work heats the
-    material (Eq. (28); False: isothermal); ``mirror``: symmetry planes (:class:`~refsph.boundaries.MirrorPlanes`);
+    ``strength``: the strength model (:mod:`refsph.strength`; None: elastic; whether plastic work heats, Eq. (28),
+    is its own ``heating`` switch, and its ``cp`` is the body's heat capacity); ``mirror``: symmetry planes
+    (:class:`~refsph.boundaries.MirrorPlanes`);
     ``walls``: rigid walls (:class:`~refsph.boundaries.RigidWall`); ``rigid``: tools
     (:class:`~refsph.boundaries.RigidBody`, their particles the last rows of ``state``); ``clamps``: held
     particles (:class:`~refsph.boundaries.Clamp`); ``friction``: a :class:`~refsph.contact.CoulombFriction` for
     the TLSPH pinball contact (None: frictionless, as in the paper); ``info``: numbers that describe the scene
     (written to ``summary.json`` as ``scene_info``: JSON scalars, strings and short lists only); ``arrays``:
     per-particle arrays the scene's measurements need (index sets; not written to the summary); ``thermal``: heat
-    conduction during the run (a :class:`refsph.thermal.Conduction`; None: none, the paper's adiabatic model).
+    conduction during the run (a :class:`refsph.thermal.Conduction`; None: none, the paper's adiabatic model);
+    ``friction_heat``: the frictional heat of the contact (a :class:`refsph.thermal.FrictionHeat`; None: friction
+    makes no heat). Either switches the run's heat flow on (:class:`refsph.thermal.HeatFlow`).
     """
 
     state: State
@@ -85,7 +88,6 @@ class Setup:
     n_snapshots: int
     info: dict = field(default_factory=dict)
     strength: StrengthModel | None = None
-    heating: bool = True
     mirror: MirrorPlanes | None = None
     walls: tuple = ()
     snapshot_times: tuple = ()
@@ -94,6 +96,7 @@ class Setup:
     friction: object = None
     arrays: dict = field(default_factory=dict)
     thermal: object = None
+    friction_heat: object = None
 
     def __post_init__(self):
         if self.strength is None:

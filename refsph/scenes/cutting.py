@@ -17,8 +17,8 @@ Numerics: Table 5 (dp = 0.01 mm, h = 0.018 mm: h/dp = 1.8, beta1 = beta2 = 0.5),
 Courant 0.3 (the paper's fixed 1e-10 s is 9x smaller), ESPH Verlet skin 0.15 h; TLSPH reference updates at
 max |E| > 0.5 (``Numerics.ref_update_strain``).
 
-Measurements (``summary.json`` metrics, :func:`cutting_metrics`; :func:`analyse_run` recomputes them from a run
-folder):
+Measurements (``summary.json`` metrics, :func:`cutting_metrics`; :func:`refsph.io.analyse_cutting_run` recomputes
+them from a run folder):
 
 * ``cutting_force_history``, ``thrust_force_history`` ([t, F], per metre of thickness, 400 time bins): the force of
   the workpiece on the tool along +x (against the cut; the tool moves along -x) and along +y (pushing the tool
@@ -36,12 +36,10 @@ folder):
 from __future__ import annotations
 
 import math
-from pathlib import Path
 
 import numpy as np
 
 from ..boundaries import Clamp, RigidBody
-from ..io import load_reactions, load_run, load_snapshot
 from ..paper_data import CUTTING_GEOMETRY, CUTTING_OBSERVED, CUTTING_TABLE5
 from ..state import concatenate_states, make_state
 from .base import Numerics, Scene, Setup
@@ -49,7 +47,7 @@ from .measure import (N_FORCE_BINS, TOOL_BODY, aisi4340_johnson_cook, aisi4340_m
                       block_lattice, time_mean)
 
 __all__ = ["SCENE", "cutting_particles", "chip_thickness", "lattice_shape", "shear_bands", "cutting_metrics",
-           "analyse_run", "cutting_table", "STEADY_FROM", "BAND_REL_PROMINENCE"]
+           "cutting_table", "STEADY_FROM", "BAND_REL_PROMINENCE"]
 STEADY_FROM = 0.5             # force means over the second half of the run (t > STEADY_FROM t_end)
 BAND_REL_PROMINENCE = 0.5     # a shear band: a strain peak along the chip at least this x the median above its
 #                               surroundings (see shear_bands)
@@ -210,7 +208,8 @@ def cutting_metrics(reaction: dict, x: np.ndarray, eps_p: np.ndarray, T: np.ndar
                     t_end: float) -> dict:
     """The ``metrics`` of ``summary.json`` from the tool's reaction history (``{'t', 'dt', 'tool'}``, as
     :func:`refsph.io.load_reactions` returns it) and the final positions, plastic strain and temperature of all
-    particles (workpiece first, then the tool). :func:`analyse_run` calls it on a run folder."""
+    particles (workpiece first, then the tool). :func:`refsph.io.analyse_cutting_run` calls it on a run
+    folder."""
     n = info["n_work"]
     t_r, dt = np.asarray(reaction["t"]), np.asarray(reaction["dt"])
     F = np.asarray(reaction["tool"])
@@ -248,21 +247,6 @@ def cutting_metrics(reaction: dict, x: np.ndarray, eps_p: np.ndarray, T: np.ndar
 
 def _metrics(hist, state, setup):
     return cutting_metrics(hist["reaction"], state.x, state.eps_p, state.T, state.t, setup.info, setup.t_end)
-
-
-def analyse_run(directory, snapshot: int = -1) -> dict:
-    """:func:`cutting_metrics` of a cutting run folder (``refsph run cutting --out DIR``) from its
-    ``summary.json``, ``reaction_forces.csv`` and snapshot number ``snapshot`` (default: the last); the forces
-    cover the whole run. Lets a changed measurement be applied to earlier runs without running them again."""
-    directory = Path(directory)
-    summary, snaps = load_run(directory)
-    if summary.get("scene") != "cutting":
-        raise ValueError(f"{directory} is not a cutting run (scene {summary.get('scene')!r})")
-    if not snaps:
-        raise FileNotFoundError(f"{directory} has no snapshots")
-    z = load_snapshot(snaps[snapshot])
-    return cutting_metrics(load_reactions(directory / "reaction_forces.csv"), z["x"], z["eps_p"], z["T"], z["t"],
-                           summary["scene_info"], summary["t_end"])
 
 
 def _cell(value, width: int, fmt: str, scale: float = 1.0) -> str:

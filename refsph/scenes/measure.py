@@ -48,11 +48,13 @@ def aisi4340_material() -> ElasticMaterial:
     return ElasticMaterial(rho0=t["rho"], E=t["E_Pa"], nu=t["nu"])
 
 
-def aisi4340_johnson_cook(eps_dot_0: float) -> JohnsonCook:
-    """Table 3 Johnson-Cook constants, chi = 0.9 (Section 2.3), the given reference strain rate (not printed)."""
+def aisi4340_johnson_cook(eps_dot_0: float, heating: bool = True) -> JohnsonCook:
+    """Table 3 Johnson-Cook constants, chi = 0.9 (Section 2.3), the given reference strain rate (not printed);
+    ``heating``: plastic work heats the material (Eq. (28); False: isothermal)."""
     t = AISI4340_TABLE3
     return JohnsonCook(A=t["A_Pa"], B=t["B_Pa"], n=t["n"], C=t["C"], m=t["m"], eps_dot_0=float(eps_dot_0),
-                       T_room=t["T_room_K"], T_melt=t["T_melt_K"], cp=t["cp_J_kgK"], chi=t["taylor_quinney"])
+                       T_room=t["T_room_K"], T_melt=t["T_melt_K"], cp=t["cp_J_kgK"], chi=t["taylor_quinney"],
+                       heating=heating)
 
 
 # ----------------------------------------------------------------------------- time averages

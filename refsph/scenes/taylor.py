@@ -26,6 +26,8 @@ half a spacing at each end; diameter D = 2 (max r + dr/2), r = sqrt(x^2 + y^2) (
 """
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 
 from ..boundaries import MirrorPlanes, RigidWall
@@ -125,7 +127,7 @@ def _default_dp(dim, quick):
 def _build(dim, dp, quick, *, T_melt, symmetry, eps_dot_0, heating, layout, speed_factor):
     g = TAYLOR_GEOMETRY
     mat = taylor_material()
-    jc = taylor_johnson_cook(T_melt, eps_dot_0)
+    jc = dataclasses.replace(taylor_johnson_cook(T_melt, eps_dot_0), heating=bool(heating))
     if not isinstance(symmetry, (bool, np.bool_)):         # strings are converted by Scene.setup
         raise ValueError(f"option symmetry must be True or False, got {symmetry!r}")
     symmetry = bool(symmetry)
@@ -150,7 +152,7 @@ def _build(dim, dp, quick, *, T_melt, symmetry, eps_dot_0, heating, layout, spee
     fraction_inv = (4.0 if dim == 3 else 2.0) if symmetry else 1.0     # whole body / model
     m_total = float(np.sum(state.m)) * fraction_inv
     return Setup(state=state, material=mat, dp=dp, numerics=numerics, t_end=t_end, n_snapshots=10,
-                 strength=jc, heating=bool(heating), mirror=mirror, walls=(wall,), snapshot_times=(15e-6, 30e-6),
+                 strength=jc, mirror=mirror, walls=(wall,), snapshot_times=(15e-6, 30e-6),
                  info=dict(dr=dr, dz=dz, symmetry=symmetry, length0=g["length_m"], diameter0=g["diameter_m"],
                            v0=v0, mass_per_model=float(np.sum(state.m)),
                            mass_full_body=m_total, model_fraction_inverse=fraction_inv,

@@ -162,15 +162,14 @@ def _build(dim, dp, quick, *, case, material, vc, tu, n_tu, travel, length, mass
     tool_mat = TOOL_CARBIDE_RLA
     tool = make_state(xt, [-vc, 0.0], tool_mat["rho"], dx * dx, T0=T0, body=np.full(len(xt), TOOL_BODY))
     numerics = Numerics(h_over_dp=1.3, kernel="wendland", integrator="leapfrog", courant=0.3, beta1=0.5, beta2=0.5)
-    thermal = None
+    thermal = friction_heat = None
     if parse_bool(conduction, "option conduction"):
         loss = SurfaceLoss(**RLA_SURFACE_LOSS, T_ambient=T0, detector=detector, alpha_radius=1.3 * dx)
-        thermal = Conduction(k=mat["k_W_mK"], cp=mat["cp_J_kgK"] / s, courant=0.3,
+        thermal = Conduction(k=mat["k_W_mK"], courant=0.3,
                              tools={TOOL_BODY: (tool_mat["k_W_mK"], tool_mat["cp_J_kgK"])},
                              fixed=tuple(int(k) for k in np.concatenate([held, work.n + np.flatnonzero(tool_held)])),
-                             T_fixed=T0, loss=loss,
-                             friction_heat=FrictionHeat(eta=CONTACT_RLA["friction_work_to_heat"],
-                                                        chip_fraction=float(chip_fraction)))
+                             T_fixed=T0, loss=loss)
+        friction_heat = FrictionHeat(eta=CONTACT_RLA["friction_work_to_heat"], chip_fraction=float(chip_fraction))
     mu = CoulombFriction(mu0=mat["mu0"], q=mat["q_friction"], T_room=T0, T_melt=mat["T_melt_K"])
     info = dict(case=int(case), material=material, vc_m_s=vc, tu_m=tu, dx=dx, length_m=nx * dx, height_m=ny * dx,
                 y0=y0, n_work=work.n, n_tool=tool.n, travel_m=travel * tu, mass_scale=s,
@@ -181,7 +180,7 @@ def _build(dim, dp, quick, *, case, material, vc, tu, n_tu, travel, length, mass
                  dp=dx, numerics=numerics, t_end=travel * tu / vc, n_snapshots=8, info=info,
                  strength=_strength(mat, s), rigid=(RigidBody("tool", TOOL_BODY, (-vc, 0.0)),),
                  clamps=(Clamp("held", held),), friction=mu if parse_bool(friction, "option friction") else None,
-                 thermal=thermal)
+                 thermal=thermal, friction_heat=friction_heat)
 
 
 def rake_frame(x: np.ndarray, t: float, info: dict) -> tuple[np.ndarray, np.ndarray]:

@@ -21,7 +21,7 @@ from .notebook import repository_root
 
 __all__ = ["chapter_files", "execute_chapter", "executed_path", "build_book"]
 
-CONF = '''# Sphinx configuration of the refsph book (written by refsph.book; edit refsph/book.py)
+CONF = '''# Sphinx configuration of the refsph book (written by refsph.teaching.book; edit refsph/teaching/book.py)
 project = "refsph: SPH for metal machining, chapter by chapter"
 author = "refsph contributors"
 extensions = ["myst_nb"]
@@ -50,7 +50,7 @@ def executed_path(chapter: Path) -> Path:
 def execute_chapter(chapter: Path, quick: bool = True, timeout: int = 600, figures: Path | None = None):
     """Run one chapter as a notebook (jupytext + nbclient) in its own kernel; returns (notebook, seconds) and
     writes the executed notebook to ``build/executed/``. ``figures``: where its figures go (default: the
-    chapter's build folder, see :mod:`refsph.notebook`)."""
+    chapter's build folder, see :mod:`refsph.teaching.notebook`)."""
     import jupytext
     import nbclient
     import nbformat

@@ -21,9 +21,9 @@ from typing import Callable
 
 import numpy as np
 
-from .material import ElasticMaterial, eos_pressure, jaumann_deviatoric_rate
-from .plasticity import J2Plasticity, equivalent_strain_rate
-from .strength import plastic_update
+from ..material import ElasticMaterial, eos_pressure, jaumann_deviatoric_rate
+from ..plasticity import J2Plasticity, equivalent_strain_rate
+from ..strength import plastic_update
 
 __all__ = ["material_point"]
 
@@ -42,9 +42,8 @@ def _step(S, rho, eps_p, T, l, dt, mat: ElasticMaterial, jc: J2Plasticity | None
     def ret(S_trial, rho_):
         if jc is None:
             return S_trial, 0.0, 0.0, 0.0
-        S_n, _, deps, dw, dT = plastic_update(S_trial, Szz, eps_p, T, np.array([rho_]), eps_dot, jc, mat.G,
-                                              heating=heating)
-        return S_n, float(deps[0]), float(dw[0]), float(dT[0])
+        S_n, _, deps, dw, dT = plastic_update(S_trial, Szz, eps_p, T, np.array([rho_]), eps_dot, jc, mat.G)
+        return S_n, float(deps[0]), float(dw[0]), float(dT[0]) if heating else 0.0
 
     rho_half = rho * np.exp(-0.5 * dt * tr)
     S_half, _, _, _ = ret(S + 0.5 * dt * rates(S), rho_half)

@@ -1,6 +1,6 @@
 """What every chapter needs before its first equation, in one call (chapters/ are lessons, not reports):
 
-    from refsph.notebook import chapter
+    from refsph.teaching.notebook import chapter
     ch = chapter("05_contact")      # ch.quick, ch.save(fig, "name.png"), ch.tmp, ch.elapsed()
 
 * **Quick mode.** ``REFSPH_QUICK=1`` (the tests, the book) makes every chapter run in under a minute;
@@ -28,7 +28,7 @@ FIELD_CMAP = "viridis"
 
 def repository_root() -> Path:
     """The refsph checkout (the folder holding chapters/ and figures/)."""
-    return Path(__file__).resolve().parent.parent
+    return Path(__file__).resolve().parents[2]
 
 
 @dataclass

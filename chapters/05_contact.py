@@ -562,6 +562,9 @@ assert o["face"].min() < 0.0
 # * **No frictional heat**, and no heat flow into the tool.
 # * **Resolution.** The pinball radius, the washboard and the ESPH stand-off all scale with $\Delta p$: a particle
 #   wall is a surface only to within a fraction of a spacing.
+# * **Sliding.** On a row of tool particles the pinball's resistance to sliding is set by the row's geometry and
+#   the step, not by $\mu$. The continuation, `05_penalty_contact`, shows it on a tilted plane with a closed form
+#   and writes the alternative of `refsph.penalty`: a penalty force on the tool's exact geometry (issue 22).
 #
 # ## Your turn
 #

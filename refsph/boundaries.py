@@ -192,13 +192,16 @@ class RigidBody:
 
     ``body`` must be a positive id (0 is the workpiece); its particles must come after every deformable
     particle in the state (the solvers work on the leading deformable rows as one block) and start with the
-    velocity of this motion (:meth:`velocity_at`)."""
+    velocity of this motion (:meth:`velocity_at`). ``shape``: its exact boundary for the penalty contact
+    (:class:`refsph.penalty.RoundedPolygon`, relative to the centroid of its particles; None: the body is its
+    particles, as the pinball contact sees it)."""
 
     name: str
     body: int
     velocity: tuple
     angular_velocity: float | tuple = 0.0
     centre: tuple | None = None
+    shape: object = None
 
     def __post_init__(self):
         if isinstance(self.body, bool) or not isinstance(self.body, (int, np.integer)) or self.body < 1:
@@ -232,6 +235,9 @@ class RigidBody:
                              f"3-vector in 3D, got {self.angular_velocity!r}")
         if self.centre is not None and len(self.centre) != d:
             raise ValueError(f"rigid body {self.name!r}: centre has {len(self.centre)} components, the state is {d}D")
+        if self.shape is not None and (d != 2 or self.rotates):
+            raise ValueError(f"rigid body {self.name!r}: a shape (the penalty contact's geometry) is implemented for "
+                             "2D tools that translate")
 
     def _omega3(self) -> np.ndarray:
         w = np.asarray(self.angular_velocity, dtype=float)

@@ -1,5 +1,6 @@
 """How the bodies of a TLSPH run meet: the pinball contact (Eqs. (32)-(36), :mod:`refsph.contact`) between the
-deformable rows and the rigid tools, and between every two deformable bodies.
+deformable rows and the rigid tools, and between every two deformable bodies (:class:`PinballCoupling`); or the
+penalty contact on the tools' exact geometry (:mod:`refsph.penalty`, :class:`PenaltyCoupling`).
 
 :class:`PinballCoupling` is the part of the TLSPH solver (:mod:`refsph.solvers`) that knows which rows meet which:
 the deformable rows [0, n) against the rigid rows [n, N) (a rigid partner: m_b = mu_b = inf), and each pair of
@@ -11,11 +12,15 @@ from __future__ import annotations
 
 import numpy as np
 
+from scipy.spatial import cKDTree
+
 from . import contact as _contact
+from .boundaries import RigidBody
 from .contact import ContactResult, PinballContact
+from .penalty import PenaltyContact, penalty_contact
 from .state import State
 
-__all__ = ["PinballCoupling"]
+__all__ = ["PinballCoupling", "PenaltyCoupling"]
 
 
 def _check_dt(dt) -> None:
@@ -79,3 +84,72 @@ class PinballCoupling:
         if several_bodies:
             out["pinball_contacts_between_bodies_last_step"] = self.n_body_contacts
         return out
+
+
+class PenaltyCoupling:
+    """The penalty contact (:mod:`refsph.penalty`) of the deformable rows [0, n) with every rigid body that has a
+    ``shape``: the forces from the exact geometry, the reaction spread over the body's rows in proportion to their
+    mass (their sum is the force on the body), the friction power deposited on the deformable particle and on the
+    body's particle nearest to it (each contact's power counted once on each side, as the pinball does). The
+    tangential history xi of the last evaluation is committed at the end of the step (:meth:`commit`)."""
+
+    def __init__(self, contact: PenaltyContact, rigid: tuple[RigidBody, ...]):
+        if not rigid or any(b.shape is None for b in rigid):
+            raise ValueError("the penalty contact needs the exact geometry of every rigid body (RigidBody.shape, a "
+                             "refsph.penalty.RoundedPolygon); use the pinball contact for bodies made of particles")
+        self.contact, self.rigid = contact, tuple(rigid)
+        self.xi: np.ndarray | None = None                  # committed tangential history (n, d)
+        self.trial: np.ndarray | None = None               # the last evaluation's
+        self.max_penetration = 0.0
+        self.n_contacts = 0
+
+    def with_tools(self, state: State, n: int, dt: float) -> ContactResult:
+        """The contact of the deformable rows [0, n) with the rigid bodies for a step dt (a ContactResult: the
+        deformable rows' acceleration, the force on each rigid row, the friction power on both sides)."""
+        _check_dt(dt)
+        d = state.dim
+        if self.xi is None or self.xi.shape != (n, d):
+            self.xi = np.zeros((n, d))
+        x, v, m = state.x[:n], state.v[:n], state.m[:n]
+        T = None if state.T is None else state.T[:n]
+        a, power_a = np.zeros((n, d)), np.zeros(n)
+        force_b, power_b = np.zeros((state.n - n, d)), np.zeros(state.n - n)
+        trial, contacts, deepest = np.zeros((n, d)), 0, 0.0
+        for b in self.rigid:
+            rows = np.flatnonzero(state.body == b.body)
+            c = penalty_contact(x, v, m, T, b.shape, state.x[rows].mean(axis=0), np.asarray(b.velocity), dt,
+                                self.contact, self.xi)
+            a += c.a
+            trial += c.xi
+            power_a += c.friction_power
+            mb = state.m[rows]
+            force_b[rows - n] = c.force_on_tool[None, :] * (mb / mb.sum())[:, None]
+            hot = np.flatnonzero(c.friction_power > 0)
+            if len(hot):
+                _, near = cKDTree(state.x[rows]).query(x[hot])
+                np.add.at(power_b, rows[near] - n, c.friction_power[hot])
+            contacts += int(np.count_nonzero(c.gap > 0))
+            deepest = max(deepest, float(c.gap.max(initial=0.0)))
+        self.trial = trial
+        self.max_penetration = max(self.max_penetration, deepest)
+        self.n_contacts = contacts
+        return ContactResult(a=a, force_on_b=force_b, n_contacts=contacts, max_penetration=deepest,
+                             friction_power_a=power_a, friction_power_b=power_b)
+
+    def commit(self) -> None:
+        """The step ended: its last evaluation's tangential history becomes the committed one."""
+        if self.trial is not None:
+            self.xi, self.trial = self.trial, None
+
+    def checkpoint(self) -> dict:
+        ck = dict(max_penetration=np.float64(self.max_penetration), n_contacts=np.int64(self.n_contacts))
+        if self.xi is not None:
+            ck["penalty_xi"] = self.xi.copy()
+        return ck
+
+    def restore(self, ck: dict) -> None:
+        self.max_penetration, self.n_contacts = float(ck["max_penetration"]), int(ck["n_contacts"])
+        self.xi = np.array(ck["penalty_xi"]) if "penalty_xi" in ck else None
+
+    def diagnostics(self, several_bodies: bool) -> dict:
+        return {"max_penalty_penetration_m": self.max_penetration, "penalty_contacts_last_step": self.n_contacts}

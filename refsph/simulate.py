@@ -33,6 +33,7 @@ import numpy as np
 
 from . import __version__
 from .contact import PinballContact
+from .penalty import PenaltyContact
 from .esph import ESPHParams
 from .integrate import PARTS, SelfAdvancing, Solver, Step, StepPhysics, Stepper, cfl_time_step, make_stepper
 from .stability import warnings_for
@@ -84,6 +85,8 @@ def make_solver(method: str, setup: Setup) -> Solver:
         prm = ESPHParams(h=h, dp=setup.dp, beta1=nm.beta1, beta2=nm.beta2, gamma=nm.gamma, n_ap=nm.n_ap,
                          eps=nm.eps, kernel=kernel, correction=bool(nm.esph_correction))
         return ESPHSolver(setup.material, prm, skin_factor=nm.skin_factor, **common)
+    if nm.contact not in ("pinball", "penalty"):
+        raise ValueError(f"Numerics.contact must be 'pinball' or 'penalty', got {nm.contact!r}")
     if method == "tlsph":
         if nm.esph_correction:
             raise ValueError("esph_correction is an ESPH option; TLSPH's kernel-gradient correction is 'corrected'")
@@ -93,7 +96,11 @@ def make_solver(method: str, setup: Setup) -> Solver:
         contact = None
         if setup.friction is not None and not setup.rigid:
             raise ValueError("friction acts in the contact with rigid bodies, and this setup has none")
-        if setup.rigid or len(_deformable_bodies(setup)) > 1:
+        if nm.contact == "penalty" and setup.rigid:
+            contact = PenaltyContact(alpha=nm.penalty_alpha, damping=nm.penalty_damping, offset=0.5 * setup.dp,
+                                     time_scale=nm.courant * h / setup.material.c_longitudinal,
+                                     friction=setup.friction)
+        elif setup.rigid or len(_deformable_bodies(setup)) > 1:
             k = nm.contact_k if nm.contact_k is not None else setup.dp / (2.0 * h)
             contact = PinballContact(k=k, K_p=nm.contact_Kp, friction=setup.friction)
         return TLSPHSolver(setup.material, prm, contact=contact, dp=setup.dp, **common)

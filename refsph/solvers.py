@@ -24,10 +24,11 @@ import numpy as np
 
 from .boundaries import Constraints, Ghosts, MirrorPlanes
 from .contact import PinballContact
-from .coupling import PinballCoupling
+from .coupling import PenaltyCoupling, PinballCoupling
 from .esph import ESPHParams, esph_rates
 from .material import ElasticMaterial, eos_pressure
 from .neighbours import PairBlocks, VerletList, check_threads
+from .penalty import PenaltyContact
 from .reference import ReferenceConfiguration, with_identity
 from .state import Rates, State
 from .strength import Elastic, StrengthModel, check_strength_fields, strength_stage
@@ -212,20 +213,26 @@ class TLSPHSolver(SolverBase):
     """TLSPH rates with a fixed sparse operator, rebuilt at reference-configuration updates
     (:class:`~refsph.reference.ReferenceConfiguration`). With symmetry planes the ghosts are the mirror images of
     the reference configuration (fixed with the operator); a ghost's F is the mirror image of its source's. With
-    rigid bodies the operator covers the deformable rows only, and the bodies meet through the pinball ``contact``
-    (:class:`~refsph.coupling.PinballCoupling`; ``dp`` gives the 2D force per unit thickness)."""
+    rigid bodies the operator covers the deformable rows only, and the bodies meet through the ``contact``: the
+    pinball (a :class:`~refsph.contact.PinballContact`, :class:`~refsph.coupling.PinballCoupling`; ``dp`` gives the
+    2D force per unit thickness) or, with the tools, the penalty contact on their exact geometry (a
+    :class:`~refsph.penalty.PenaltyContact`, :class:`~refsph.coupling.PenaltyCoupling`)."""
 
     method = "tlsph"
     evolved = ("x", "v", "S", "S_zz")
 
     def __init__(self, material: ElasticMaterial, params: TLSPHParams, *, strength: StrengthModel | None = None,
                  mirror: MirrorPlanes | None = None, walls=(), rigid=(), clamps=(),
-                 contact: PinballContact | None = None, dp: float | None = None, threads: int = 1):
+                 contact: PinballContact | PenaltyContact | None = None, dp: float | None = None, threads: int = 1):
         super().__init__(material, params, strength, mirror, Constraints(walls, rigid, clamps, mirror), threads)
         if self.constraints.rigid and contact is None:
-            raise ValueError("TLSPH with rigid bodies needs a contact model (PinballContact)")
+            raise ValueError("TLSPH with rigid bodies needs a contact model (PinballContact or PenaltyContact)")
         self.contact = contact
-        self.coupling = None if contact is None else PinballCoupling(contact, contact.k * params.h, material.G, dp)
+        if isinstance(contact, PenaltyContact):
+            self.coupling = PenaltyCoupling(contact, self.constraints.rigid)
+        else:
+            self.coupling = None if contact is None else PinballCoupling(contact, contact.k * params.h, material.G,
+                                                                         dp)
         self.reference = ReferenceConfiguration(params, mirror, self.threads)
 
     @property
@@ -244,7 +251,7 @@ class TLSPHSolver(SolverBase):
         (Eq. (2)) and refuses a state whose rho says otherwise (an initial pressure it would silently drop). J is
         1 in the reference configuration (every x = X) and det F of the operator otherwise."""
         self.check_common(state)
-        if self.several_bodies and self.contact is None:
+        if self.several_bodies and not isinstance(self.contact, PinballContact):
             raise ValueError(f"deformable bodies {self.constraints.deformable_bodies} meet only through the pinball "
                              "contact: give the solver a PinballContact (refsph.simulate.make_solver does)")
         if self.contact is not None and self.contact.friction is not None and state.T is None:
@@ -317,6 +324,8 @@ class TLSPHSolver(SolverBase):
         """rho = m / (J V0) (Eq. (2)); reference update when max |E| > ref_update_strain
         (:meth:`~refsph.reference.ReferenceConfiguration.end_step`)."""
         self._body(state)
+        if isinstance(self.coupling, PenaltyCoupling):
+            self.coupling.commit()                          # the step's tangential history (stick / slip)
         return self.reference.end_step(state, self.constraints.n_deformable, self.several_bodies)
 
     def own_checkpoint(self) -> dict:

@@ -59,7 +59,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .kernels import Kernel
-from .neighbours import PairSum, find_pairs
+from .neighbours import PairSum, VerletList, find_pairs
 from .surface import surface_alpha_shape, surface_sph
 
 __all__ = ["laplacian", "conduction_rate", "thermal_time_step", "advance_at_rest", "Conduction", "SurfaceLoss",
@@ -226,14 +226,15 @@ def conduct(state, model: Conduction, h: float, kernel: Kernel, dt: float, cp: f
 
 def thermal_step(state, model: Conduction | None, k: np.ndarray, c: np.ndarray, h: float, kernel: Kernel,
                  dt: float, friction_heat: FrictionHeat | None = None, friction_power: np.ndarray | None = None,
-                 tool_rows: np.ndarray | None = None) -> tuple[np.ndarray, dict]:
+                 tool_rows: np.ndarray | None = None, pairs: tuple | None = None) -> tuple[np.ndarray, dict]:
     """One explicit step dt of Eq. (29) with the harmonic-mean conductivity between materials (module text; ``k``,
     ``c``: per row, :func:`coefficients`; ``model`` None: no conduction), the frictional heat (``friction_power``:
     (N,) [W] per row, as the tool contact leaves it in ``Rates.friction_power``; split by ``friction_heat``:
     ``chip_fraction`` to the rows not in ``tool_rows``, the rest to the tool rows), the surface loss, then the fixed
     rows reset. Pairs are found in the current configuration, across bodies (heat flows from the chip into a
-    conducting tool). Returns (T, heat) with heat = {'friction', 'lost', 'removed'} [J; per metre of thickness in
-    2D] moved in the step."""
+    conducting tool); ``pairs``: the half pairs within the support, sorted by I then J, if the caller has them
+    (:class:`HeatFlow` keeps a Verlet list). Returns (T, heat) with heat = {'friction', 'lost', 'removed'} [J; per
+    metre of thickness in 2D] moved in the step."""
     n, d = state.x.shape
     V = state.m / state.rho
     mc = state.m * c
@@ -241,7 +242,7 @@ def thermal_step(state, model: Conduction | None, k: np.ndarray, c: np.ndarray, 
     dT = np.zeros(n)
     pairs = None
     if model is not None:
-        I, J, fr = _pairs_and_fr(state.x, h, kernel)
+        I, J, fr = _pairs_and_fr(state.x, h, kernel, pairs)
         pairs = (I, J)
         kk = k[I] + k[J]
         k_ij = np.divide(2.0 * k[I] * k[J], kk, out=np.zeros_like(kk), where=kk > 0)
@@ -268,6 +269,7 @@ def thermal_step(state, model: Conduction | None, k: np.ndarray, c: np.ndarray, 
 
 
 LEDGER = ("plastic", "friction", "lost", "removed")
+SKIN = 0.3                                  # the heat step's Verlet skin, in units of h
 
 
 class HeatFlow:
@@ -287,6 +289,7 @@ class HeatFlow:
         self.h, self.kernel, self.rigid_ids = h, kernel, tuple(rigid_ids)
         self.ledger = {k: 0.0 for k in LEDGER}
         self.k = self.c = self.mc = self.T0 = self.tool_rows = None
+        self.pairs = VerletList(kernel.support * h, SKIN * h)   # the heat step's pair search (module text)
         self.rho_of_return_map = "start"
 
     def bind(self, state, solver) -> None:
@@ -320,11 +323,23 @@ class HeatFlow:
         self.ledger["plastic"] += self.plastic_heat(before, after)
         power = step.rates.friction_power if step.rates is not None else None
         T, moved = thermal_step(after, self.conduction, self.k, self.c, self.h, self.kernel, dt, self.friction_heat,
-                                power, self.tool_rows)
+                                power, self.tool_rows, self.pairs_within_support(after.x))
         for key, val in moved.items():
             self.ledger[key] += val
         after.T = T
         return after
+
+    def pairs_within_support(self, x: np.ndarray) -> tuple | None:
+        """The half pairs within the kernel's support, sorted by I then J: those of a Verlet list (cutoff the
+        support, a skin of ``SKIN`` h, rebuilt when a particle has moved half the skin) that lie within the
+        support now. The same list, in the same order, as a fresh search (:func:`refsph.neighbours.find_pairs`),
+        so the same sums to the bit, without a k-d tree every step. None without conduction (no pairs needed)."""
+        if self.conduction is None:
+            return None
+        I, J = self.pairs.update(x)
+        d = x[I] - x[J]
+        keep = np.einsum("pk,pk->p", d, d) <= self.pairs.cutoff ** 2
+        return I[keep], J[keep]
 
     def balance(self, state) -> dict:
         """The heat ledger [J; per metre of thickness in 2D]: made (plastic, friction), stored (sum m c (T - T0)),

@@ -32,8 +32,11 @@ class Numerics:
     spacing); contact_Kp: the pinball scaling factor K_p (Eq. (33)); threads: threads that share the pair sums
     (0 = one per available core); integrator: the time stepper (:data:`refsph.integrate.STEPPERS`); esph_correction:
     ESPH's normalised velocity gradient (:mod:`refsph.esph`; off: Eq. (23) as printed); hourglass: TLSPH hourglass
-    control coefficient (Ganzenmueller 2015, :mod:`refsph.tlsph`; 0 = off, as in the paper). The numbers of a run
-    do not depend on ``threads``, only its speed does.
+    control coefficient (Ganzenmueller 2015, :mod:`refsph.tlsph`; 0 = off, as in the paper); contact: the TLSPH
+    contact with rigid tools, 'pinball' (Eqs. (32)-(36), the paper's) or 'penalty' (:mod:`refsph.penalty`, on the
+    tools' exact geometry, ``RigidBody.shape``); penalty_alpha: the penalty stiffness alpha m / dt^2 (the fraction of
+    the penetration removed per step); penalty_damping: the damping ratio of the penalty's normal spring. The
+    numbers of a run do not depend on ``threads``, only its speed does.
     """
 
     h_over_dp: float = 1.5
@@ -53,6 +56,9 @@ class Numerics:
     integrator: str = "predictor_corrector"
     esph_correction: bool = False
     hourglass: float = 0.0
+    contact: str = "pinball"
+    penalty_alpha: float = 0.1
+    penalty_damping: float = 0.5
 
 
 def numerics_field_optional(name: str) -> bool:

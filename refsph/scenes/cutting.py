@@ -43,7 +43,7 @@ from ..boundaries import Clamp, RigidBody
 from ..paper_data import CUTTING_GEOMETRY, CUTTING_OBSERVED, CUTTING_TABLE5
 from ..state import concatenate_states, make_state
 from .base import Numerics, Scene, Setup
-from .measure import (N_FORCE_BINS, TOOL_BODY, aisi4340_johnson_cook, aisi4340_material, binned_mean,
+from .measure import (N_FORCE_BINS, TOOL_BODY, aisi4340_johnson_cook, aisi4340_material, binned_mean, box_outline,
                       block_lattice, time_mean)
 
 __all__ = ["SCENE", "cutting_particles", "chip_thickness", "lattice_shape", "shear_bands", "cutting_metrics",
@@ -100,7 +100,7 @@ def _build(dim, dp, quick, *, feed, travel, eps_dot_0):
                  n_snapshots=8, info=dict(n_work=work.n, n_tool=tool.n, dx=dx, dy=dy, feed_m=float(feed), y0=y0,
                                           tool_layers=layers, travel_m=float(travel), tool_speed_m_s=speed,
                                           eps_dot_0=float(eps_dot_0)),
-                 strength=jc, rigid=(RigidBody("tool", TOOL_BODY, (-speed, 0.0)),),
+                 strength=jc, rigid=(RigidBody("tool", TOOL_BODY, (-speed, 0.0), shape=box_outline(xt, dx, dy)),),
                  clamps=(Clamp("held", clamp),))
 
 

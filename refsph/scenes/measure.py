@@ -9,6 +9,7 @@ import numpy as np
 from ..material import ElasticMaterial, eos_pressure, von_mises
 from ..neighbours import find_pairs
 from ..paper_data import AISI4340_TABLE3
+from ..penalty import RoundedPolygon
 from ..plasticity import JohnsonCook
 from ..state import State
 
@@ -46,6 +47,15 @@ def aisi4340_material() -> ElasticMaterial:
     elastic test scenes)."""
     t = AISI4340_TABLE3
     return ElasticMaterial(rho0=t["rho"], E=t["E_Pa"], nu=t["nu"])
+
+
+def box_outline(x: np.ndarray, dx: float, dy: float) -> RoundedPolygon:
+    """The exact outline of a rectangular tool made of lattice particles x (a block, or only its surface layers),
+    for the penalty contact (``Numerics.contact = 'penalty'``): the sharp rectangle the particles fill (their faces
+    dx/2 and dy/2 beyond the outer centres), relative to the particles' centroid (``RigidBody.shape``)."""
+    lo, hi = x.min(axis=0) - [0.5 * dx, 0.5 * dy], x.max(axis=0) + [0.5 * dx, 0.5 * dy]
+    rect = [[lo[0], lo[1]], [hi[0], lo[1]], [hi[0], hi[1]], [lo[0], hi[1]]]
+    return RoundedPolygon.from_polygon(rect, 0.0, x.mean(axis=0))
 
 
 def aisi4340_johnson_cook(eps_dot_0: float, heating: bool = True) -> JohnsonCook:

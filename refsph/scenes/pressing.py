@@ -49,7 +49,7 @@ from ..paper_data import PRESSING_GEOMETRY, PRESSING_RESOLUTIONS_M, PRESSING_TAB
 from ..state import concatenate_states, make_state
 from .base import Numerics, Scene, Setup
 from .measure import (N_FORCE_BINS, TOOL_BODY, aisi4340_johnson_cook, aisi4340_material, binned_mean,
-                      block_lattice, kinetic_energy, time_mean)
+                      block_lattice, box_outline, kinetic_energy, time_mean)
 
 __all__ = ["SCENE", "pressing_particles", "pressing_table"]
 
@@ -105,7 +105,8 @@ def _build(dim, dp, quick, *, travel, eps_dot_0, speed_factor):
     return Setup(state=state, material=mat, dp=dx, numerics=numerics, t_end=t_end, n_snapshots=10,
                  info=dict(n_block=block.n, n_tool=tool.n, dx=dx, dy=dy, tool_layers=layers,
                            travel_m=float(travel), tool_speed_m_s=speed),
-                 arrays=dict(line_index=line), strength=jc, rigid=(RigidBody("tool", TOOL_BODY, (-speed, 0.0)),),
+                 arrays=dict(line_index=line), strength=jc,
+                 rigid=(RigidBody("tool", TOOL_BODY, (-speed, 0.0), shape=box_outline(xt, dx, dy)),),
                  clamps=(Clamp("left_side", clamp),), snapshot_times=tuple(t_end * np.array([0.25, 0.5, 0.75])))
 
 

@@ -61,6 +61,7 @@ from ..material import ElasticMaterial
 from ..paper_data import (AISI1045_RLA, CONTACT_RLA, RLA_SURFACE_LOSS, TI6AL4V_RLA, TOOL_CARBIDE_RLA,
                           rla_cutting_case)
 from ..plasticity import JohnsonCook, ModifiedJohnsonCook
+from ..penalty import RoundedPolygon
 from ..state import concatenate_states, make_state
 from ..thermal import Conduction, FrictionHeat, SurfaceLoss
 from .base import Numerics, Scene, Setup, parse_bool
@@ -112,6 +113,19 @@ def tool_particles(dx: float, tu: float, apex) -> tuple[np.ndarray, np.ndarray]:
     x = apex[0] + u * math.sin(g) + w * math.cos(g)
     y = apex[1] + u * math.cos(g) - w * math.sin(g)
     return np.stack([x, y], axis=1), held
+
+
+def tool_shape(tu: float, apex, centroid) -> RoundedPolygon:
+    """The tool's exact outline for the penalty contact (``Numerics.contact = 'penalty'``): in the rake-face
+    coordinates of :func:`tool_particles` the polygon (0, 0), (5 tu, 0), (5 tu, 3 tu), (3 tu / tan(beta), 3 tu)
+    (rake face w = 0, flank at the wedge angle beta, the held top and back faces), every corner rounded by the
+    edge radius (the cutting edge's 10 um; the far corners alike), placed with the edge at ``apex``; ``centroid``:
+    that of the tool's particles."""
+    g, beta = math.radians(RAKE_DEG), math.radians(90.0 - RAKE_DEG - CLEARANCE_DEG)
+    uw = np.array([[0.0, 0.0], [5 * tu, 0.0], [5 * tu, 3 * tu], [3 * tu / math.tan(beta), 3 * tu]])
+    x = apex[0] + uw[:, 0] * math.sin(g) + uw[:, 1] * math.cos(g)
+    y = apex[1] + uw[:, 0] * math.cos(g) - uw[:, 1] * math.sin(g)
+    return RoundedPolygon.from_polygon(np.stack([x, y], axis=1), EDGE_RADIUS, centroid)
 
 
 def _case_values(case, material, vc, tu):
@@ -176,9 +190,10 @@ def _build(dim, dp, quick, *, case, material, vc, tu, n_tu, travel, length, mass
                 inertia_ratio=s * mat["rho"] * vc * vc / mat["A_Pa"], rake_deg=RAKE_DEG, clearance_deg=CLEARANCE_DEG,
                 edge_radius_m=EDGE_RADIUS, apex0=[nx * dx, y0], detector=detector, chip_fraction=float(chip_fraction),
                 A_Pa=mat["A_Pa"], measured=row)
+    body = RigidBody("tool", TOOL_BODY, (-vc, 0.0), shape=tool_shape(tu, (nx * dx, y0), xt.mean(axis=0)))
     return Setup(state=concatenate_states(work, tool), material=ElasticMaterial(s * mat["rho"], mat["E_Pa"], mat["nu"]),
                  dp=dx, numerics=numerics, t_end=travel * tu / vc, n_snapshots=8, info=info,
-                 strength=_strength(mat, s), rigid=(RigidBody("tool", TOOL_BODY, (-vc, 0.0)),),
+                 strength=_strength(mat, s), rigid=(body,),
                  clamps=(Clamp("held", held),), friction=mu if parse_bool(friction, "option friction") else None,
                  thermal=thermal, friction_heat=friction_heat)
 

@@ -1,0 +1,91 @@
+"""Where a thermomechanical cutting step spends its time (issue 22, part 5): cProfile over the first t_u of cut of
+case 1 at the scene's default resolution (t_u / 5, 2,584 particles), grouped by the piece of the method each
+function belongs to.
+
+    python benchmarks/profile_cutting.py                      # about a minute; prints the table
+    python benchmarks/profile_cutting.py --set contact=penalty --json /tmp/p.json
+    python benchmarks/profile_cutting.py --quick              # the quick scene (a few hundred particles)
+
+The groups are the modules of refsph (refsph.thermal: conduction and the heat step; refsph.surface: the free-surface
+detector; refsph.neighbours: pair search and pair sums; refsph.tlsph / reference: the TLSPH rates and the
+operator; refsph.contact / penalty / coupling: the tool contact; ...), by each function's own time (tottime), with
+the functions of NumPy, SciPy and Python charged to the refsph function that called them.
+"""
+from __future__ import annotations
+
+import cProfile
+import json
+import pstats
+import sys
+import time
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))      # benchmarks/study.py, however this file is loaded
+import study  # noqa: E402
+
+study.pin_threads()
+
+from refsph.scenes.base import parse_bool  # noqa: E402
+from refsph.simulate import run  # noqa: E402
+
+OPTIONS = dict(case=1, travel=1.0)
+
+
+def group_of(filename: str) -> str | None:
+    """The refsph module of a profiled function (None: not refsph's)."""
+    path = Path(filename)
+    if "refsph" not in path.parts:
+        return None
+    return ".".join(path.parts[path.parts.index("refsph"):]).removesuffix(".py")
+
+
+def charged_times(stats: pstats.Stats) -> dict:
+    """Each refsph module's time: its functions' own time plus that of the non-refsph functions they call (each
+    callee's time split among its refsph callers in proportion to the calls)."""
+    out: dict[str, float] = {}
+    for (fname, _, _), (_, _, tottime, _, callers) in stats.stats.items():
+        own = group_of(fname)
+        if own is not None:
+            out[own] = out.get(own, 0.0) + tottime
+            continue
+        refsph_callers = {k: v for k, v in callers.items() if group_of(k[0]) is not None}
+        total = sum(v[0] for v in refsph_callers.values())
+        for (cname, _, _), v in refsph_callers.items():
+            out[group_of(cname)] = out.get(group_of(cname), 0.0) + tottime * v[0] / total
+    return out
+
+
+def main(argv=None) -> int:
+    ap = study.parser(__doc__, "quick")
+    ap.add_argument("--set", action="append", default=[], metavar="NAME=VALUE", help="a Numerics field")
+    ap.add_argument("--json", type=Path, default=None, help="also write the table as JSON here")
+    args = ap.parse_args(argv)
+    numerics = dict(threads=1)
+    for item in args.set:
+        name, value = item.split("=", 1)
+        numerics[name] = value if not value.replace(".", "", 1).isdigit() else float(value)
+        if value.lower() in ("true", "false"):
+            numerics[name] = parse_bool(value, name)
+    prof = cProfile.Profile()
+    t0 = time.perf_counter()
+    prof.enable()
+    res = run("thermal_cutting", "tlsph", quick=args.quick, progress=False, options=OPTIONS, numerics=numerics)
+    prof.disable()
+    wall = time.perf_counter() - t0
+    times = charged_times(pstats.Stats(prof))
+    total = sum(times.values())
+    steps, n = res.summary["n_steps"], res.summary["n_particles"]
+    rows = [[k, study.fmt(v, ".2f"), study.fmt(100 * v / total, ".1f")] for k, v in
+            sorted(times.items(), key=lambda kv: -kv[1]) if v > 0.005 * total]
+    print(study.md_table(["module", "s", "%"], rows))
+    print(f"\n{steps} steps, {n} particles, {wall:.1f} s wall (profiled): {1e6 * wall / (steps * n):.2f} us per "
+          f"particle-step; numerics {numerics}")
+    if args.json:
+        args.json.write_text(json.dumps(dict(numerics=numerics, options=OPTIONS, quick=args.quick, n_steps=steps,
+                                             n_particles=n,
+                                             wall_s=wall, seconds=times), indent=1) + "\n")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -82,6 +82,7 @@ from ..io import json_ready
 from ..kernels import get_kernel
 from ..neighbours import find_pairs
 from ..paper_data import AISI1045_RLA
+from ..penalty import PenaltyContact, RoundedPolygon, penalty_contact
 from ..plasticity import ModifiedJohnsonCook
 from ..scenes import aisi4340_johnson_cook, aisi4340_material, get_scene, lattice
 from ..simulate import run, simulate
@@ -401,6 +402,48 @@ def _surface_case(root):
                   counts=dict(particles=len(x), surface_sph=int(sph.sum()), surface_alpha=int(alpha_shape.sum())))
 
 
+def _penalty_friction_case(root):
+    """The penalty contact (refsph.penalty, issue 22) of particles around a cutting edge: a wedge rounded by 20 um,
+    particles inside and outside the core and the fillet, sliding and sticking, hot and cold, with a random
+    committed tangential history."""
+    rng = np.random.default_rng(22)
+    wedge = [[0.0, 0.0], [1e-3, 0.0], [1e-3, 0.6e-3], [0.25e-3, 0.6e-3]]
+    tool = RoundedPolygon.from_polygon(wedge, 20e-6, [0.5e-3, 0.3e-3])
+    n = 40
+    x = np.stack([rng.uniform(-40e-6, 60e-6, n), rng.uniform(-40e-6, 60e-6, n)], axis=1)
+    v = rng.normal(0.0, 2.0, (n, 2))
+    m = np.full(n, 7850.0 * 1e-10)
+    T = rng.uniform(293.0, 1900.0, n)
+    xi = rng.normal(0.0, 8e-6, (n, 2))                          # some within the cone, some beyond it
+    t = AISI1045_RLA
+    law = CoulombFriction(mu0=t["mu0"], q=t["q_friction"], T_room=t["T_room_K"], T_melt=t["T_melt_K"])
+    contact = PenaltyContact(alpha=0.1, damping=0.5, offset=5e-6, time_scale=2e-9, friction=law)
+    shift, V, dt = np.array([0.5e-3, 0.3e-3]), np.array([-1.0, 0.0]), 1.5e-9
+    c = penalty_contact(x, v, m, T, tool, shift, V, dt, contact, xi)
+    out = dict(gap=c.gap, a=c.a, force_on_tool=c.force_on_tool, friction_power=c.friction_power, xi=c.xi,
+               f_normal=c.f_normal, f_tangent=c.f_tangent)
+    units = dict(x="m", v="m/s", m="kg/m", T="K", xi_in="m", core="m", radius="m", shift="m", V="m/s", dt="s",
+                 alpha="1", damping="1", offset="m", time_scale="s", mu0="1", q="1", T_room="K", T_melt="K",
+                 gap="m", a="m/s^2", force_on_tool="N/m", friction_power="W/m", xi="m", f_normal="N/m",
+                 f_tangent="N/m")
+    on = c.gap > 0
+    return _write(root, "penalty_friction", "penalty contact on a rounded wedge (exact geometry) with Coulomb "
+                  "friction mu(T) as a return map on a tangential spring: particles in the core, on the faces and "
+                  "around the fillet, sticking and sliding", "refsph/penalty.py (issue 22); mu(T) of the second "
+                  "paper's Eqs. (10)-(11)",
+                  dict(x=x, v=v, m=m, T=T, xi_in=xi, core=np.asarray(tool.core), radius=np.float64(tool.radius),
+                       shift=shift, V=V, dt=np.float64(dt), alpha=np.float64(contact.alpha),
+                       damping=np.float64(contact.damping), offset=np.float64(contact.offset),
+                       time_scale=np.float64(contact.time_scale), mu0=np.float64(law.mu0), q=np.float64(law.q),
+                       T_room=np.float64(law.T_room), T_melt=np.float64(law.T_melt)),
+                  out, units, {k: 1e-12 for k in out}, "closed forms per particle: round-off only",
+                  counts=dict(particles=n, in_contact=int(on.sum()),
+                              sliding=int(np.count_nonzero(c.friction_power > 0))),
+                  conventions="core vertices relative to shift (the tool particles' centroid), counter-clockwise; "
+                              "gap = offset + radius - (signed distance to the core); the history xi_in is projected "
+                              "on the tangent plane before v_t dt is added; see refsph/penalty.py")
+
+
 def _pinball_friction_case(root):
     dp = 1e-4
     h = 1.5 * dp
@@ -577,7 +620,7 @@ def _registry() -> list[tuple[tuple[str, ...], object]]:
               (("return_map_johnson_cook", "return_map_modified"), _return_map_cases), (("pinball",), _pinball_case),
               (steps + runs, _step_and_run_cases), (("conduction",), _conduction_case),
               (("surface_notch",), _surface_case), (("pinball_friction",), _pinball_friction_case),
-              (leapfrog, _leapfrog_cases)]
+              (leapfrog, _leapfrog_cases), (("penalty_friction",), _penalty_friction_case)]
     for key in METRIC_RUNS:
         for method in ("esph", "tlsph"):
             groups.append(((f"metrics_{key}_{method}",), lambda root, k=key, m=method: _metric_case(root, k, m)))

@@ -427,6 +427,14 @@ def _penalty_friction_case(root):
                  gap="m", a="m/s^2", force_on_tool="N/m", friction_power="W/m", xi="m", f_normal="N/m",
                  f_tangent="N/m")
     on = c.gap > 0
+    tau = contact.time_scale                                # the stick/slip switch: |k xi*| against mu f_N
+    nrm = np.where(on[:, None], tool.gap(x, shift)[1], 0.0)
+    vt = (v - V) - np.einsum("nd,nd->n", v - V, nrm)[:, None] * nrm
+    xi_trial = xi - np.einsum("nd,nd->n", xi, nrm)[:, None] * nrm + vt * dt
+    f_trial = contact.alpha * m / tau ** 2 * np.linalg.norm(xi_trial, axis=1)
+    limit = law.mu(T) * c.f_normal
+    rubbing = on & (limit > 0)
+    margin = float(np.min(np.abs(f_trial[rubbing] / limit[rubbing] - 1.0))) if rubbing.any() else None
     return _write(root, "penalty_friction", "penalty contact on a rounded wedge (exact geometry) with Coulomb "
                   "friction mu(T) as a return map on a tangential spring: particles in the core, on the faces and "
                   "around the fillet, sticking and sliding", "refsph/penalty.py (issue 22); mu(T) of the second "
@@ -439,6 +447,7 @@ def _penalty_friction_case(root):
                   out, units, {k: 1e-12 for k in out}, "closed forms per particle: round-off only",
                   counts=dict(particles=n, in_contact=int(on.sum()),
                               sliding=int(np.count_nonzero(c.friction_power > 0))),
+                  margins=dict(trial_friction_over_mu_f_normal_to_1=margin),
                   conventions="core vertices relative to shift (the tool particles' centroid), counter-clockwise; "
                               "gap = offset + radius - (signed distance to the core); the history xi_in is projected "
                               "on the tangent plane before v_t dt is added; see refsph/penalty.py")

@@ -102,6 +102,13 @@ class PenaltyCoupling:
         self.trial: np.ndarray | None = None               # the last evaluation's
         self.max_penetration = 0.0
         self.n_contacts = 0
+        self.rows: list | None = None                      # each body's rows (State.body is fixed in a run)
+
+    def body_rows(self, state: State) -> list:
+        """The rows of each rigid body (found once: a run's State.body does not change)."""
+        if self.rows is None:
+            self.rows = [np.flatnonzero(state.body == b.body) for b in self.rigid]
+        return self.rows
 
     def with_tools(self, state: State, n: int, dt: float) -> ContactResult:
         """The contact of the deformable rows [0, n) with the rigid bodies for a step dt (a ContactResult: the
@@ -115,8 +122,7 @@ class PenaltyCoupling:
         a, power_a = np.zeros((n, d)), np.zeros(n)
         force_b, power_b = np.zeros((state.n - n, d)), np.zeros(state.n - n)
         trial, contacts, deepest = np.zeros((n, d)), 0, 0.0
-        for b in self.rigid:
-            rows = np.flatnonzero(state.body == b.body)
+        for b, rows in zip(self.rigid, self.body_rows(state)):
             c = penalty_contact(x, v, m, T, b.shape, state.x[rows].mean(axis=0), np.asarray(b.velocity), dt,
                                 self.contact, self.xi)
             a += c.a

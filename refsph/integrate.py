@@ -156,8 +156,9 @@ class StepPhysics(Protocol):
     """Physics beside the mechanics (heat now: :class:`refsph.thermal.HeatFlow`), called by the run loop in this
     order: ``bind(state, solver)`` once at the start; every step ``step_limit(state)`` (the largest stable step,
     inf for none), then after the mechanical step ``advance(before, step, dt)`` -> the state with this physics'
-    fields advanced; ``record(state)`` -> scalars for the history; ``summary(state)`` -> entries of summary.json;
-    ``checkpoint()`` -> arrays and ``restore(arrays)`` for a restart."""
+    fields advanced; ``record(state)`` -> scalars for the history; ``describe()`` -> what summary.json says of the
+    model (under ``name``), ``summary(state)`` -> entries of summary.json as they stand; ``checkpoint()`` -> arrays
+    and ``restore(arrays)`` for a restart."""
 
     name: str
 
@@ -168,6 +169,8 @@ class StepPhysics(Protocol):
     def advance(self, before: State, step: Step, dt: float) -> State: ...
 
     def record(self, state: State) -> dict: ...
+
+    def describe(self) -> dict: ...
 
     def summary(self, state: State) -> dict: ...
 

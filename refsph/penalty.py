@@ -152,7 +152,8 @@ class PenaltyResult:
     """One evaluation: ``a`` (N, d) the contact acceleration of each particle; ``force_on_tool`` (d,) the reaction
     on the tool (the sum of -f over the particles); ``friction_power`` (N,) [W; 2D: W/m] the power each particle's
     return map dissipates; ``xi`` (N, d) the trial tangential history (what the step commits); ``gap`` (N,) the
-    penetration depth (<= 0: no contact); ``f_normal`` (N,) and ``f_tangent`` (N, d) the contact forces."""
+    penetration depth (<= 0: no contact); ``f_normal`` (N,) and ``f_tangent`` (N, d) the contact forces;
+    ``f_trial`` (N, d) the trial (stick) tangential force -k xi* that the return map started from."""
 
     a: np.ndarray
     force_on_tool: np.ndarray
@@ -161,11 +162,13 @@ class PenaltyResult:
     gap: np.ndarray
     f_normal: np.ndarray
     f_tangent: np.ndarray
+    f_trial: np.ndarray
 
 
 def return_map_friction(xi_trial: np.ndarray, k: np.ndarray, f_limit: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Coulomb's return map on the tangential spring (module text): (f_t, xi) from the trial history xi* (N, d),
-    the stiffness k (N,) and the limit mu f_N (N,): stick if |k xi*| <= mu f_N, else slip back to the cone."""
+    the stiffness k (N,) and the limit mu f_N (N,): stick if |k xi*| <= mu f_N, else slip back to the cone. The
+    trial force is -k xi*."""
     f_trial = -k[:, None] * xi_trial
     norm = np.linalg.norm(f_trial, axis=1)
     slip = norm > f_limit
@@ -196,6 +199,7 @@ def penalty_contact(x: np.ndarray, v: np.ndarray, m: np.ndarray, T: np.ndarray |
     fN = np.where(on, np.maximum(k * g - beta * m * vn / tau, 0.0), 0.0)
     f = fN[:, None] * np.where(on[:, None], n, 0.0)
     f_t = np.zeros((n_p, d))
+    f_trial = np.zeros((n_p, d))
     power = np.zeros(n_p)
     xi_new = np.zeros((n_p, d))
     if contact.friction is not None and np.any(on):
@@ -206,8 +210,9 @@ def penalty_contact(x: np.ndarray, v: np.ndarray, m: np.ndarray, T: np.ndarray |
         vt = vr - vn[:, None] * nn
         xi_trial = np.where(on[:, None], xi_p + vt * dt, 0.0)
         f_t, xi_new = return_map_friction(xi_trial, k, contact.friction.mu(T) * fN)
+        f_trial = -k[:, None] * xi_trial
         slipped = np.linalg.norm(xi_trial, axis=1) - np.linalg.norm(xi_new, axis=1)
         power = np.linalg.norm(f_t, axis=1) * np.maximum(slipped, 0.0) / dt
         f = f + f_t
     return PenaltyResult(a=f / m[:, None], force_on_tool=-f.sum(axis=0), friction_power=power, xi=xi_new, gap=g,
-                         f_normal=fN, f_tangent=f_t)
+                         f_normal=fN, f_tangent=f_t, f_trial=f_trial)

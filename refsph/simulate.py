@@ -245,7 +245,7 @@ class RunRecord:
                             friction=(dataclasses.asdict(setup.friction) if setup.friction is not None else None)),
             scene_info=setup.info, snapshot_times=[float(t) for t in self.times], refsph_version=__version__,
             provenance=provenance(solver.threads), status="running", metrics={},
-            **{p.name: json_ready(p.describe()) for p in self.parts.physics if hasattr(p, "describe")})
+            **{p.name: json_ready(p.describe()) for p in self.parts.physics})
 
     def record(self, state: State) -> None:
         values = self.record_fn(state, self.setup) if self.record_fn is not None else {}

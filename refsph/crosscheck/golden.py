@@ -427,11 +427,7 @@ def _penalty_friction_case(root):
                  gap="m", a="m/s^2", force_on_tool="N/m", friction_power="W/m", xi="m", f_normal="N/m",
                  f_tangent="N/m")
     on = c.gap > 0
-    tau = contact.time_scale                                # the stick/slip switch: |k xi*| against mu f_N
-    nrm = np.where(on[:, None], tool.gap(x, shift)[1], 0.0)
-    vt = (v - V) - np.einsum("nd,nd->n", v - V, nrm)[:, None] * nrm
-    xi_trial = xi - np.einsum("nd,nd->n", xi, nrm)[:, None] * nrm + vt * dt
-    f_trial = contact.alpha * m / tau ** 2 * np.linalg.norm(xi_trial, axis=1)
+    f_trial = np.linalg.norm(c.f_trial, axis=1)             # the stick/slip switch: |f*| against mu f_N
     limit = law.mu(T) * c.f_normal
     rubbing = on & (limit > 0)
     margin = float(np.min(np.abs(f_trial[rubbing] / limit[rubbing] - 1.0))) if rubbing.any() else None

@@ -56,12 +56,7 @@ def incline(theta: float, mu: float, *, mass_scale: float, contact: str, dx: flo
     mat = ElasticMaterial(rho0=7850.0 * mass_scale, E=200e9, nu=0.3)
     block = make_state(lattice([nx * dx, ny * dx], dx), [0.0, 0.0], mat.rho0, dx * dx, T0=293.0)
     y0 = block.x[:, 1].min() - 0.5 * dx                                   # the block's bottom face: the plane
-    xs = (np.arange(-2 * nx, 3 * nx + 1) + 0.5) * dx
-    row = np.stack([xs, np.full(len(xs), y0 - 0.5 * dx)], axis=1)        # the tool's top row (faces at y0)
-    plane = make_state(row, [0.0, 0.0], mat.rho0, dx * dx, T0=293.0, body=np.full(len(xs), PLANE_BODY))
-    outline = [[xs[0] - 0.5 * dx, y0 - dx], [xs[-1] + 0.5 * dx, y0 - dx], [xs[-1] + 0.5 * dx, y0],
-               [xs[0] - 0.5 * dx, y0]]
-    tool = RigidBody("plane", PLANE_BODY, (0.0, 0.0), shape=RoundedPolygon.from_polygon(outline, 0.0, row.mean(0)))
+    plane, tool = _plane_under((np.arange(-2 * nx, 3 * nx + 1) + 0.5) * dx, y0, dx, mat.rho0)
     friction = CoulombFriction(mu0=mu, q=1.0, T_room=293.0, T_melt=1800.0) if mu > 0 else None
     setup = Setup(state=concatenate_states(block, plane), material=mat, dp=dx, t_end=t_end, n_snapshots=1,
                   rigid=(tool,), friction=friction,
@@ -101,13 +96,14 @@ def sliding(history: dict, t: np.ndarray, v: np.ndarray) -> dict:
     return dict(a=sliding_acceleration(t, v), mu_eff=float(np.sum(F[:, 0] * dt) / -np.sum(F[:, 1] * dt)))
 
 
-def _plane_under(y0: float, x_lo: float, x_hi: float, dx: float, rho: float):
-    """A tool whose top face is y = y0 over [x_lo, x_hi]: one row of particles under it (centres dx/2 below) and
-    its outline (a slab one spacing deep): (state, RigidBody)."""
-    xs = np.arange(x_lo + 0.5 * dx, x_hi, dx)
+def _plane_under(xs: np.ndarray, y0: float, dx: float, rho: float):
+    """A rigid plane whose top face is y = y0 under the particle columns ``xs``: one row of tool particles (centres
+    dx/2 below the face, for the reaction and the pinball) and its outline (a slab one spacing deep, from the first
+    column's left face to the last one's right face, for the penalty contact): (state, RigidBody)."""
     row = np.stack([xs, np.full(len(xs), y0 - 0.5 * dx)], axis=1)
     plane = make_state(row, [0.0, 0.0], rho, dx * dx, T0=293.0, body=np.full(len(xs), PLANE_BODY))
-    outline = [[x_lo, y0 - dx], [x_hi, y0 - dx], [x_hi, y0], [x_lo, y0]]
+    lo, hi = xs[0] - 0.5 * dx, xs[-1] + 0.5 * dx
+    outline = [[lo, y0 - dx], [hi, y0 - dx], [hi, y0], [lo, y0]]
     return plane, RigidBody("plane", PLANE_BODY, (0.0, 0.0),
                             shape=RoundedPolygon.from_polygon(outline, 0.0, row.mean(0)))
 
@@ -127,7 +123,8 @@ def strip_impact(*, length: float, width: float, dx: float, v0: float, contact: 
     mat = ElasticMaterial(rho0=7850.0, E=200e9, nu=0.0)
     nx, ny = round(width / dx), round(length / dx)
     strip = make_state(lattice([nx * dx, ny * dx], dx), [0.0, -v0], mat.rho0, dx * dx, T0=293.0)
-    plane, tool = _plane_under(strip.x[:, 1].min() - 0.5 * dx, -nx * dx, 2 * nx * dx, dx, mat.rho0)
+    plane, tool = _plane_under(np.arange(-nx * dx + 0.5 * dx, 2 * nx * dx, dx), strip.x[:, 1].min() - 0.5 * dx, dx,
+                               mat.rho0)
     t_c = 2.0 * ny * dx / bar_speed(mat)
     setup = Setup(state=concatenate_states(strip, plane), material=mat, dp=dx, t_end=1.5 * t_c, n_snapshots=1,
                   rigid=(tool,), numerics=Numerics(contact=contact, integrator=integrator, beta1=0.5, beta2=0.5,

@@ -62,6 +62,8 @@ def main(argv=None) -> int:
     args = ap.parse_args(argv)
     numerics = dict(threads=1)
     for item in args.set:
+        if "=" not in item:
+            ap.error(f"--set takes NAME=VALUE (a Numerics field), got {item!r}")
         name, value = item.split("=", 1)
         numerics[name] = value if not value.replace(".", "", 1).isdigit() else float(value)
         if value.lower() in ("true", "false"):

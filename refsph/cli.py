@@ -88,6 +88,9 @@ def main(argv=None) -> int:
         except subprocess.CalledProcessError as e:
             print(f"refsph: writing the golden cases failed ({e})", file=sys.stderr)
             return 2
+        except ValueError as e:
+            print(f"refsph: {e}", file=sys.stderr)
+            return 2
         print(f"{len(names)} golden cases in {args.dir}: {', '.join(names)}")
         return 0
     if args.cmd == "compare":

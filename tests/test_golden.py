@@ -214,3 +214,18 @@ def test_export_vtk(tmp_path):
     m = meshio.read(tmp_path / "vtk" / "snap_00010.vtu")
     assert m.points.shape[1] == 3 and {"x", "v", "S", "F", "id", "p"} <= set(m.point_data)
     assert m.point_data["S"].shape[1] == 9
+
+
+def test_oracle_refuses_a_folder_it_did_not_write_and_names_bad_patterns(tmp_path, capsys):
+    """refsph oracle empties what it writes into, so it refuses a non-empty folder without a golden index.json
+    (nothing there is touched) and says which pattern matches no case, with no traceback."""
+    from refsph.cli import main
+    mine = tmp_path / "mine"
+    mine.mkdir()
+    (mine / "notes.txt").write_text("keep me")
+    assert main(["oracle", str(mine), "--only", "pinball"]) == 2
+    assert "not a golden-case directory" in capsys.readouterr().err
+    assert (mine / "notes.txt").read_text() == "keep me" and len(list(mine.iterdir())) == 1
+    assert main(["oracle", str(tmp_path / "new"), "--only", "no_such_case"]) == 2
+    err = capsys.readouterr().err
+    assert "no golden case matches no_such_case" in err and "Traceback" not in err

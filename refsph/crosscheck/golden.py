@@ -679,11 +679,22 @@ def _check_pinned() -> None:
                            "cases would depend on this CPU")
 
 
-def _write_cases(root: Path, only=None) -> list[str]:
-    _check_pinned()
+def _check_target(root: Path, only=None) -> set:
+    """The cases to write (ValueError naming the patterns if none match), after refusing a directory that holds
+    anything but golden cases: writing empties it (or the chosen cases' folders), and refsph deletes only what it
+    wrote (a golden directory has its index.json)."""
     chosen = set(case_names(only))
     if not chosen:
         raise ValueError(f"no golden case matches {' '.join(only)} (the cases: {', '.join(case_names())})")
+    if root.exists() and (not root.is_dir() or (any(root.iterdir()) and not (root / "index.json").is_file())):
+        raise ValueError(f"{root} exists and is not a golden-case directory (no index.json): refsph oracle writes "
+                         "into a new or empty directory, or one it wrote before")
+    return chosen
+
+
+def _write_cases(root: Path, only=None) -> list[str]:
+    _check_pinned()
+    chosen = _check_target(root, only)
     if only is None and root.exists():
         shutil.rmtree(root)
     for name in chosen:
@@ -709,6 +720,7 @@ def write_golden_cases(directory, only=None) -> list[str]:
     child process with :func:`pinned_environment` (module text: the bytes do not depend on the CPU)."""
     if os.environ.get(CHILD) == "1":
         return _write_cases(Path(directory), only)
+    _check_target(Path(directory), only)                   # bad input is said here, not in the child's traceback
     cmd = [sys.executable, "-m", "refsph.crosscheck.golden", str(directory)] + (["--only", *only] if only else [])
     subprocess.run(cmd, env=pinned_environment(), check=True)
     return case_names(only)

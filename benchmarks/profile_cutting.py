@@ -58,8 +58,17 @@ def charged_times(stats: pstats.Stats) -> dict:
 def main(argv=None) -> int:
     ap = study.parser(__doc__, "quick")
     ap.add_argument("--set", action="append", default=[], metavar="NAME=VALUE", help="a Numerics field")
+    ap.add_argument("--option", action="append", default=[], metavar="NAME=VALUE",
+                    help="a scene option besides case=1, travel=1 (e.g. n_tu=10)")
+    ap.add_argument("--top", type=int, default=0, help="also list the N refsph functions that cost most")
     ap.add_argument("--json", type=Path, default=None, help="also write the table as JSON here")
     args = ap.parse_args(argv)
+    options = dict(OPTIONS)
+    for item in args.option:
+        if "=" not in item:
+            ap.error(f"--option takes NAME=VALUE (a scene option), got {item!r}")
+        name, value = item.split("=", 1)
+        options[name] = value
     numerics = dict(threads=1)
     for item in args.set:
         if "=" not in item:
@@ -71,7 +80,7 @@ def main(argv=None) -> int:
     prof = cProfile.Profile()
     t0 = time.perf_counter()
     prof.enable()
-    res = run("thermal_cutting", "tlsph", quick=args.quick, progress=False, options=OPTIONS, numerics=numerics)
+    res = run("thermal_cutting", "tlsph", quick=args.quick, progress=False, options=options, numerics=numerics)
     prof.disable()
     wall = time.perf_counter() - t0
     times = charged_times(pstats.Stats(prof))
@@ -80,10 +89,13 @@ def main(argv=None) -> int:
     rows = [[k, study.fmt(v, ".2f"), study.fmt(100 * v / total, ".1f")] for k, v in
             sorted(times.items(), key=lambda kv: -kv[1]) if v > 0.005 * total]
     print(study.md_table(["module", "s", "%"], rows))
+    if args.top:
+        print()
+        pstats.Stats(prof).sort_stats("cumulative").print_stats(r"refsph", args.top)
     print(f"\n{steps} steps, {n} particles, {wall:.1f} s wall (profiled): {1e6 * wall / (steps * n):.2f} us per "
           f"particle-step; numerics {numerics}")
     if args.json:
-        args.json.write_text(json.dumps(dict(numerics=numerics, options=OPTIONS, quick=args.quick, n_steps=steps,
+        args.json.write_text(json.dumps(dict(numerics=numerics, options=options, quick=args.quick, n_steps=steps,
                                              n_particles=n,
                                              wall_s=wall, seconds=times), indent=1) + "\n")
     return 0

@@ -40,44 +40,75 @@ import numpy as np  # noqa: E402
 
 ROOT = Path(__file__).resolve().parent.parent
 OUT_JSON = ROOT / "benchmarks" / "thermal_cutting.json"
+BEFORE_JSON = ROOT / "benchmarks" / "thermal_cutting_pinball_tu5.json"   # issue 19's sweep: pinball, t_u/5, 8 t_u
 REPORT = ROOT / "benchmarks" / "thermal_cutting_report.md"
 RUNS = ROOT / "runs" / "thermal_cutting"
 FIG = ROOT / "figures"
-SCALING = (0.25, 1.0, 4.0, 16.0)           # factors on the default mass scale (case 1)
-RESOLUTION = (4.0, 7.0)                    # particles across t_u besides the default 5 (case 1)
+N_TU, TRAVEL = 10.0, 16.0                  # the sweep: dx = t_u / 10, 16 t_u of cut (means over the last quarter)
+INERTIA = 0.01                             # the mass-scaling rule: s rho vc^2 = 0.01 A (module text)
 KEEP = ("cutting_force_N_per_m", "passive_force_N_per_m", "force_ratio", "rake_face_temperature_K",
         "rake_face_temperature_max_K", "free_chip_surface_temperature_K", "chip_thickness_mm", "contact_length_mm",
         "max_temperature_K", "max_plastic_strain", "tool_work_J_per_m", "cut_length_mm", "mass_scale",
-        "inertia_ratio", "width_matching_Fc_mm", "measured")
+        "inertia_ratio", "width_matching_Fc_mm", "drift_last_quarter", "measured")
 
 
-def jobs(scaling: bool, detector: bool, only=None, resolution: bool = False) -> dict:
-    """{key: scene options} of the runs asked for."""
-    from refsph.paper_data import AISI1045_RLA, rla_cutting_case
-    from refsph.scenes.thermal_cutting import mass_scale_for
-    if scaling:
-        s1 = mass_scale_for(AISI1045_RLA, rla_cutting_case(1)["vc_m_per_min"] / 60.0, 0.01)
-        return {f"scaling {f:g}": dict(case=1, mass_scale=f * s1) for f in SCALING if f != 1.0}
-    if detector:
-        return {"detector alpha": dict(case=1, detector="alpha")}
-    if resolution:
-        return {f"resolution {n:g}": dict(case=1, n_tu=n) for n in RESOLUTION}
-    return {f"case {n}": dict(case=n) for n in range(1, 19) if only is None or n in only}
+def converged(case: int, **more) -> dict:
+    """The sweep's options for a case: dx = t_u / N_TU, TRAVEL t_u of cut on a workpiece 1.25 TRAVEL t_u long."""
+    from refsph.paper_data import rla_cutting_case
+    tu = rla_cutting_case(case)["tu_mm"] * 1e-3
+    return dict(dict(case=case, n_tu=N_TU, travel=TRAVEL, length=1.25 * TRAVEL * tu), **more)
 
 
-QUICK = dict(length=1.2e-3, travel=4.0)       # --quick: chapter 11's short cut at the quick resolution
+def _s(case: int) -> float:
+    from refsph.scenes.thermal_cutting import MATERIALS, mass_scale_for
+    from refsph.paper_data import rla_cutting_case
+    row = rla_cutting_case(case)
+    return mass_scale_for(MATERIALS[row["material"]], row["vc_m_per_min"] / 60.0, INERTIA)
 
 
-def run_case(key: str, options: dict, quick: bool = False) -> dict:
+STUDY_NAMES = ("cases", "scaling", "scatter", "resolution", "tool", "contact")
+
+
+def jobs(studies=STUDY_NAMES, only=None) -> dict:
+    """{key: (scene options, Numerics overrides)} of the runs asked for, in the order they run (a sweep that spans
+    sessions does the informative ones first: case 1 and what tests its numerics, then the 18 cases, then the
+    long resolution checks). ``only``: case numbers (the 'cases' study)."""
+    todo = {}
+
+    def add(study_name, key, options, numerics=None):
+        if study_name in studies and (study_name != "cases" or only is None or options["case"] in only):
+            todo[key] = (options, dict(numerics or {}))
+    add("cases", "case 1", converged(1))
+    add("scaling", "case 1 s/2", converged(1, mass_scale=_s(1) / 2))
+    add("cases", "case 10", converged(10))
+    add("scaling", "case 10 s/2", converged(10, mass_scale=_s(10) / 2))
+    for seed in (1, 2, 3):
+        add("scatter", f"case 1 jitter {seed}", converged(1, jitter=0.01, seed=seed))
+    add("resolution", "case 1 n_tu 5", converged(1, n_tu=5.0))
+    add("resolution", "case 10 n_tu 5", converged(10, n_tu=5.0))
+    for n in list(range(2, 10)) + list(range(11, 19)):
+        add("cases", f"case {n}", converged(n))
+    add("tool", "case 1 tool x2", converged(1, tool_length=10.0, tool_depth=6.0))
+    add("contact", "case 1 pinball", converged(1), dict(contact="pinball"))
+    add("contact", "case 1 all friction heat to the chip", converged(1, chip_fraction=1.0))
+    add("resolution", "case 1 n_tu 15", converged(1, n_tu=15.0))
+    add("resolution", "case 10 n_tu 15", converged(10, n_tu=15.0))
+    return todo
+
+
+QUICK = dict(length=1.2e-3, travel=4.0, n_tu=5.0)   # --quick: chapter 11's short cut at the quick resolution
+
+
+def run_case(key: str, options: dict, numerics: dict, quick: bool = False) -> dict:
     """One run (continued from its checkpoint if an earlier attempt was killed); its record."""
     from refsph.simulate import SimulationError, run
-    out = RUNS / (key.replace(" ", "_") + ("_quick" if quick else ""))
+    out = RUNS / (key.replace(" ", "_").replace("/", "") + ("_quick" if quick else ""))
     restart = (out / "snapshots" / "restart.npz").exists()
     t0 = time.perf_counter()
-    rec = dict(key=key, options=options, quick=quick)
+    rec = dict(key=key, options=options, numerics=numerics, quick=quick)
     try:
         res = run("thermal_cutting", "tlsph", out=out, progress=False, restart=restart, quick=quick,
-                  options=dict(options, **(QUICK if quick else {})), numerics=dict(threads=1))
+                  options=dict(options, **(QUICK if quick else {})), numerics=dict(numerics, threads=1))
         s = res.summary
     except SimulationError as e:
         s = json.loads((out / "summary.json").read_text())
@@ -184,30 +215,46 @@ def _f(v, fmt: str) -> str:
     return "-" if v is None or (isinstance(v, float) and not math.isfinite(v)) else format(v, fmt)
 
 
-def report(res: dict) -> str:
-    """The page, from the records alone; its prose is benchmarks/templates/thermal_cutting_report.md."""
+def report(res: dict, before: dict | None = None) -> str:
+    """The page, from the records alone (``before``: issue 19's pinball sweep, ``BEFORE_JSON``, for its mean errors);
+    its prose is benchmarks/templates/thermal_cutting_report.md."""
+    if before is None and BEFORE_JSON.exists():
+        before = json.loads(BEFORE_JSON.read_text())
     P, rows = study.Page("thermal_cutting_report"), comparison(res)
-    lines = [P("head")] + [_case_line(r) for r in rows] + ["", P("mean_errors")]
+    old = comparison(before) if before else None
+    done = [r for r in rows if r["status"] == "ok"]
+    lines = [P("head", n_tu=f"{N_TU:g}", travel=f"{TRAVEL:g}", inertia=f"{100 * INERTIA:g}", done=len(done))]
+    lines += [_case_line(r) for r in rows] + ["", P("mean_errors")]
     for mat in ("AISI1045", "Ti6Al4V"):
         sel = [r for r in rows if r["material"] == mat]
+        was = [r for r in old if r["material"] == mat] if old else None
         ran = [r for r in sel if r["status"] == "ok"]
-        for q, name in (("TRF", "T_RF"), ("TFCS", "T_FCS"), ("ratio", "Fp/Fc")):
-            lines.append(f"| {mat} | {name} | {_f(_mean(sel, f'{q}_err'), '.1f')} | {_mean(sel, f'{q}_sph_err'):.1f} "
-                         f"| {_mean(sel, f'{q}_pfem_err'):.1f} | {len(ran)} of {len(sel)} |")
-        lines.append(f"| {mat} | T_RF, hottest contact particle | {_f(_mean(sel, 'TRFmax_err'), '.1f')} | | | |")
+        for q, name in (("TRF", "T_RF, contact mean"), ("TRFmax", "T_RF, hottest contact particle"),
+                        ("TFCS", "T_FCS"), ("ratio", "Fp/Fc")):
+            paper = ("", "") if q == "TRFmax" else (f"{_mean(sel, f'{q}_sph_err'):.1f}",
+                                                   f"{_mean(sel, f'{q}_pfem_err'):.1f}")
+            lines.append(f"| {mat} | {name} | {_f(_mean(sel, f'{q}_err'), '.1f')} | "
+                         f"{_f(_mean(was, f'{q}_err'), '.1f') if was else '-'} | {paper[0]} | {paper[1]} | "
+                         f"{len(ran)} of {len(sel)} |")
     lines += ["", P("forces")]
     for r in rows:
         lines.append(f"| {r['case']} | {_f(r['Fc_N_per_mm'], '.1f')} | {_f(r['Fp_N_per_mm'], '.1f')} | "
                      f"{r['Fc_exp']:.0f}, {r['Fp_exp']:.0f} | {_f(r['width_mm'], '.2f')} | {_f(r['chip_mm'], '.3f')} | "
-                     f"{_f(r['contact_mm'], '.3f')} | {_f(r['heat_residual'], '.1e')} | {_f(r['wall_s'], '.0f')} |")
+                     f"{_f(r['contact_mm'], '.3f')} | {_f(r['wall_s'], '.0f')} |")
+    lines += ["", P("steady")]
+    for r in rows:
+        v = _values(res["runs"][f"case {r['case']}"]) if r["status"] == "ok" else {}
+        lines.append(_row([(r["case"], "d")] + [(v.get(key), fmt) for _, key, fmt in STEADY_COLUMNS]))
     lines += ["", P("trends")]
     yes = {True: "yes", False: "no", None: "-"}
     for mat, t in trends(rows).items():
         lines.append(f"| {mat} | {yes[t['Fc_rises_with_tu']]} / {yes[t['Fc_exp_rises_with_tu']]} | "
                      f"{yes[t['TRF_rises_with_vc']]} / {yes[t['TRF_exp_rises_with_vc']]} |")
     lines += _study_lines(res)
-    done = [r for r in res["runs"].values() if r.get("wall_time_s")]
-    lines += ["", P("total", n=len(done), minutes=f"{sum(r['wall_time_s'] for r in done) / 60:.1f}"), ""]
+    todo = [k for k in jobs() if k not in res["runs"]]
+    recorded = [r for r in res["runs"].values() if r.get("wall_time_s")]
+    lines += ["", P("total", n=len(recorded), minutes=f"{sum(r['wall_time_s'] for r in recorded) / 60:.1f}",
+                    todo=len(todo), keys=", ".join(f"'{k}'" for k in todo) or "none"), ""]
     return "\n".join(lines)
 
 
@@ -228,43 +275,92 @@ def _row(cells) -> str:
     return "| " + " | ".join(_f(v, fmt) for v, fmt in cells) + " |"
 
 
-def _case1_values(r: dict) -> dict:
-    """A case-1 study run's metrics with the derived columns of the study tables (and their sort keys)."""
+def _values(r: dict) -> dict:
+    """A run's metrics with the derived columns of the study tables: forces per mm, resolution, the drifts over the
+    last quarter, and where the tool's work went (heat ledger over the tool's work)."""
     m, hb = r.get("metrics") or {}, r.get("heat_balance") or {}
-    return dict(m, Fc=1e-3 * m.get("cutting_force_N_per_m", math.nan), dx_um=1e6 * r["dp"], across=1e-4 / r["dp"],
-                n_particles=r.get("n_particles"), n_steps=r.get("n_steps"), wall=r.get("wall_time_s"),
-                lost=hb.get("lost_J"), made=sum(hb.get(k, math.nan) for k in ("plastic_J", "friction_J")))
+    drift = m.get("drift_last_quarter") or {}
+    work = m.get("tool_work_J_per_m", math.nan)
+    out = dict(m, Fc=1e-3 * m.get("cutting_force_N_per_m", math.nan),
+               Fp=1e-3 * m.get("passive_force_N_per_m", math.nan), dx_um=1e6 * r["dp"],
+               across=r["scene_info"]["tu_m"] / r["dp"], n_particles=r.get("n_particles"), n_steps=r.get("n_steps"),
+               wall=r.get("wall_time_s"), lost=hb.get("lost_J"),
+               made=sum(hb.get(k, math.nan) for k in ("plastic_J", "friction_J", "dissipation_J")),
+               residual=hb.get("residual_rel"))
+    for key, name in (("cutting_force_N_per_m", "Fc"), ("passive_force_N_per_m", "Fp")):
+        out[f"{name}_drift_pct"] = 100.0 * drift.get(key, math.nan) / m.get(key, math.nan)
+    for key, name in (("rake_face_temperature_K", "TRF"), ("free_chip_surface_temperature_K", "TFCS")):
+        out[f"{name}_drift"] = drift.get(key, math.nan)
+    for key in ("plastic_J", "friction_J", "dissipation_J", "removed_J"):
+        out[f"{key[:-2]}_of_work"] = 100.0 * hb.get(key, math.nan) / work
+    out["made_of_work"] = 100.0 * out["made"] / work
+    return out
 
 
+STEADY_COLUMNS = (("Fc drift [%]", "Fc_drift_pct", ".1f"), ("Fp drift [%]", "Fp_drift_pct", ".1f"),
+                  ("T_RF drift [K]", "TRF_drift", ".0f"), ("T_FCS drift [K]", "TFCS_drift", ".0f"),
+                  ("plastic heat [% of work]", "plastic_of_work", ".1f"),
+                  ("friction heat [%]", "friction_of_work", ".1f"),
+                  ("viscosity + contact damping heat [%]", "dissipation_of_work", ".1f"),
+                  ("all heat made [%]", "made_of_work", ".1f"), ("removed at held faces [%]", "removed_of_work", ".1f"),
+                  ("ledger residual", "residual", ".0e"))
+BASIC = (("Fc [N/mm]", "Fc", ".1f"), ("Fp [N/mm]", "Fp", ".1f"), ("Fp/Fc", "force_ratio", ".3f"),
+         ("T_RF [K]", "rake_face_temperature_K", ".0f"), ("T_RF max [K]", "rake_face_temperature_max_K", ".0f"),
+         ("T_FCS [K]", "free_chip_surface_temperature_K", ".0f"), ("chip [mm]", "chip_thickness_mm", ".3f"),
+         ("contact [mm]", "contact_length_mm", ".3f"))
 STUDIES = (
-    ("Mass scaling (case 1)", lambda k: k.startswith("scaling") or k == "case 1", "mass_scale",
-     (("s", "mass_scale", ".0f"), ("s rho vc^2 / A", "inertia_ratio", ".4f"), ("Fc [N/mm]", "Fc", ".1f"),
-      ("Fp/Fc", "force_ratio", ".3f"), ("T_RF [K]", "rake_face_temperature_K", ".0f"),
-      ("T_FCS [K]", "free_chip_surface_temperature_K", ".0f"), ("chip [mm]", "chip_thickness_mm", ".3f"),
-      ("steps", "n_steps", "d"), ("wall [s]", "wall", ".0f"))),
-    ("Resolution (case 1)", lambda k: k.startswith("resolution") or k == "case 1", "across",
-     (("particles across t_u", "across", ".0f"), ("dx [um]", "dx_um", ".1f"), ("particles", "n_particles", "d"),
-      ("Fc [N/mm]", "Fc", ".1f"), ("Fp/Fc", "force_ratio", ".3f"), ("T_RF [K]", "rake_face_temperature_K", ".0f"),
-      ("T_RF max [K]", "rake_face_temperature_max_K", ".0f"),
-      ("T_FCS [K]", "free_chip_surface_temperature_K", ".0f"), ("chip [mm]", "chip_thickness_mm", ".3f"),
-      ("contact [mm]", "contact_length_mm", ".3f"), ("steps", "n_steps", "d"), ("wall [s]", "wall", ".0f"))),
-    ("Surface detector (case 1: SPH detector; alpha: the alpha-shape)",
-     lambda k: k in ("case 1", "detector alpha"), "lost",
-     (("Fc [N/mm]", "Fc", ".2f"), ("Fp/Fc", "force_ratio", ".4f"), ("T_RF [K]", "rake_face_temperature_K", ".1f"),
-      ("T_FCS [K]", "free_chip_surface_temperature_K", ".1f"), ("heat lost [J/m]", "lost", ".3e"),
-      ("heat made [J/m]", "made", ".3f"), ("wall [s]", "wall", ".0f"))),
+    ("Mass scaling: s halved (the rule's factor 0.01 A in s rho vc^2 = 0.01 A halved to 0.005 A)",
+     ("case 1", "case 1 s/2", "case 10", "case 10 s/2"),
+     (("s", "mass_scale", ".0f"), ("s rho vc^2 / A", "inertia_ratio", ".4f")) + BASIC
+     + (("viscosity + damping heat [% of work]", "dissipation_of_work", ".1f"), ("steps", "n_steps", "d"),
+        ("wall [s]", "wall", ".0f"))),
+    ("Run-to-run scatter: case 1 and three runs with the workpiece's particles moved at random by up to 0.01 dx",
+     ("case 1", "case 1 jitter 1", "case 1 jitter 2", "case 1 jitter 3"), BASIC),
+    ("Resolution (particles across t_u)",
+     ("case 1 n_tu 5", "case 1", "case 1 n_tu 15", "case 10 n_tu 5", "case 10", "case 10 n_tu 15"),
+     (("across t_u", "across", ".0f"), ("dx [um]", "dx_um", ".1f"), ("particles", "n_particles", "d")) + BASIC
+     + (("steps", "n_steps", "d"), ("wall [s]", "wall", ".0f"))),
+    ("Tool size (case 1: the tool 5 t_u x 3 t_u; x2: 10 t_u x 6 t_u, 1 mm x 0.6 mm)", ("case 1", "case 1 tool x2"),
+     BASIC + (("removed at held faces [% of work]", "removed_of_work", ".1f"),)),
+    ("Contact and heat split (case 1: penalty contact, half the frictional heat into the chip)",
+     ("case 1", "case 1 pinball", "case 1 all friction heat to the chip"),
+     BASIC + (("friction heat [% of work]", "friction_of_work", ".1f"),
+              ("viscosity + damping heat [% of work]", "dissipation_of_work", ".1f"))),
 )
 
 
+def scatter(res: dict) -> dict:
+    """Mean and sample standard deviation (percent of the mean) of each basic quantity over case 1 and its jittered
+    runs (those recorded ok)."""
+    runs = [res["runs"][k] for k in STUDIES[1][1] if k in res["runs"] and res["runs"][k]["status"] == "ok"]
+    out = {}
+    for _, key, _ in BASIC:
+        v = np.array([_values(r)[key] for r in runs], dtype=float)
+        if len(v) >= 2:
+            out[key] = dict(n=len(v), mean=float(v.mean()), std_pct=float(100 * v.std(ddof=1) / abs(v.mean())))
+    return out
+
+
 def _study_lines(res: dict) -> list[str]:
-    """The case-1 studies: mass scaling, resolution, surface detector (a row per recorded run)."""
+    """The studies: a row per recorded run (or 'to run'), and the scatter's spread."""
     runs, lines = res["runs"], []
-    for title, member, order, columns in STUDIES:
+    for title, keys, columns in STUDIES:
         lines += ["", f"## {title}", "", "| run | " + " | ".join(c[0] for c in columns) + " |",
                   "|---" * (len(columns) + 1) + "|"]
-        values = {k: _case1_values(runs[k]) for k in runs if member(k) and "dp" in runs[k]}   # not a crashed run
-        for k in sorted(values, key=lambda k: values[k].get(order) or 0.0):
-            lines.append(f"| {k} " + _row((values[k].get(key), fmt) for _, key, fmt in columns))
+        for k in keys:
+            r = runs.get(k)
+            if r is None or r.get("status") != "ok":
+                lines.append(f"| {k} | " + " | ".join(["-"] * (len(columns) - 1)
+                                                      + ["to run" if r is None else r["status"][:40]]) + " |")
+                continue
+            v = _values(r)
+            lines.append(f"| {k} " + _row((v.get(key), fmt) for _, key, fmt in columns))
+        if keys is STUDIES[1][1]:
+            sc = scatter(res)
+            if sc:
+                lines += ["", "Spread (sample standard deviation over the runs, percent of their mean): " + ", ".join(
+                    f"{name} {sc[key]['std_pct']:.1f} %" for name, key, _ in BASIC if key in sc)
+                    + f" ({next(iter(sc.values()))['n']} runs)."]
     return lines
 
 
@@ -314,7 +410,7 @@ def main(argv=None) -> int:
     if args.quick and args.json == OUT_JSON:
         _parser().error("--quick writes try-out records: give them their own --json file")
     if not args.report:
-        sweep(store(args.json), jobs(args.scaling, args.detector, args.only, args.resolution), args)
+        sweep(store(args.json), jobs(args.study or STUDY_NAMES, args.only), args)
     res = load(args.json)                                 # with what another sweep on the same file added
     if args.json != OUT_JSON:
         print(report(res))
@@ -329,9 +425,9 @@ def main(argv=None) -> int:
 def _parser():
     ap = study.parser(__doc__, "jobs", "scheduler", "only", jobs=dict(default=2, help="local processes (default 2)"),
                       only=dict(type=int, nargs="*", help="case numbers to run (default: all 18)"))
-    ap.add_argument("--scaling", action="store_true", help="the mass-scaling study on case 1")
-    ap.add_argument("--detector", action="store_true", help="case 1 with the alpha-shape detector")
-    ap.add_argument("--resolution", action="store_true", help="case 1 at other resolutions")
+    ap.add_argument("--study", nargs="*", choices=STUDY_NAMES, default=None,
+                    help="which runs: the 18 cases, the mass-scaling, scatter, resolution, tool-size and contact "
+                         "checks (default: all, in the order jobs() gives)")
     ap.add_argument("--redo", nargs="*", default=(), help="keys to run again (e.g. 'case 3')")
     study.add_flags(ap, "report", "quick", report=dict(help="table and figures from the committed JSON only"),
                     quick=dict(help="quick short cuts (a try-out; give --json elsewhere)"))
@@ -344,11 +440,11 @@ def sweep(runs: study.RunStore, todo: dict, args) -> None:
     todo = {k: todo[k] for k in runs.pending(todo, redo=args.redo)}
     print(f"{len(todo)} runs to do ({len(runs.records())} recorded)", flush=True)
     t0 = time.perf_counter()
-    tasks = {k: (k, o, args.quick) for k, o in todo.items()}
+    tasks = {k: (k, o, nm, args.quick) for k, (o, nm) in todo.items()}
     for k, (key, rec) in enumerate(study.execute(run_case, tasks, args.jobs, args.scheduler)):
         runs.commit(key, rec)
         m = rec.get("metrics", {})
-        print(f"[{k + 1}/{len(todo)}] {key:16s} {rec['status']:6s} Fp/Fc {_f(m.get('force_ratio'), '.2f')} "
+        print(f"[{k + 1}/{len(todo)}] {key:24s} {rec['status']:6s} Fp/Fc {_f(m.get('force_ratio'), '.2f')} "
               f"T_RF {_f(m.get('rake_face_temperature_K'), '.0f')} K, {_f(rec.get('wall_time_s'), '.0f')} s "
               f"({(time.perf_counter() - t0) / 60:.1f} min elapsed)", flush=True)
 

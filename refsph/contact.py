@@ -143,7 +143,9 @@ class ContactResult:
     deformable set (Eq. (36)); ``force_on_b``: (n_b, d) force on each partner particle (the reaction, equal and
     opposite pair by pair); ``n_contacts``: pairs with p_d > 0; ``max_penetration``: max p_d [m] (0 if none);
     ``friction_power_a``, ``friction_power_b``: (n_a,), (n_b,) the friction power |f_t| |v_t| of each particle's
-    pairs [W] (each pair's power counted once on each side; zeros without friction)."""
+    pairs [W] (each pair's power counted once on each side; zeros without friction); ``heat_power_a``: (n_a,) the
+    power the contact's normal damping dissipates at each particle of set a [W] (the penalty contact's; None: not
+    computed, as for the pinball)."""
 
     a: np.ndarray
     force_on_b: np.ndarray
@@ -151,6 +153,7 @@ class ContactResult:
     max_penetration: float
     friction_power_a: np.ndarray | None = None
     friction_power_b: np.ndarray | None = None
+    heat_power_a: np.ndarray | None = None
 
 
 def pinball_contact(x_a, v_a, m_a, x_b, v_b, m_b, R, mu_a, mu_b, dt, contact: PinballContact,

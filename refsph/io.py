@@ -53,16 +53,17 @@ __all__ = ["save_snapshot", "load_snapshot", "state_from_snapshot", "state_from_
 SNAPSHOT_UNITS = dict(FIELD_UNITS, p="Pa", sigma_vm="Pa", F="1", id="1 (particle id)")
 
 
-def save_snapshot(path, state: State, material, F: np.ndarray | None = None) -> None:
-    """Write one snapshot (atomically: a crash never leaves a half-written file)."""
+def save_snapshot(path, state: State, material, F: np.ndarray | None = None, ids: np.ndarray | None = None) -> None:
+    """Write one snapshot (atomically: a crash never leaves a half-written file). ``ids``: the particles' ids, if
+    not their rows (particles read with ``--from`` keep the ids of their file)."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     arrays = dict(
         t=np.float64(state.t), x=state.x, v=state.v, m=state.m, rho=state.rho,
         p=eos_pressure(state.rho, material.rho0, material.K), S=state.S, S_zz=state.S_zz,
         sigma_vm=von_mises(state.S, state.S_zz), X=state.X, V0=state.V0,
-        id=np.arange(state.n, dtype=np.int64),          # refsph never reorders particles: the id is the row
-    )
+        id=np.arange(state.n, dtype=np.int64) if ids is None else np.asarray(ids, dtype=np.int64),
+    )                                                   # refsph never reorders particles: by default the id is the row
     if F is not None:
         arrays["F"] = F
     if state.plastic:
@@ -93,14 +94,15 @@ def state_from_snapshot(snap) -> State:
                  t=float(z["t"]), **extra)
 
 
-def state_from_particles(path, rho0: float, T0: float | None, clamp_names=()) -> tuple[State, dict]:
-    """An external particle set (``.npz``) as a State, and the clamps' index arrays it gives.
+def state_from_particles(path, rho0: float, T0: float | None, clamp_names=()) -> tuple[State, dict, np.ndarray | None]:
+    """An external particle set (``.npz``) as a State, the clamps' index arrays it gives, and its particle ids.
 
     Required arrays: ``x`` (N, d) [m], ``v`` (N, d) [m/s], ``m`` (N,) [kg; 2D: kg/m]. Optional: ``body`` (N,)
     (ids of rigid bodies, their rows last; needed where the scene has tools), ``rho`` (default rho0), ``S``
     (N, d, d) and ``S_zz`` (N,) [Pa] (default 0), ``X`` (default x), ``V0`` (default m / rho0), ``T`` (default
-    ``T0``) and ``eps_p``, ``eps_dot_p``, ``W_p`` (default 0) for a plasticity law, and ``clamp_<name>`` index
-    arrays for every clamp of the scene. Errors name the missing or inconsistent array."""
+    ``T0``) and ``eps_p``, ``eps_dot_p``, ``W_p`` (default 0) for a plasticity law, ``clamp_<name>`` index
+    arrays for every clamp of the scene, and ``id`` (N,) distinct integers: the particles' ids, which the run's
+    snapshots then carry (None: the rows). Errors name the missing or inconsistent array."""
     with np.load(path, allow_pickle=False) as z:
         a = {k: z[k] for k in z.files}
     missing = [k for k in ("x", "v", "m") if k not in a]
@@ -111,7 +113,7 @@ def state_from_particles(path, rho0: float, T0: float | None, clamp_names=()) ->
         raise ValueError(f"{path}: x must have shape (N, 2) or (N, 3), got {x.shape}")
     n, d = x.shape
     shapes = dict(v=(n, d), m=(n,), body=(n,), rho=(n,), S=(n, d, d), S_zz=(n,), X=(n, d), V0=(n,), T=(n,),
-                  eps_p=(n,), eps_dot_p=(n,), W_p=(n,))
+                  eps_p=(n,), eps_dot_p=(n,), W_p=(n,), id=(n,))
     for k, shape in shapes.items():
         if k in a and np.shape(a[k]) != shape:
             raise ValueError(f"{path}: array {k} has shape {np.shape(a[k])}, expected {shape} (N = {n} from x)")
@@ -131,7 +133,13 @@ def state_from_particles(path, rho0: float, T0: float | None, clamp_names=()) ->
             raise ValueError(f"{path}: the scene holds particles by the clamp {name!r}: give their indices as "
                              f"clamp_{name}")
         clamps[name] = np.asarray(a[f"clamp_{name}"])
-    return state, clamps
+    ids = None
+    if "id" in a:
+        ids = np.asarray(a["id"])
+        if ids.dtype.kind not in "iu" or len(np.unique(ids)) != n:
+            raise ValueError(f"{path}: id must hold N = {n} distinct integers (the particles' ids), got "
+                             f"dtype {ids.dtype} with {len(np.unique(ids))} distinct values")
+    return state, clamps, ids
 
 
 def load_run(directory) -> tuple[dict, list[Path]]:

@@ -31,6 +31,10 @@ the penetration per step (omega dt <= sqrt(alpha), stable for alpha < 4 in the l
 taken: a step shortened to land on an output time would otherwise make the spring 1/(dt/tau)^2 times stiffer. With
 k proportional to m / tau^2 the contact is independent of mass scaling (tau ~ sqrt(rho) ~ sqrt(m)).
 
+The normal force's non-elastic part, f_N - k g (the damping, or the spring force the clip at 0 drops), takes
+the power -(f_N - k g) v_n >= 0 out of the motion (``damping_power``): a run with ``Setup.dissipation_heat`` puts
+it into the particle as heat.
+
 **Friction** (Coulomb with mu(T), :class:`refsph.contact.CoulombFriction`), a return map on an elastic tangential
 spring of the same stiffness, with per-particle history xi (the stuck tangential displacement, kept between steps):
 
@@ -94,6 +98,13 @@ class RoundedPolygon:
             core.append(np.linalg.solve(A, [c[k - 1], c[k]]))
         return cls(core=np.asarray(core) - np.asarray(centroid, dtype=float), radius=float(radius))
 
+    def bounding_circle(self, shift: np.ndarray) -> tuple[np.ndarray, float]:
+        """(centre, radius) of a circle that holds the whole tool (core + ``shift`` grown by the radius): a point
+        farther than that from the centre has a gap below -(its distance - radius)."""
+        P = np.asarray(self.core) + np.asarray(shift, dtype=float)
+        c = P.mean(axis=0)
+        return c, float(np.sqrt(np.max(np.sum((P - c) ** 2, axis=1)))) + self.radius
+
     def gap(self, x: np.ndarray, shift: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(g, n) of points x (N, 2) against the tool with its core at core + ``shift`` (2,) [m] (the centroid of the
         tool's particles): the penetration depth g =
@@ -153,7 +164,9 @@ class PenaltyResult:
     on the tool (the sum of -f over the particles); ``friction_power`` (N,) [W; 2D: W/m] the power each particle's
     return map dissipates; ``xi`` (N, d) the trial tangential history (what the step commits); ``gap`` (N,) the
     penetration depth (<= 0: no contact); ``f_normal`` (N,) and ``f_tangent`` (N, d) the contact forces;
-    ``f_trial`` (N, d) the trial (stick) tangential force -k xi* that the return map started from."""
+    ``f_trial`` (N, d) the trial (stick) tangential force -k xi* that the return map started from;
+    ``damping_power`` (N,) [W; 2D: W/m] the power the normal force's non-elastic part takes out of the motion,
+    -(f_N - k g) v_n >= 0 (the damping, beta m v_n^2 / tau, or the spring force the no-adhesion clip drops)."""
 
     a: np.ndarray
     force_on_tool: np.ndarray
@@ -163,6 +176,7 @@ class PenaltyResult:
     f_normal: np.ndarray
     f_tangent: np.ndarray
     f_trial: np.ndarray
+    damping_power: np.ndarray
 
 
 def return_map_friction(xi_trial: np.ndarray, k: np.ndarray, f_limit: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -198,6 +212,7 @@ def penalty_contact(x: np.ndarray, v: np.ndarray, m: np.ndarray, T: np.ndarray |
     beta = 2.0 * contact.damping * np.sqrt(contact.alpha)
     fN = np.where(on, np.maximum(k * g - beta * m * vn / tau, 0.0), 0.0)
     f = fN[:, None] * np.where(on[:, None], n, 0.0)
+    damping_power = np.where(on, np.maximum(-(fN - k * g) * vn, 0.0), 0.0)
     f_t = np.zeros((n_p, d))
     f_trial = np.zeros((n_p, d))
     power = np.zeros(n_p)
@@ -215,4 +230,4 @@ def penalty_contact(x: np.ndarray, v: np.ndarray, m: np.ndarray, T: np.ndarray |
         power = np.linalg.norm(f_t, axis=1) * np.maximum(slipped, 0.0) / dt
         f = f + f_t
     return PenaltyResult(a=f / m[:, None], force_on_tool=-f.sum(axis=0), friction_power=power, xi=xi_new, gap=g,
-                         f_normal=fN, f_tangent=f_t, f_trial=f_trial)
+                         f_normal=fN, f_tangent=f_t, f_trial=f_trial, damping_power=damping_power)

@@ -79,6 +79,8 @@ def make_solver(method: str, setup: Setup) -> Solver:
         if setup.friction is not None:
             raise ValueError("friction is a law of the TLSPH pinball contact; ESPH tools act through the SPH "
                              "sums and have no friction model (run TLSPH, or set friction=None)")
+        if setup.dissipation_heat:
+            raise ValueError("dissipation_heat is a TLSPH option (ESPH's artificial viscosity heat is not computed)")
         if nm.hourglass:
             raise ValueError("hourglass control is a TLSPH option (ESPH's neighbours change every step, its zig-zag "
                              "modes are the tensile instability's, see gamma)")
@@ -92,7 +94,7 @@ def make_solver(method: str, setup: Setup) -> Solver:
             raise ValueError("esph_correction is an ESPH option; TLSPH's kernel-gradient correction is 'corrected'")
         prm = TLSPHParams(h=h, beta1=nm.beta1, beta2=nm.beta2, eps=nm.eps, kernel=kernel,
                           corrected=nm.corrected, ref_update_strain=nm.ref_update_strain,
-                          hourglass=float(nm.hourglass))
+                          hourglass=float(nm.hourglass), viscous_heat=bool(setup.dissipation_heat))
         contact = None
         if setup.friction is not None and not setup.rigid:
             raise ValueError("friction acts in the contact with rigid bodies, and this setup has none")
@@ -115,7 +117,8 @@ def step_physics(setup: Setup) -> list[StepPhysics]:
         return []
     chi = float(getattr(setup.strength, "chi", 0.0)) if heats(setup.strength) else 0.0
     return [HeatFlow(setup.thermal, setup.friction_heat, heat_capacity(setup.strength), chi, setup.h,
-                     get_kernel(setup.numerics.kernel), [b.body for b in setup.rigid])]
+                     get_kernel(setup.numerics.kernel), [b.body for b in setup.rigid],
+                     dissipation_heat=bool(setup.dissipation_heat))]
 
 
 def _deformable_bodies(setup: Setup) -> list:
@@ -256,7 +259,8 @@ class RunRecord:
 
     def save(self, name: str, state: State) -> Path:
         path = self.out / "snapshots" / name
-        save_snapshot(path, state, self.setup.material, self.solver.deformation_gradient(state))
+        save_snapshot(path, state, self.setup.material, self.solver.deformation_gradient(state),
+                      ids=self.setup.arrays.get("id"))
         return path
 
     def next_output_time(self) -> float:
@@ -553,7 +557,7 @@ def run(scene_name: str, method: str, *, dim: int | None = None, dp: float | Non
 def _use_particles(setup: Setup, path) -> None:
     """Replace the setup's particles by those of ``path`` (its clamps re-indexed from the file)."""
     T0 = setup.state.T[0] if setup.state.T is not None else None
-    state, clamps = state_from_particles(path, setup.material.rho0, T0, [c.name for c in setup.clamps])
+    state, clamps, ids = state_from_particles(path, setup.material.rho0, T0, [c.name for c in setup.clamps])
     if state.dim != setup.state.dim:
         raise ValueError(f"{path}: the particles are {state.dim}D, the scene is {setup.state.dim}D")
     if setup.rigid and state.body is None:
@@ -561,7 +565,7 @@ def _use_particles(setup: Setup, path) -> None:
                          "the body id of every particle as body")
     setup.state = state
     setup.clamps = tuple(Clamp(c.name, clamps[c.name]) for c in setup.clamps)
-    setup.arrays = {}
+    setup.arrays = {} if ids is None else {"id": ids}          # the file's particle ids, which the snapshots keep
 
 
 def _tolerant(metrics):

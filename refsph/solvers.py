@@ -175,7 +175,7 @@ class ESPHSolver(SolverBase):
         r = esph_rates(ext, self.material, self.params, I, J, pairs=self.pair_sum, part=part)
         r = r if ext is state else r.rows(state.n)
         if out is not None:
-            out.update(I=I, J=J, p=eos_pressure(state.rho, self.material.rho0, self.material.K))
+            out.update(pair_i=I, pair_j=J, p=eos_pressure(state.rho, self.material.rho0, self.material.K))
         return self.constraints.constrain(state, r, record=part != "deformation")
 
     def after_step(self, state: State) -> State:
@@ -272,7 +272,7 @@ class TLSPHSolver(SolverBase):
         """Eqs. (16)-(23) on the deformable body; with rigid bodies, the pinball contact (Eqs. (32)-(36)) for a
         step of size ``dt`` (Eq. (34)). ``part``: 'all', 'deformation' (stress rates) or 'forces' (dv/dt, contact
         included): the leapfrog's halves. ``out``: a dict that receives F, J, P, l, rho, p of the deformable rows
-        (:func:`~refsph.tlsph.tlsph_rates`) and the operator's half pairs (I, J)."""
+        (:func:`~refsph.tlsph.tlsph_rates`; J there is det F) and the operator's half pairs (pair_i, pair_j)."""
         body = self._body(state)
         ref = self.reference
         op = ref.operator(body, self.several_bodies)
@@ -282,7 +282,7 @@ class TLSPHSolver(SolverBase):
         r = r if ext is body else r.rows(body.n)
         if out is not None:
             out.update({k: (None if out[k] is None else out[k][:body.n]) for k in ("F", "J", "P", "l", "rho", "p")},
-                       I=op.I, J=op.J)
+                       pair_i=op.I, pair_j=op.J)
         if part != "deformation" and self.several_bodies:
             r.v = r.v + self.coupling.between_bodies(body, self.constraints.deformable_bodies, dt)
         if body is not state:
@@ -292,17 +292,23 @@ class TLSPHSolver(SolverBase):
     def _with_rigid(self, state: State, r: Rates, dt: float, contact: bool = True) -> Rates:
         """Rates of all rows: the deformable ones plus the pinball contact (``contact``), the rigid ones carrying
         the reaction (dv/dt = contact force / m, turned into the recorded force and then zeroed by the
-        constraints), and the contact's friction power on both sides (``Rates.friction_power``)."""
+        constraints), the contact's friction power on both sides (``Rates.friction_power``) and, where the rates
+        carry the viscous heat, the contact's damping power added to it (``Rates.heat_power``)."""
         n, N, d = self.constraints.n_deformable, state.n, state.dim
         v = np.zeros((N, d))
         v[:n] = r.v
-        power = None
+        power = heat = None
+        if r.heat_power is not None:
+            heat = np.zeros(N)
+            heat[:n] = r.heat_power
         if contact:
             c = self.coupling.with_tools(state, n, dt)
             v[:n] += c.a
             v[n:] = c.force_on_b / state.m[n:, None]
             if c.friction_power_a is not None:
                 power = np.concatenate([c.friction_power_a, c.friction_power_b])
+            if heat is not None and c.heat_power_a is not None:
+                heat[:n] += c.heat_power_a
         S = np.zeros((N, d, d))
         S[:n] = r.S
         S_zz = np.zeros(N)
@@ -311,7 +317,7 @@ class TLSPHSolver(SolverBase):
         if r.l is not None:
             l = np.zeros((N, d, d))
             l[:n] = r.l
-        return Rates(x=state.v.copy(), v=v, rho=None, S=S, S_zz=S_zz, l=l, friction_power=power)
+        return Rates(x=state.v.copy(), v=v, rho=None, S=S, S_zz=S_zz, l=l, friction_power=power, heat_power=heat)
 
     def deformation_gradient(self, state: State) -> np.ndarray:
         """Eq. (18) for every row (rigid rows: I)."""

@@ -143,7 +143,10 @@ class Rates:
     integrated (TLSPH, Eq. (2)); ``l`` is the velocity gradient the stress rate came from (the strength model takes
     its strain rate from it). ``friction_power``: (N,) the friction power |f_t| |v_t| [W; 2D: W/m] each row takes
     part in at this evaluation (the tool contact's, :mod:`refsph.contact`; None: no friction), the source of the
-    frictional heat (:class:`refsph.thermal.HeatFlow`)."""
+    frictional heat (:class:`refsph.thermal.HeatFlow`). ``heat_power``: (N,) the power [W; 2D: W/m] the numerical
+    dissipation (artificial viscosity, :func:`refsph.tlsph.reference_viscosity`; the penalty contact's normal
+    damping, :mod:`refsph.penalty`) takes out of the motion in each row (None: not computed), the heat a run with
+    ``Setup.dissipation_heat`` puts back."""
 
     x: np.ndarray
     v: np.ndarray
@@ -152,13 +155,14 @@ class Rates:
     S_zz: np.ndarray
     l: np.ndarray | None = None
     friction_power: np.ndarray | None = None
+    heat_power: np.ndarray | None = None
 
     def rows(self, n: int) -> "Rates":
         """The rates of the first n rows (the real particles of a real + ghost evaluation)."""
         def first(a):
             return None if a is None else a[:n]
         return Rates(x=self.x[:n], v=self.v[:n], rho=first(self.rho), S=self.S[:n], S_zz=self.S_zz[:n],
-                     l=first(self.l), friction_power=first(self.friction_power))
+                     l=first(self.l), friction_power=first(self.friction_power), heat_power=first(self.heat_power))
 
 
 def make_state(x: np.ndarray, v: np.ndarray, rho0: float, volume: np.ndarray | float,

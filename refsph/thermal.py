@@ -43,11 +43,13 @@ The sources and sinks of a cutting run (:func:`thermal_step`, one explicit step 
 run loop's heat physics (:class:`refsph.integrate.StepPhysics`): its step limit, its step after the mechanical one,
 and the heat ledger, which checks
 
-    plastic + friction = stored + lost + removed at fixed rows      (``summary.json``'s ``heat_balance``)
+    plastic + friction + dissipation = stored + lost + removed at fixed rows      (``summary.json``'s ``heat_balance``)
 
 with the plastic heat counted independently of the temperatures the return map changed: chi sum_i m_i dW_p,i /
 rho_i (Eq. (28) summed; W_p the plastic work density), and the stored heat sum_i m_i c_p (T_i - T_i(0)). A wrong chi
-or c_p in the heating, or heat made or lost anywhere else, shows as a residual.
+or c_p in the heating, or heat made or lost anywhere else, shows as a residual. 'dissipation' is the numerical
+dissipation a run with ``Setup.dissipation_heat`` turns into heat (artificial viscosity and the penalty contact's
+damping, ``Rates.heat_power``; zero otherwise): without it that work leaves the energy balance unaccounted.
 
 The heat capacity c_p of the deformable body is the strength model's (``JohnsonCook.cp``, ``Elastic(cp=...)``): one
 place for the number that both the plastic heating (Eq. (28)) and conduction (Eq. (29)) use.
@@ -80,8 +82,18 @@ def laplacian(f: np.ndarray, x: np.ndarray, V: np.ndarray, h: float, kernel: Ker
 def _pairs_and_fr(x: np.ndarray, h: float, kernel: Kernel, pairs: tuple | None = None):
     """Half pairs within the support (``pairs`` if given) and (dW/dr)/r on each: (I, J, fr)."""
     I, J = pairs if pairs is not None else find_pairs(x, kernel.support * h)
-    r = np.sqrt(np.sum((x[I] - x[J]) ** 2, axis=1))
+    r = np.sqrt(_distance2(x, I, J))
     return I, J, kernel.dw_dr_over_r(r, h, x.shape[1])      # zero beyond the support
+
+
+def _distance2(x: np.ndarray, I: np.ndarray, J: np.ndarray) -> np.ndarray:
+    """|x_I - x_J|^2 per pair, a component at a time (a gather of contiguous columns: faster than x[I] - x[J])."""
+    r2 = np.zeros(len(I))
+    for k in range(x.shape[1]):
+        xk = np.ascontiguousarray(x[:, k])
+        dk = np.take(xk, I) - np.take(xk, J)
+        r2 += dk * dk
+    return r2
 
 
 def conduction_rate(T: np.ndarray, x: np.ndarray, V: np.ndarray, a: np.ndarray | float, h: float, kernel: Kernel,
@@ -122,19 +134,24 @@ class SurfaceLoss:
     """Heat lost on free surfaces (the second paper's Eq. (6)): q = h_c (T_s - T_inf) + emissivity sigma_SB
     (T_s^4 - T_inf^4) [W/m^2], on the particles the ``detector`` marks ('sph': :func:`refsph.surface.surface_sph`;
     'alpha': :func:`refsph.surface.surface_alpha_shape` with circumradius limit ``alpha_radius`` [m]), each with
-    the area V^((d-1)/d) (a spacing per unit thickness in 2D, a spacing squared in 3D)."""
+    the area V^((d-1)/d) (a spacing per unit thickness in 2D, a spacing squared in 3D). ``refresh``: in a run
+    (:class:`HeatFlow`), the surface rows are found again once a particle has moved more than ``refresh`` h since
+    they were last found (0: every step); the surface moves with the material, far slower than a step."""
 
     h_c: float
     emissivity: float
     T_ambient: float
     detector: str = "sph"
     alpha_radius: float | None = None
+    refresh: float = 0.0
 
     def __post_init__(self):
         if not (self.h_c >= 0 and 0 <= self.emissivity <= 1 and self.T_ambient > 0):
             raise ValueError(f"SurfaceLoss needs h_c >= 0, 0 <= emissivity <= 1, T_ambient > 0; got {self}")
         if self.detector not in ("sph", "alpha"):
             raise ValueError(f"SurfaceLoss.detector must be 'sph' or 'alpha', got {self.detector!r}")
+        if not (np.isfinite(self.refresh) and 0.0 <= self.refresh <= 0.5):
+            raise ValueError(f"SurfaceLoss.refresh must lie in [0, 0.5] (units of h), got {self.refresh!r}")
         if self.detector == "alpha" and not (self.alpha_radius is not None and self.alpha_radius > 0):
             raise ValueError("the alpha-shape detector needs alpha_radius > 0 [m] (PFEM codes: 1.2-1.5 spacings)")
 
@@ -226,21 +243,22 @@ def conduct(state, model: Conduction, h: float, kernel: Kernel, dt: float, cp: f
 
 def thermal_step(state, model: Conduction | None, k: np.ndarray, c: np.ndarray, h: float, kernel: Kernel,
                  dt: float, friction_heat: FrictionHeat | None = None, friction_power: np.ndarray | None = None,
-                 tool_rows: np.ndarray | None = None, pairs: tuple | None = None) -> tuple[np.ndarray, dict]:
+                 tool_rows: np.ndarray | None = None, pairs: tuple | None = None,
+                 surface: np.ndarray | None = None) -> tuple[np.ndarray, dict]:
     """One explicit step dt of Eq. (29) with the harmonic-mean conductivity between materials (module text; ``k``,
     ``c``: per row, :func:`coefficients`; ``model`` None: no conduction), the frictional heat (``friction_power``:
     (N,) [W] per row, as the tool contact leaves it in ``Rates.friction_power``; split by ``friction_heat``:
     ``chip_fraction`` to the rows not in ``tool_rows``, the rest to the tool rows), the surface loss, then the fixed
     rows reset. Pairs are found in the current configuration, across bodies (heat flows from the chip into a
     conducting tool); ``pairs``: the half pairs within the support, sorted by I then J, if the caller has them
-    (:class:`HeatFlow` keeps a Verlet list). Returns (T, heat) with heat = {'friction', 'lost', 'removed'} [J; per
+    (:class:`HeatFlow` keeps a Verlet list); ``surface``: the free-surface rows, if the caller has them (else found
+    here by ``model.loss.detector``). Returns (T, heat) with heat = {'friction', 'lost', 'removed'} [J; per
     metre of thickness in 2D] moved in the step."""
     n, d = state.x.shape
     V = state.m / state.rho
     mc = state.m * c
     heat = dict(friction=0.0, lost=0.0, removed=0.0)
     dT = np.zeros(n)
-    pairs = None
     if model is not None:
         I, J, fr = _pairs_and_fr(state.x, h, kernel, pairs)
         pairs = (I, J)
@@ -256,7 +274,7 @@ def thermal_step(state, model: Conduction | None, k: np.ndarray, c: np.ndarray, 
         dT += Q / mc
         heat["friction"] = float(Q.sum())
     if model is not None and model.loss is not None:          # Eq. (6) on the free surface of the conducting rows
-        on = free_surface(state.x, V, h, kernel, model.loss, pairs) & (k > 0)
+        on = (free_surface(state.x, V, h, kernel, model.loss, pairs) if surface is None else surface) & (k > 0)
         lost = dt * model.loss.flux(state.T[on]) * V[on] ** ((d - 1) / d)
         dT[on] -= lost / mc[on]
         heat["lost"] = float(lost.sum())
@@ -268,7 +286,7 @@ def thermal_step(state, model: Conduction | None, k: np.ndarray, c: np.ndarray, 
     return T, heat
 
 
-LEDGER = ("plastic", "friction", "lost", "removed")
+LEDGER = ("plastic", "friction", "dissipation", "lost", "removed")
 SKIN = 0.3                                  # the heat step's Verlet skin, in units of h
 
 
@@ -276,17 +294,21 @@ class HeatFlow:
     """The heat of a run as a physics the run loop steps (:class:`refsph.integrate.StepPhysics`): conduction
     (``conduction``, or None), frictional heat (``friction_heat``, or None) and the heat ledger (module text).
     ``cp``, ``chi``: the deformable body's heat capacity and Taylor-Quinney coefficient (the strength model's; chi
-    0 when the law does not heat); ``rigid_ids``: the rigid bodies' ids; ``h``, ``kernel``: the run's."""
+    0 when the law does not heat); ``rigid_ids``: the rigid bodies' ids; ``h``, ``kernel``: the run's;
+    ``dissipation_heat``: the numerical dissipation of the step's rates (``Rates.heat_power``: artificial viscosity,
+    contact damping) heats the row it was taken from (ledger entry 'dissipation')."""
 
     name = "heat"
 
     def __init__(self, conduction: Conduction | None, friction_heat: FrictionHeat | None, cp: float, chi: float,
-                 h: float, kernel: Kernel, rigid_ids=()):
+                 h: float, kernel: Kernel, rigid_ids=(), *, dissipation_heat: bool = False):
         if not (cp is not None and np.isfinite(cp) and cp > 0):
             raise ValueError("heat conduction and frictional heat need the body's heat capacity: the strength "
                              f"model's cp (JohnsonCook(cp=...), Elastic(cp=...)), got {cp!r}")
         self.conduction, self.friction_heat, self.cp, self.chi = conduction, friction_heat, float(cp), float(chi)
         self.h, self.kernel, self.rigid_ids = h, kernel, tuple(rigid_ids)
+        self.dissipation_heat = bool(dissipation_heat)
+        self.surface = self.surface_x = None               # the free-surface rows and where they were found
         self.ledger = {k: 0.0 for k in LEDGER}
         self.k = self.c = self.mc = self.T0 = self.tool_rows = None
         self.pairs = VerletList(kernel.support * h, SKIN * h)   # the heat step's pair search (module text)
@@ -322,12 +344,35 @@ class HeatFlow:
         after = step.state
         self.ledger["plastic"] += self.plastic_heat(before, after)
         power = step.rates.friction_power if step.rates is not None else None
+        pairs = self.pairs_within_support(after.x)
         T, moved = thermal_step(after, self.conduction, self.k, self.c, self.h, self.kernel, dt, self.friction_heat,
-                                power, self.tool_rows, self.pairs_within_support(after.x))
+                                power, self.tool_rows, pairs, self.surface_rows(after, pairs))
         for key, val in moved.items():
             self.ledger[key] += val
+        if self.dissipation_heat and step.rates is not None and step.rates.heat_power is not None:
+            Q = dt * step.rates.heat_power                             # [J] per row, taken from the motion
+            T = T + Q / self.mc
+            self.ledger["dissipation"] += float(Q.sum())
+            if self.conduction is not None and len(self.conduction.fixed):
+                fixed = np.asarray(self.conduction.fixed)
+                self.ledger["removed"] += float(np.sum(self.mc[fixed] * (T[fixed] - self.conduction.T_fixed)))
+                T[fixed] = self.conduction.T_fixed
         after.T = T
         return after
+
+    def surface_rows(self, state, pairs) -> np.ndarray | None:
+        """The free-surface rows of the losses (``SurfaceLoss.refresh``): found again once a particle has moved more
+        than refresh h since the last time; None (thermal_step finds them) with refresh 0 or no losses."""
+        loss = None if self.conduction is None else self.conduction.loss
+        if loss is None or loss.refresh == 0.0:
+            return None
+        if self.surface is not None and len(self.surface) == state.n:
+            moved = state.x - self.surface_x
+            if np.max(np.einsum("nd,nd->n", moved, moved)) <= (loss.refresh * self.h) ** 2:
+                return self.surface
+        self.surface = free_surface(state.x, state.m / state.rho, self.h, self.kernel, loss, pairs)
+        self.surface_x = state.x.copy()
+        return self.surface
 
     def pairs_within_support(self, x: np.ndarray) -> tuple | None:
         """The half pairs within the kernel's support, sorted by I then J: those of a Verlet list (cutoff the
@@ -337,18 +382,19 @@ class HeatFlow:
         if self.conduction is None:
             return None
         I, J = self.pairs.update(x)
-        d = x[I] - x[J]
-        keep = np.einsum("pk,pk->p", d, d) <= self.pairs.cutoff ** 2
+        keep = _distance2(x, I, J) <= self.pairs.cutoff ** 2
         return I[keep], J[keep]
 
     def balance(self, state) -> dict:
-        """The heat ledger [J; per metre of thickness in 2D]: made (plastic, friction), stored (sum m c (T - T0)),
-        lost (surface), removed (at fixed temperatures), and the residual made - stored - lost - removed."""
+        """The heat ledger [J; per metre of thickness in 2D]: made (plastic, friction, dissipation), stored
+        (sum m c (T - T0)), lost (surface), removed (at fixed temperatures), and the residual
+        made - stored - lost - removed."""
         stored = float(np.sum(self.mc * (state.T - self.T0)))
         h = self.ledger
-        made = h["plastic"] + h["friction"]
+        made = h["plastic"] + h["friction"] + h["dissipation"]
         residual = made - stored - h["lost"] - h["removed"]
-        return dict(plastic_J=h["plastic"], friction_J=h["friction"], stored_J=stored, lost_J=h["lost"],
+        return dict(plastic_J=h["plastic"], friction_J=h["friction"], dissipation_J=h["dissipation"],
+                    stored_J=stored, lost_J=h["lost"],
                     removed_J=h["removed"], residual_J=residual, residual_rel=residual / made if made > 0 else 0.0)
 
     def record(self, state) -> dict:
@@ -369,10 +415,17 @@ class HeatFlow:
                                                                         "alpha_radius")})
         if self.friction_heat is not None:
             out["friction_heat"] = dict(eta=self.friction_heat.eta, chip_fraction=self.friction_heat.chip_fraction)
+        if self.dissipation_heat:
+            out["dissipation_heat"] = True
         return out
 
     def checkpoint(self) -> dict:
-        return {k: np.float64(v) for k, v in self.ledger.items()}
+        ck = {k: np.float64(v) for k, v in self.ledger.items()}
+        if self.surface is not None:
+            ck.update(surface=self.surface.copy(), surface_x=self.surface_x.copy())
+        return ck
 
     def restore(self, arrays: dict) -> None:
-        self.ledger = {k: float(arrays[k]) for k in LEDGER}
+        self.ledger = {k: float(arrays[k]) if k in arrays else 0.0 for k in LEDGER}   # (older: no 'dissipation')
+        if "surface" in arrays:
+            self.surface, self.surface_x = np.array(arrays["surface"], dtype=bool), np.array(arrays["surface_x"])

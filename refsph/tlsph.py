@@ -57,7 +57,9 @@ class TLSPHParams:
     beta1, beta2, eps: artificial viscosity (Eqs. (12)-(13)); corrected: kernel-gradient correction;
     ref_update_strain: update the reference configuration when max_i |E_i| exceeds it, with
     E = (F^T F - I)/2 the Green-Lagrange strain (None: never); hourglass: the coefficient alpha of
-    :func:`hourglass_acceleration` (0: off, as in the paper)."""
+    :func:`hourglass_acceleration` (0: off, as in the paper); viscous_heat: also return the power the artificial
+    viscosity dissipates in each particle (``Rates.heat_power``, :func:`reference_viscosity`), for a run that turns
+    it into heat (``Setup.dissipation_heat``)."""
 
     h: float
     beta1: float
@@ -67,6 +69,7 @@ class TLSPHParams:
     corrected: bool
     ref_update_strain: float | None
     hourglass: float = 0.0
+    viscous_heat: bool = False
 
 
 class ReferenceOperator:
@@ -212,8 +215,9 @@ def green_lagrange_norm(F: np.ndarray) -> np.ndarray:
 
 
 def reference_viscosity(x: np.ndarray, v: np.ndarray, m: np.ndarray, rho: np.ndarray, B: np.ndarray,
-                        op: ReferenceOperator, c0: float, prm: TLSPHParams) -> np.ndarray:
-    """Artificial viscosity of Eq. (17) in the reference frame: -sum_j m_j pi_ij (B_i + B_j)/2 grad_i W(X_ij).
+                        op: ReferenceOperator, c0: float, prm: TLSPHParams) -> tuple[np.ndarray, np.ndarray | None]:
+    """Artificial viscosity of Eq. (17) in the reference frame: -sum_j m_j pi_ij (B_i + B_j)/2 grad_i W(X_ij);
+    returns (a, q), q (N,) [W; 2D: W/m] the power it dissipates in each particle if ``prm.viscous_heat`` (else None).
 
     pi_ij is Eqs. (12)-(13) with the current x_ij, v_ij (zero for receding pairs, v_ij . x_ij >= 0). As in the
     stress term, the pair sum is split into an i-side and a j-side sum, so that no B is gathered per pair:
@@ -223,22 +227,32 @@ def reference_viscosity(x: np.ndarray, v: np.ndarray, m: np.ndarray, rho: np.nda
     g_ij = grad_i W(X_ij). Both are antisymmetric pair sums (momentum conserved to round-off), computed block
     by block over ``op.pairs`` (a :class:`~refsph.neighbours.PairBlocks`, see :func:`_viscosity_block`).
     B is (N, d, d).
+
+    The dissipated power (Monaghan's energy equation, the viscous term of the SPH energy equation, in the
+    reference frame): the pair's forces -/+ m_i m_j pi_ij gbar_ij (gbar_ij = (B_i + B_j) g_ij / 2) do the work
+    -m_i m_j pi_ij v_ij . gbar_ij per unit time on the two particles together (<= 0: pi_ij is zero for receding
+    pairs); each particle takes half of it as heat,
+
+        q_i = m_i / 2 sum_j m_j pi_ij v_ij . gbar_ij   >= 0,    sum_i q_i = -sum_i m_i v_i . a_i (the viscous a).
     """
     n, d = x.shape
     particle = dict(x=[np.ascontiguousarray(x[:, k]) for k in range(d)],
                     v=[np.ascontiguousarray(v[:, k]) for k in range(d)],
                     rho=rho, m=m, m_B=[[m * B[:, c, b] for b in range(d)] for c in range(d)])
+    if prm.viscous_heat:
+        particle["B"] = [[np.ascontiguousarray(B[:, c, b]) for b in range(d)] for c in range(d)]
     sums = op.pairs.reduce(lambda blk: _viscosity_block(blk, particle, c0, prm, d))
     a = np.empty((n, d))
     for c in range(d):                          # rows of block b: sum_j m_j pi g_b, sum_j m_j B_j,cb pi g_b (c...)
         a[:, c] = sum(B[:, c, b] * sums[b * (d + 1)] + sums[b * (d + 1) + 1 + c] for b in range(d))
     a *= -0.5
-    return a
+    return a, (0.5 * m * sums[d * (d + 1)] if prm.viscous_heat else None)
 
 
 def _viscosity_block(blk, particle: dict, c0: float, prm: TLSPHParams, d: int) -> np.ndarray:
     """Over one block's pairs (rows over its window): for each direction b, the row sum_j m_j pi_ij (g_ij)_b,
-    then the d rows sum_j m_j (B_j)_cb pi_ij (g_ij)_b, c = 0..d-1."""
+    then the d rows sum_j m_j (B_j)_cb pi_ij (g_ij)_b, c = 0..d-1; with ``particle['B']`` one more row,
+    sum_j m_j pi_ij v_ij . (B_i + B_j) g_ij / 2 (the viscous heat, :func:`reference_viscosity`)."""
     I, J = blk.I, blk.J
     dx = [np.take(xk, I) - np.take(xk, J) for xk in particle["x"]]     # current x_ij
     dv = [np.take(vk, I) - np.take(vk, J) for vk in particle["v"]]     # v_ij
@@ -250,12 +264,20 @@ def _viscosity_block(blk, particle: dict, c0: float, prm: TLSPHParams, d: int) -
     rho = particle["rho"]
     pi = artificial_viscosity(vr, r2, 0.5 * (np.take(rho, I) + np.take(rho, J)), c0, prm.h, prm.beta1,
                               prm.beta2, prm.eps)
-    out = np.empty((d * (d + 1), blk.sums.n))
+    heat = "B" in particle
+    out = np.empty((d * (d + 1) + heat, blk.sums.n))
     for b in range(d):
         t = pi * blk.gW[b]
         out[b * (d + 1)] = blk.sums.antisymmetric(t, blk.local(particle["m"]))
         for c in range(d):
             out[b * (d + 1) + 1 + c] = blk.sums.antisymmetric(t, blk.local(particle["m_B"][c][b]))
+    if heat:                                    # v_ij . gbar_ij, gbar_ij = (B_i + B_j) g_ij / 2; symmetric in i, j
+        w = np.zeros(len(I))
+        for c in range(d):
+            for b in range(d):
+                Bcb = particle["B"][c][b]
+                w += dv[c] * (0.5 * (np.take(Bcb, I) + np.take(Bcb, J))) * blk.gW[b]
+        out[d * (d + 1)] = blk.sums.symmetric(pi * w, blk.local(particle["m"]))
     return out
 
 
@@ -278,7 +300,7 @@ def tlsph_rates(state: State, mat: ElasticMaterial, prm: TLSPHParams, op: Refere
     rho_ref = m / op.V                                      # reference density rho_0 = m / V
     rho = rho_ref / J                                       # Eq. (2)
     p = eos_pressure(rho, mat.rho0, mat.K)                  # Eq. (24)
-    l, P = None, None
+    l, P, heat_power = None, None, None
     if part == "forces":                                    # the deformation half is not asked for
         dS, dS_zz = np.zeros((n, d, d)), np.zeros(n)
     else:
@@ -295,12 +317,13 @@ def tlsph_rates(state: State, mat: ElasticMaterial, prm: TLSPHParams, op: Refere
         # Eq. (17), artificial viscosity: a_i -= sum_j m_j pi_ij (B_i + B_j)/2 grad_i W_ij,  B = J F^-T
         if prm.beta1 > 0 or prm.beta2 > 0:
             B = J[:, None, None] * transpose(Finv)
-            a += reference_viscosity(x, v, m, rho, B, op, mat.c0, prm)
+            a_visc, heat_power = reference_viscosity(x, v, m, rho, B, op, mat.c0, prm)
+            a += a_visc
         if prm.hourglass > 0:
             a += hourglass_acceleration(x, F, m, op, mat.E, prm.hourglass)
     if out is not None:
         out.update(F=F, J=J, P=P, l=l, rho=rho, p=p)
-    return Rates(x=v.copy(), v=a, rho=None, S=dS, S_zz=dS_zz, l=l)
+    return Rates(x=v.copy(), v=a, rho=None, S=dS, S_zz=dS_zz, l=l, heat_power=heat_power)
 
 
 def hourglass_acceleration(x: np.ndarray, F: np.ndarray, m: np.ndarray, op: ReferenceOperator, E: float,

@@ -95,7 +95,7 @@ def _study():
 def test_run_store_keeps_good_records_and_reads_the_committed_format(tmp_path):
     """A failed run never replaces a good record; a rerun skips what is recorded; the committed records load."""
     study = _study()
-    committed = study.RunStore(BENCH / "thermal_cutting.json")
+    committed = study.RunStore(BENCH / "thermal_cutting_pinball_tu5.json")     # issue 19's finished sweep
     assert committed.load()["runs"]["case 1"]["status"] == "ok"
     assert committed.pending(["case 1", "case 99"]) == ["case 99"]
     store = study.RunStore(tmp_path / "runs.json")

@@ -176,14 +176,17 @@ def test_compare_runs_threads_and_perturbation(tmp_path):
 @pytest.mark.parametrize("method", ["esph", "tlsph"])
 def test_rates_of_a_snapshot_are_the_run_s(tmp_path, method):
     """rates() of a run's first snapshot gives the rates the run used: one step with them reproduces the run's
-    first step; F, P, J for TLSPH, half pairs I < J."""
+    first step; F, P, J_det = det F for TLSPH (not the pair index J, issue 23), half pairs I < J."""
     res = run("pressing", method, quick=True, progress=False, t_end=1e-9, out=tmp_path)
     snap = sorted((tmp_path / "snapshots").glob("snap_*.npz"))[0]
     out = rates(snap, "pressing", method, quick=True)
     n = res.state.n
     assert out["v_dot"].shape == (n, 2) and np.all(out["I"] < out["J"]) and out["n_pairs"] == len(out["I"])
     if method == "tlsph":
-        assert out["F"].shape[1:] == (2, 2) and "P" in out and "J" in out
+        from refsph.tensor import det
+        assert out["F"].shape[1:] == (2, 2) and "P" in out
+        np.testing.assert_allclose(out["J_det"], det(out["F"]), rtol=1e-12)
+    assert out["I"].dtype.kind == "i" and out["J"].dtype.kind == "i" and len(out["J"]) == out["n_pairs"]
     assert np.all(np.isfinite(out["S_returned"])) and np.any(out["d_eps_p"] >= 0)
 
 
@@ -214,6 +217,11 @@ def test_export_vtk(tmp_path):
     m = meshio.read(tmp_path / "vtk" / "snap_00010.vtu")
     assert m.points.shape[1] == 3 and {"x", "v", "S", "F", "id", "p"} <= set(m.point_data)
     assert m.point_data["S"].shape[1] == 9
+    from refsph.io import load_snapshot                          # 2D: the plane-strain zz components (issue 23)
+    z = load_snapshot(tmp_path / "snapshots" / "snap_00010.npz")
+    assert np.any(z["S_zz"] != 0)
+    np.testing.assert_array_equal(m.point_data["S"][:, 8], z["S_zz"])
+    np.testing.assert_allclose(np.linalg.det(m.point_data["F"].reshape(-1, 3, 3)), np.linalg.det(z["F"]), rtol=1e-12)
 
 
 def test_oracle_refuses_a_folder_it_did_not_write_and_names_bad_patterns(tmp_path, capsys):

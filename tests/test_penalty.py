@@ -55,6 +55,43 @@ def _slide(theta: float, s: float = 1.0, contact: str = "penalty"):
     return sliding(res.history, t, v), res
 
 
+def test_damping_power_is_what_the_normal_damping_takes():
+    """A particle approaching the face: the damping force beta m |v_n| / tau does the work beta m v_n^2 / tau per unit
+    time (damping_power); a receding one whose spring the no-adhesion clip drops: k g v_n; none out of contact."""
+    tool = RoundedPolygon(core=[[-1, -1], [1, -1], [1, 0], [-1, 0]], radius=0.0)
+    c = PenaltyContact(alpha=0.1, damping=0.5, offset=0.0, time_scale=1e-8)
+    m, beta, k = 1e-3, 2 * 0.5 * np.sqrt(0.1), 0.1 * 1e-3 / 1e-16
+    x = np.array([[0.0, -1e-9], [0.3, -1e-9], [0.6, 1e-6]])
+    v = np.array([[0.0, -2.0], [0.0, 50.0], [0.0, -2.0]])
+    r = penalty_contact(x, v, np.full(3, m), None, tool, np.zeros(2), np.zeros(2), 1e-8, c, np.zeros((3, 2)))
+    assert r.f_normal[1] == 0.0 and r.f_normal[0] > 0
+    assert r.damping_power == pytest.approx([beta * m * 4.0 / 1e-8, k * 1e-9 * 50.0, 0.0], rel=1e-9)
+
+
+def test_coupling_leaves_out_only_particles_that_cannot_touch():
+    """PenaltyCoupling computes the contact on the rows within the tool's bounding circle: the same forces, friction
+    and damping powers as the contact of every row."""
+    from refsph.boundaries import RigidBody
+    from refsph.coupling import PenaltyCoupling
+    from refsph.state import concatenate_states, make_state
+    rng = np.random.default_rng(3)
+    xw = rng.uniform(-3e-4, 3e-4, (400, 2))
+    tool_x = rng.uniform(-5e-5, 5e-5, (30, 2))
+    tool = RoundedPolygon.from_polygon([[-5e-5, -5e-5], [5e-5, -5e-5], [5e-5, 5e-5], [-5e-5, 5e-5]], 1e-5,
+                                       tool_x.mean(axis=0))
+    state = concatenate_states(make_state(xw, rng.normal(size=(400, 2)), 7800.0, DX * DX, T0=300.0),
+                               make_state(tool_x, [0.0, 0.0], 1.5e4, DX * DX, T0=300.0, body=np.full(30, 1)))
+    contact = PenaltyContact(alpha=0.1, damping=0.5, offset=5e-6, time_scale=1e-8, friction=FRICTION)
+    pc = PenaltyCoupling(contact, (RigidBody("tool", 1, (0.0, 0.0), shape=tool),))
+    got = pc.with_tools(state, 400, 1e-8)
+    full = penalty_contact(xw, state.v[:400], state.m[:400], state.T[:400], tool, tool_x.mean(axis=0), np.zeros(2),
+                           1e-8, contact, np.zeros((400, 2)))
+    assert np.count_nonzero(full.gap > 0) > 5 and len(pc.candidates(xw, tool, tool_x.mean(axis=0))) < 200
+    np.testing.assert_array_equal(got.a, full.a)
+    np.testing.assert_array_equal(got.friction_power_a, full.friction_power)
+    np.testing.assert_array_equal(got.heat_power_a, full.damping_power)
+
+
 def test_block_sticks_below_the_friction_angle():
     theta = np.arctan(0.5 * MU)
     m, res = _slide(theta)

@@ -81,6 +81,14 @@ def test_run_from_external_particles(tmp_path, capsys):
     ref = run("pressing", "tlsph", quick=True, t_end=0.05e-6, progress=False)
     assert np.array_equal(res.state.x, ref.state.x)                  # the same particles: the same run
     assert res.summary["run_args"]["particles"] == str(f.resolve())
+    ids = np.random.default_rng(0).permutation(s.n) + 1000         # the file's own ids: the snapshots keep them
+    np.savez(f, x=s.x, v=s.v, m=s.m, body=s.body, clamp_left_side=setup.clamps[0].index, id=ids)
+    run("pressing", "tlsph", quick=True, t_end=0.05e-6, progress=False, particles=f, out=tmp_path / "ids")
+    snaps = sorted((tmp_path / "ids" / "snapshots").glob("snap_*.npz"))
+    assert all(np.array_equal(np.load(p)["id"], ids) for p in snaps) and len(snaps) > 1
+    np.savez(f, x=s.x, v=s.v, m=s.m, body=s.body, clamp_left_side=setup.clamps[0].index, id=np.zeros(s.n, int))
+    assert main(["run", "pressing", "--quick", "--quiet", "--from", str(f), "--out", str(tmp_path / "q")]) == 2
+    assert "distinct integers" in capsys.readouterr().err
     np.savez(f, x=s.x, v=s.v, m=s.m, body=s.body)
     assert main(["run", "pressing", "--quick", "--quiet", "--from", str(f), "--out", str(tmp_path / "q")]) == 2
     assert "clamp_left_side" in capsys.readouterr().err

@@ -175,3 +175,25 @@ def test_convective_cooling_of_a_block():
     assert hot[0] == pytest.approx(0.5 * STEFAN_BOLTZMANN * (1000.0 ** 4 - 300.0 ** 4))
     with pytest.raises(ValueError, match="emissivity"):
         SurfaceLoss(h_c=1.0, emissivity=2.0, T_ambient=300.0)
+
+
+def test_the_surface_is_found_again_once_particles_have_moved_refresh_h():
+    """SurfaceLoss.refresh: the heat flow keeps the free-surface rows until a particle has moved more than refresh h
+    (the same rows as a fresh detection while nothing moved); refresh outside [0, 0.5] is refused."""
+    from refsph.scenes import aisi4340_material
+    from refsph.state import make_state
+    from refsph.surface import surface_sph
+    from refsph.thermal import Conduction, HeatFlow, SurfaceLoss
+    dp, h = 1e-4, 1.5e-4
+    st = make_state(lattice([10 * dp, 10 * dp], dp), [0.0, 0.0], aisi4340_material().rho0, dp * dp, T0=600.0)
+    flow = HeatFlow(Conduction(k=50.0, courant=0.2, loss=SurfaceLoss(h_c=10.0, emissivity=0.0, T_ambient=300.0,
+                                                                     refresh=0.1)), None, 480.0, 0.0, h, KERNEL)
+    flow.bind(st, None)
+    first = flow.surface_rows(st, None)
+    np.testing.assert_array_equal(first, surface_sph(st.x, st.m / st.rho, h, KERNEL))
+    st.x[0, 0] += 0.09 * h
+    assert flow.surface_rows(st, None) is first
+    st.x[0, 0] += 0.02 * h
+    assert flow.surface_rows(st, None) is not first
+    with pytest.raises(ValueError, match="refresh"):
+        SurfaceLoss(h_c=10.0, emissivity=0.0, T_ambient=300.0, refresh=1.0)

@@ -9,7 +9,7 @@ import pytest
 from refsph.contact import CoulombFriction, PinballContact, pinball_contact
 from refsph.kernels import get_kernel
 from refsph.scenes import get_scene
-from refsph.scenes.thermal_cutting import EDGE_RADIUS, tool_particles
+from refsph.scenes.thermal_cutting import EDGE_RADIUS, drift, tool_particles
 from refsph.simulate import cfl_time_step, run
 from refsph.state import make_state
 from refsph.thermal import Conduction, FrictionHeat, coefficients, thermal_step
@@ -49,14 +49,15 @@ def short_cut():
 
 
 def test_heat_balance_of_a_cutting_run(short_cut):
-    """plastic + frictional heat = heat stored + lost + removed at the fixed rows (to round-off: every term is
-    counted where it is made), and the heat made is a fraction of the tool's work (chi = 0.9 of the plastic work;
-    the rest is elastic and kinetic energy and viscous and contact dissipation)."""
+    """plastic + frictional heat + the numerical dissipation's heat = heat stored + lost + removed at the fixed rows
+    (to round-off: every term is counted where it is made), and the heat made is a fraction of the tool's work
+    (chi = 0.9 of the plastic work; the rest is elastic and kinetic energy and the cold work)."""
     hb, m = short_cut.summary["heat_balance"], short_cut.summary["metrics"]
     assert short_cut.summary["status"] == "ok"
     assert hb["plastic_J"] > 0 and hb["friction_J"] > 0 and hb["lost_J"] > 0 and hb["removed_J"] > 0
+    assert hb["dissipation_J"] > 0                  # artificial viscosity and contact damping, turned into heat
     assert abs(hb["residual_rel"]) < 1e-9
-    made = hb["plastic_J"] + hb["friction_J"]
+    made = hb["plastic_J"] + hb["friction_J"] + hb["dissipation_J"]
     assert 0.5 < made / m["tool_work_J_per_m"] < 1.0
     assert 293.0 < m["rake_face_temperature_K"] < m["max_temperature_K"] < 1773.0
     assert m["cutting_force_N_per_m"] > 0 and m["passive_force_N_per_m"] > 0
@@ -104,6 +105,13 @@ def test_mass_scaling_keeps_rho_cp_and_lengthens_the_step():
     assert b.info["inertia_ratio"] == pytest.approx(100 * a.info["inertia_ratio"])
 
 
+def test_drift_is_the_change_over_the_window():
+    t = np.linspace(0.0, 1.0, 101)
+    assert drift(t, 3.0 + 8.0 * t, 0.75, 1.0) == pytest.approx(2.0)             # slope 8 over a quarter
+    assert drift(t, np.where(t < 0.5, 100.0, 5.0), 0.75, 1.0) == pytest.approx(0.0, abs=1e-12)
+    assert np.isnan(drift(t[:2], t[:2], 0.0, 1.0))
+
+
 def test_tool_geometry():
     """Rake face 10 deg from the normal to the cut, a 70 deg wedge, the first layer exactly on a line (no
     staircase), and the 10 um edge rounding removing the corner particles once dx resolves it."""
@@ -130,6 +138,15 @@ def test_scene_options_and_refusals():
     assert s.info["tu_m"] == pytest.approx(0.1e-3) and s.dp == pytest.approx(0.1e-3 / 5)
     assert s.friction is not None and s.thermal is not None and s.numerics.kernel == "wendland"
     assert scene.setup(material="AISI1045", vc=2.0, tu=0.15e-3, conduction=False, friction=False).thermal is None
+    assert s.numerics.contact == "penalty" and s.dissipation_heat and s.thermal.loss.refresh > 0
+    big = scene.setup(case=13, length=0.6e-3, travel=2.0, tool_length=10.0, tool_depth=6.0)
+    assert big.info["n_tool"] > 3 * s.info["n_tool"] and big.info["tool_length_m"] == pytest.approx(1e-3)
+    shaken = scene.setup(case=13, length=0.6e-3, travel=2.0, jitter=0.01, seed=2)
+    moved = np.abs(shaken.state.x[:s.info["n_work"]] - s.state.x[:s.info["n_work"]])
+    assert 0 < moved.max() <= 0.01 * s.dp and np.array_equal(shaken.state.x[s.info["n_work"]:],
+                                                                s.state.x[s.info["n_work"]:])
+    with pytest.raises(ValueError, match="jitter"):
+        scene.setup(case=13, jitter=0.5)
     with pytest.raises(ValueError, match="material"):
         scene.setup(material="copper")
     with pytest.raises(ValueError, match="case"):

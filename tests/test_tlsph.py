@@ -1,5 +1,6 @@
 """TLSPH (refsph.tlsph): the sparse operators against plain pair loops, the kernel-gradient correction,
 conservation, objectivity of the stress measure, and the reference-configuration update."""
+import dataclasses
 import math
 
 import numpy as np
@@ -275,3 +276,22 @@ def test_reference_update_refuses_a_singular_F():
     F[3] = [[1.0, 0.0], [0.0, 0.0]]                        # collapsed: J = 0
     with pytest.raises(ValueError, match="particle 3"):
         reference_update(st, F)
+
+
+@pytest.mark.parametrize("corrected", [False, True])
+def test_viscous_heat_is_the_work_the_viscosity_takes(corrected):
+    """Rates.heat_power (viscous_heat): every particle's share >= 0, their sum = -sum m v . a_visc (the power the
+    artificial viscosity takes out of the motion), the same over many pair blocks; off by default."""
+    st = random_block(seed=5)
+    op = ReferenceOperator(st.X, st.V0, H, KERNEL, corrected)
+    with_heat = dataclasses.replace(params(corrected), viscous_heat=True)
+    r = tlsph_rates(st, MAT, with_heat, op)
+    a_stress = tlsph_rates(st, MAT, params(corrected, beta=0.0), op).v
+    assert tlsph_rates(st, MAT, params(corrected), op).heat_power is None
+    q = r.heat_power
+    taken = -np.sum(st.m[:, None] * st.v * (r.v - a_stress))
+    assert taken > 0 and np.all(q >= -1e-12 * q.max())
+    assert abs(q.sum() - taken) < 1e-10 * taken
+    assert np.count_nonzero(q > 1e-6 * q.max()) > 0.5 * st.n
+    many = ReferenceOperator(st.X, st.V0, H, KERNEL, corrected, threads=2, block_size=53)
+    np.testing.assert_allclose(tlsph_rates(st, MAT, with_heat, many).heat_power, q, rtol=1e-10, atol=1e-12 * q.max())

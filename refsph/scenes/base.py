@@ -84,6 +84,9 @@ class Setup:
     conduction during the run (a :class:`refsph.thermal.Conduction`; None: none, the paper's adiabatic model);
     ``friction_heat``: the frictional heat of the contact (a :class:`refsph.thermal.FrictionHeat`; None: friction
     makes no heat). Either switches the run's heat flow on (:class:`refsph.thermal.HeatFlow`).
+    ``dissipation_heat``: the numerical dissipation (TLSPH's artificial viscosity, the penalty contact's normal
+    damping; ``Rates.heat_power``) becomes heat in the particle where it is taken from the motion, so that the
+    tool's work ends up as heat (with a heat flow only; False: it leaves the energy balance, the paper's model).
     """
 
     state: State
@@ -103,10 +106,14 @@ class Setup:
     arrays: dict = field(default_factory=dict)
     thermal: object = None
     friction_heat: object = None
+    dissipation_heat: bool = False
 
     def __post_init__(self):
         if self.strength is None:
             self.strength = Elastic()
+        if self.dissipation_heat and self.thermal is None and self.friction_heat is None:
+            raise ValueError("Setup.dissipation_heat turns numerical dissipation into heat and needs a heat flow "
+                             "(Setup.thermal or Setup.friction_heat)")
         bad = [k for k, v in self.info.items() if isinstance(v, np.ndarray)]
         if bad:
             raise ValueError(f"Setup.info goes into summary.json: put the arrays {', '.join(bad)} into Setup.arrays")

@@ -11,27 +11,36 @@ The model, as in their Sections 2.1-2.4 and Tables 1-2, A1-A3 (``refsph.paper_da
 * **Material**: modified Johnson-Cook (their Eq. (9): hardening frozen past plastic strain 2, AISI 1045; Ti6Al4V
   has no limit in their table), chi = 0.9 (Table A3), plastic heat through the return map.
 * **Tool**: rigid, 10 deg rake, 10 deg clearance, moving at -v_c along x with its cutting edge at the cut depth
-  3 t_u - t_u = 2 t_u. Its particles are a lattice aligned with the rake face (the face the chip slides on is
-  flat, not a staircase), 5 t_u along the rake face and 3 t_u deep, the wedge of 70 deg between rake and
-  clearance face, the edge rounded to 10 um (below the spacing at the default resolution: the lattice has no
-  particle in the cut-off corner, so the edge is as sharp as dx). Mechanically it is only contact (the pinball,
-  :mod:`refsph.contact`); thermally it conducts with its own k and the paper's reduced heat capacity
-  c_p = 15 J/(kg K) (Table A2; their reason, after Childs: the tool reaches its steady temperature within the
-  short simulated cut instead of seconds), held at 293 K on its top and back faces.
-* **Friction**: Coulomb, mu(T) = mu0 (1 - T*^q) (their Eqs. (10)-(11), Table 2) in the pinball contact;
-  frictional heat eta |f| |v_rel| with eta = 1, half into the chip, half into the tool
-  (:class:`refsph.thermal.FrictionHeat`, ``chip_fraction``).
+  3 t_u - t_u = 2 t_u. Mechanically it is its exact outline (:func:`tool_shape`: the wedge of 70 deg between rake
+  and clearance face, ``tool_length`` t_u along the rake face and ``tool_depth`` t_u deep, 5 x 3 by default, every
+  corner rounded to the 10 um edge radius) and the **penalty contact** (:mod:`refsph.penalty`: a force while a
+  particle's surface is inside the outline, Coulomb friction as a return map with stick and slip); the pinball
+  (:mod:`refsph.contact`, the first paper's) is ``--set contact=pinball``. Thermally it is a lattice of particles
+  aligned with the rake face (the face the chip slides on is flat, not a staircase) that conducts with its own k
+  and the paper's reduced heat capacity c_p = 15 J/(kg K) (Table A2; their reason, after Childs: the tool reaches
+  its steady temperature within the short simulated cut instead of seconds), held at 293 K on its top and back
+  faces.
+* **Friction**: Coulomb, mu(T) = mu0 (1 - T*^q) (their Eqs. (10)-(11), Table 2), return-mapped in the penalty
+  contact; frictional heat eta |f_t| |v_t| (the work the return map dissipates) with eta = 1, half into the chip,
+  half into the tool (:class:`refsph.thermal.FrictionHeat`, ``chip_fraction``; the paper's SPH code puts it all
+  into the workpiece: ``chip_fraction=1``).
 * **Heat**: Brookshaw conduction in workpiece and tool (:mod:`refsph.thermal`), convection and radiation on the
   free surface (their Eq. (6); h_c and the emissivity are not printed: :data:`refsph.paper_data.RLA_SURFACE_LOSS`)
-  on the particles the ``detector`` marks ('sph' or 'alpha').
+  on the particles the ``detector`` marks ('sph' or 'alpha'; found again once a particle has moved 0.1 h). The
+  numerical dissipation (artificial viscosity, contact damping) becomes heat where it is taken from the motion
+  (``dissipation_heat``, ``Setup.dissipation_heat``), so the heat ledger accounts for the tool's work.
 * **Numerics**: Wendland kernel, h = 1.3 dx, leapfrog, Courant 0.3 (their 0.25-0.40) on the smaller of the
   mechanical and thermal steps; artificial viscosity beta1 = beta2 = 0.5 (the first paper's cutting, Table 5).
 * **Mass scaling** (the run-time remedy; their GPU code runs at the real speed): the density is multiplied by
   s and the heat capacity divided by s, so rho c_p (hence conduction and the heating per unit plastic work) is
   unchanged and only inertia changes; the wave speed falls by sqrt(s), the explicit step grows by about sqrt(s).
   s is chosen so that s rho v_c^2 = ``inertia_ratio`` A (1 % of the initial yield stress by default), unless
-  ``mass_scale`` gives it. ``benchmarks/thermal_cutting.py --scaling`` measures what it changes.
-* **Cut length**: ``travel`` t_u (8 by default); steady-state means over the second half of the cut.
+  ``mass_scale`` gives it. The rule keeps the artificial viscosity's stress, ~ beta1 rho c h |grad v| with
+  rho c = sqrt(s rho E), the same fraction of A in every case (beta1 sqrt(inertia_ratio E / A) h |grad v| / v_c).
+* **Cut length**: ``travel`` t_u (8 by default; the benchmark's sweep: 16 at dx = t_u / 10); steady-state means
+  over the last quarter of the cut, with each quantity's drift over that quarter (:func:`drift`).
+* **Perturbed runs**: ``jitter`` moves the workpiece's particles at random by up to that many dx (``seed``), for the
+  run-to-run scatter.
 
 Measurements (``metrics``; the experiment's values: :func:`refsph.paper_data.rla_cutting_case`):
 
@@ -39,7 +48,7 @@ Measurements (``metrics``; the experiment's values: :func:`refsph.paper_data.rla
   (against the cut) and +y (pushing the tool off the workpiece), per metre of width, time means over the second
   half of the cut; ``force_ratio`` = Fp / Fc (width-free, compared with the measured ratio);
 * ``rake_face_temperature_K``: the mean temperature of the workpiece particles in contact with the rake face
-  (centre within one spacing of it, from the cutting edge to the end of contact), time mean over the second half
+  (centre within one spacing of it, from the cutting edge to the end of contact), time mean over the last quarter
   (``rake_face_temperature_max_K``: the hottest of them);
 * ``free_chip_surface_temperature_K``: the mean temperature of the chip's outer layer (in each dx-band along
   the rake face, the chip particles within one spacing of the farthest from the face) between 1 and 3 t_u along
@@ -67,10 +76,10 @@ from ..thermal import Conduction, FrictionHeat, SurfaceLoss
 from .base import Numerics, Scene, Setup, parse_bool
 from .measure import N_FORCE_BINS, TOOL_BODY, binned_mean, block_lattice, time_mean
 
-__all__ = ["SCENE", "MATERIALS", "tool_particles", "mass_scale_for", "rake_frame", "chip_measures",
-           "thermal_cutting_metrics", "thermal_cutting_table", "STEADY_FROM"]
+__all__ = ["SCENE", "MATERIALS", "tool_particles", "tool_shape", "mass_scale_for", "rake_frame", "chip_measures",
+           "drift", "thermal_cutting_metrics", "thermal_cutting_table", "STEADY_FROM"]
 
-STEADY_FROM = 0.5               # means over the second half of the cut
+STEADY_FROM = 0.75              # means over the last quarter of the cut
 RAKE_DEG, CLEARANCE_DEG, EDGE_RADIUS = 10.0, 10.0, 10e-6
 MATERIALS = {"AISI1045": AISI1045_RLA, "Ti6Al4V": TI6AL4V_RLA}
 OPTIONS = {
@@ -84,7 +93,13 @@ OPTIONS = {
     "mass_scale": (0.0, "density factor s (c_p / s keeps rho c_p); 0: chosen from inertia_ratio"),
     "inertia_ratio": (0.01, "with mass_scale 0: s such that s rho vc^2 = inertia_ratio x A"),
     "detector": ("sph", "free-surface detector of the heat losses: sph or alpha"),
-    "chip_fraction": (0.5, "share of the frictional heat that goes into the chip (the rest into the tool)"),
+    "chip_fraction": (0.5, "share of the frictional heat that goes into the chip (the rest into the tool; the "
+                           "paper's SPH code: 1)"),
+    "dissipation_heat": (True, "artificial viscosity and contact damping become heat (false: their work is lost)"),
+    "tool_length": (5.0, "the tool's rake face, in units of tu"),
+    "tool_depth": (3.0, "the tool's depth behind the rake face, in units of tu"),
+    "jitter": (0.0, "random displacement of the workpiece's particles, in units of dx (a perturbed run)"),
+    "seed": (0, "the random seed of the jitter"),
     "friction": (True, "Coulomb friction mu(T) on the tool (false: frictionless)"),
     "conduction": (True, "heat conduction, frictional heat and losses (false: adiabatic, the first paper's model)"),
 }
@@ -95,12 +110,13 @@ def mass_scale_for(material: dict, vc: float, inertia_ratio: float) -> float:
     return max(1.0, inertia_ratio * material["A_Pa"] / (material["rho"] * vc * vc))
 
 
-def tool_particles(dx: float, tu: float, apex) -> tuple[np.ndarray, np.ndarray]:
+def tool_particles(dx: float, tu: float, apex, length: float = 5.0, depth: float = 3.0
+                   ) -> tuple[np.ndarray, np.ndarray]:
     """The tool's particles (a lattice in rake-face coordinates u along the face from the edge, w into the tool:
-    u, w = (i + 1/2) dx, (j + 1/2) dx, 0 < u < 5 tu, 0 < w < 3 tu), those inside the 70 deg wedge and the
-    rounded edge, placed with the edge at ``apex``; and a mask of the held rows (top and back layers)."""
+    u, w = (i + 1/2) dx, (j + 1/2) dx, 0 < u < ``length`` tu, 0 < w < ``depth`` tu), those inside the 70 deg wedge
+    and the rounded edge, placed with the edge at ``apex``; and a mask of the held rows (top and back layers)."""
     g, beta = math.radians(RAKE_DEG), math.radians(90.0 - RAKE_DEG - CLEARANCE_DEG)
-    nu_, nw = round(5 * tu / dx), round(3 * tu / dx)
+    nu_, nw = round(length * tu / dx), round(depth * tu / dx)
     u, w = [a.ravel() * dx for a in np.meshgrid(np.arange(nu_) + 0.5, np.arange(nw) + 0.5, indexing="ij")]
     keep = np.arctan2(w, u) <= beta
     rc = EDGE_RADIUS / math.sin(beta / 2)                 # the edge circle's centre, on the bisector
@@ -115,14 +131,15 @@ def tool_particles(dx: float, tu: float, apex) -> tuple[np.ndarray, np.ndarray]:
     return np.stack([x, y], axis=1), held
 
 
-def tool_shape(tu: float, apex, centroid) -> RoundedPolygon:
+def tool_shape(tu: float, apex, centroid, length: float = 5.0, depth: float = 3.0) -> RoundedPolygon:
     """The tool's exact outline for the penalty contact (``Numerics.contact = 'penalty'``): in the rake-face
-    coordinates of :func:`tool_particles` the polygon (0, 0), (5 tu, 0), (5 tu, 3 tu), (3 tu / tan(beta), 3 tu)
-    (rake face w = 0, flank at the wedge angle beta, the held top and back faces), every corner rounded by the
-    edge radius (the cutting edge's 10 um; the far corners alike), placed with the edge at ``apex``; ``centroid``:
-    that of the tool's particles."""
+    coordinates of :func:`tool_particles` the polygon (0, 0), (L, 0), (L, D), (D / tan(beta), D), L = ``length``
+    tu, D = ``depth`` tu (rake face w = 0, flank at the wedge angle beta, the held top and back faces), every
+    corner rounded by the edge radius (the cutting edge's 10 um; the far corners alike), placed with the edge at
+    ``apex``; ``centroid``: that of the tool's particles."""
     g, beta = math.radians(RAKE_DEG), math.radians(90.0 - RAKE_DEG - CLEARANCE_DEG)
-    uw = np.array([[0.0, 0.0], [5 * tu, 0.0], [5 * tu, 3 * tu], [3 * tu / math.tan(beta), 3 * tu]])
+    L, D = length * tu, depth * tu
+    uw = np.array([[0.0, 0.0], [L, 0.0], [L, D], [D / math.tan(beta), D]])
     x = apex[0] + uw[:, 0] * math.sin(g) + uw[:, 1] * math.cos(g)
     y = apex[1] + uw[:, 0] * math.cos(g) - uw[:, 1] * math.sin(g)
     return RoundedPolygon.from_polygon(np.stack([x, y], axis=1), EDGE_RADIUS, centroid)
@@ -151,14 +168,16 @@ def _default_dp(dim, quick):
 
 
 def _build(dim, dp, quick, *, case, material, vc, tu, n_tu, travel, length, mass_scale, inertia_ratio, detector,
-           chip_fraction, friction, conduction):
+           chip_fraction, friction, conduction, dissipation_heat, tool_length, tool_depth, jitter, seed):
     if dim != 2:
         raise ValueError("the thermal cutting scene is 2D plane strain")
     row, material, vc, tu = _case_values(case, material, vc, tu)
     for name, v in (("vc", vc), ("tu", tu), ("travel", travel), ("length", length), ("n_tu", n_tu),
-                    ("inertia_ratio", inertia_ratio)):
+                    ("inertia_ratio", inertia_ratio), ("tool_length", tool_length), ("tool_depth", tool_depth)):
         if not (np.isfinite(v) and v > 0):
             raise ValueError(f"option {name} must be positive, got {v!r}")
+    if not (np.isfinite(jitter) and 0.0 <= jitter <= 0.1):
+        raise ValueError(f"option jitter must lie in [0, 0.1] (units of dx), got {jitter!r}")
     mat = MATERIALS[material]
     dx = float(dp) if dp is not None else tu / (n_tu * (0.8 if quick else 1.0))
     if tu < 2 * dx or travel * tu > 0.8 * length:
@@ -169,33 +188,40 @@ def _build(dim, dp, quick, *, case, material, vc, tu, n_tu, travel, length, mass
     nx, ny = round(length / dx), round(H / dx)
     xw, i, j = block_lattice(nx, ny, dx, dx)
     held = np.flatnonzero((i == 0) | (j == 0))
+    if jitter > 0:                                    # a perturbed run (the run-to-run scatter)
+        xw = xw + float(jitter) * dx * np.random.default_rng(int(seed)).uniform(-1.0, 1.0, xw.shape)
     y0 = ny * dx - tu
-    xt, tool_held = tool_particles(dx, tu, (nx * dx, y0))
+    xt, tool_held = tool_particles(dx, tu, (nx * dx, y0), tool_length, tool_depth)
     T0 = CONTACT_RLA["T_ref_K"]
     work = make_state(xw, [0.0, 0.0], s * mat["rho"], dx * dx, T0=T0)
     tool_mat = TOOL_CARBIDE_RLA
     tool = make_state(xt, [-vc, 0.0], tool_mat["rho"], dx * dx, T0=T0, body=np.full(len(xt), TOOL_BODY))
-    numerics = Numerics(h_over_dp=1.3, kernel="wendland", integrator="leapfrog", courant=0.3, beta1=0.5, beta2=0.5)
+    numerics = Numerics(h_over_dp=1.3, kernel="wendland", integrator="leapfrog", courant=0.3, beta1=0.5, beta2=0.5,
+                        contact="penalty")
     thermal = friction_heat = None
+    heat_of_dissipation = False
     if parse_bool(conduction, "option conduction"):
-        loss = SurfaceLoss(**RLA_SURFACE_LOSS, T_ambient=T0, detector=detector, alpha_radius=1.3 * dx)
+        loss = SurfaceLoss(**RLA_SURFACE_LOSS, T_ambient=T0, detector=detector, alpha_radius=1.3 * dx, refresh=0.1)
         thermal = Conduction(k=mat["k_W_mK"], courant=0.3,
                              tools={TOOL_BODY: (tool_mat["k_W_mK"], tool_mat["cp_J_kgK"])},
                              fixed=tuple(int(k) for k in np.concatenate([held, work.n + np.flatnonzero(tool_held)])),
                              T_fixed=T0, loss=loss)
         friction_heat = FrictionHeat(eta=CONTACT_RLA["friction_work_to_heat"], chip_fraction=float(chip_fraction))
+        heat_of_dissipation = parse_bool(dissipation_heat, "option dissipation_heat")
     mu = CoulombFriction(mu0=mat["mu0"], q=mat["q_friction"], T_room=T0, T_melt=mat["T_melt_K"])
     info = dict(case=int(case), material=material, vc_m_s=vc, tu_m=tu, dx=dx, length_m=nx * dx, height_m=ny * dx,
                 y0=y0, n_work=work.n, n_tool=tool.n, travel_m=travel * tu, mass_scale=s,
                 inertia_ratio=s * mat["rho"] * vc * vc / mat["A_Pa"], rake_deg=RAKE_DEG, clearance_deg=CLEARANCE_DEG,
                 edge_radius_m=EDGE_RADIUS, apex0=[nx * dx, y0], detector=detector, chip_fraction=float(chip_fraction),
-                A_Pa=mat["A_Pa"], measured=row)
-    body = RigidBody("tool", TOOL_BODY, (-vc, 0.0), shape=tool_shape(tu, (nx * dx, y0), xt.mean(axis=0)))
+                A_Pa=mat["A_Pa"], tool_length_m=tool_length * tu, tool_depth_m=tool_depth * tu,
+                jitter=float(jitter), seed=int(seed), measured=row)
+    body = RigidBody("tool", TOOL_BODY, (-vc, 0.0),
+                     shape=tool_shape(tu, (nx * dx, y0), xt.mean(axis=0), tool_length, tool_depth))
     return Setup(state=concatenate_states(work, tool), material=ElasticMaterial(s * mat["rho"], mat["E_Pa"], mat["nu"]),
                  dp=dx, numerics=numerics, t_end=travel * tu / vc, n_snapshots=8, info=info,
                  strength=_strength(mat, s), rigid=(body,),
                  clamps=(Clamp("held", held),), friction=mu if parse_bool(friction, "option friction") else None,
-                 thermal=thermal, friction_heat=friction_heat)
+                 thermal=thermal, friction_heat=friction_heat, dissipation_heat=heat_of_dissipation)
 
 
 def rake_frame(x: np.ndarray, t: float, info: dict) -> tuple[np.ndarray, np.ndarray]:
@@ -248,12 +274,30 @@ def _steady(hist: dict, key: str, t_from: float) -> float:
     return float(v[sel].mean()) if sel.any() else float("nan")
 
 
+def drift(t, v, t_from: float, t_end: float, weights=None) -> float:
+    """How much v(t) moves over [t_from, t_end]: the slope of the least-squares line through the samples with
+    t >= t_from, times the window's length (NaN with fewer than 3 finite samples)."""
+    t, v = np.asarray(t, dtype=float), np.asarray(v, dtype=float)
+    sel = (t >= t_from) & np.isfinite(v)
+    if np.count_nonzero(sel) < 3:
+        return float("nan")
+    w = None if weights is None else np.sqrt(np.asarray(weights, dtype=float)[sel])
+    return float(np.polyfit(t[sel], v[sel], 1, w=w)[0] * (t_end - t_from))
+
+
 def thermal_cutting_metrics(hist: dict, info: dict, t_end: float) -> dict:
-    """The ``metrics`` of a run from its history (the recorded measures and the tool's reaction)."""
+    """The ``metrics`` of a run from its history (the recorded measures and the tool's reaction): means over the
+    last quarter of the cut (``STEADY_FROM``) and the drift of each over that quarter (:func:`drift`)."""
     r = hist["reaction"]
     t_r, dt, F = np.asarray(r["t"]), np.asarray(r["dt"]), np.asarray(r["tool"])
     t_from = STEADY_FROM * t_end
     Fc, Fp = time_mean(t_r, dt, F[:, 0], t_from), time_mean(t_r, dt, F[:, 1], t_from)
+    drifts = dict(cutting_force_N_per_m=drift(t_r, F[:, 0], t_from, t_end, dt),
+                  passive_force_N_per_m=drift(t_r, F[:, 1], t_from, t_end, dt))
+    for key, name in (("T_RF", "rake_face_temperature_K"), ("T_RF_max", "rake_face_temperature_max_K"),
+                      ("T_FCS", "free_chip_surface_temperature_K"), ("chip_mm", "chip_thickness_mm"),
+                      ("contact_mm", "contact_length_mm")):
+        drifts[name] = drift(hist["t"], hist[key], t_from, t_end)
     nb = min(N_FORCE_BINS, max(1, len(t_r)))
     tb, cb = binned_mean(t_r, dt, F[:, 0], t_end, nb)
     _, pb = binned_mean(t_r, dt, F[:, 1], t_end, nb)
@@ -266,7 +310,7 @@ def thermal_cutting_metrics(hist: dict, info: dict, t_end: float) -> dict:
         max_temperature_K=float(np.max(hist["max_T"])), max_plastic_strain=float(np.max(hist["max_eps_p"])),
         tool_work_J_per_m=float(np.sum(F[:, 0] * dt) * info["vc_m_s"]),
         cut_length_mm=1e3 * info["vc_m_s"] * float(hist["t"][-1]),
-        mass_scale=info["mass_scale"], inertia_ratio=info["inertia_ratio"],
+        mass_scale=info["mass_scale"], inertia_ratio=info["inertia_ratio"], drift_last_quarter=drifts,
         cutting_force_history=np.stack([tb, cb], axis=1), passive_force_history=np.stack([tb, pb], axis=1),
         temperature_history=np.stack([np.asarray(hist["t"]), np.asarray(hist["T_RF"], dtype=float),
                                       np.asarray(hist["T_FCS"], dtype=float)], axis=1))
@@ -301,7 +345,7 @@ def thermal_cutting_table(summaries: list) -> str:
                     f"{f(meas.get('T_FCS_K'), 5, 0)} {f(m.get('chip_thickness_mm'), 5, 3)} "
                     f"{f(m.get('contact_length_mm'), 5, 3)} {f(s.get('wall_time_s'), 7, 0)}")
     rows.append("(vc in m/min, tu and chip thickness, contact length l_c in mm, temperatures in K; means over the "
-                "second half of the cut)")
+                "last quarter of the cut)")
     return "\n".join(rows)
 
 

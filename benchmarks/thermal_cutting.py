@@ -89,6 +89,7 @@ def jobs(studies=STUDY_NAMES, only=None) -> dict:
     for n in list(range(2, 10)) + list(range(11, 19)):
         add("cases", f"case {n}", converged(n))
     add("tool", "case 1 tool x2", converged(1, tool_length=10.0, tool_depth=6.0))
+    add("tool", "case 1 workpiece +8 t_u", converged(1, length=(TRAVEL + 8.0) * 1e-4))
     add("contact", "case 1 pinball", converged(1), dict(contact="pinball"))
     add("contact", "case 1 all friction heat to the chip", converged(1, chip_fraction=1.0))
     add("resolution", "case 1 n_tu 15", converged(1, n_tu=15.0))
@@ -320,8 +321,11 @@ STUDIES = (
      ("case 1 n_tu 5", "case 1", "case 1 n_tu 15", "case 10 n_tu 5", "case 10", "case 10 n_tu 15"),
      (("across t_u", "across", ".0f"), ("dx [um]", "dx_um", ".1f"), ("particles", "n_particles", "d")) + BASIC
      + (("steps", "n_steps", "d"), ("wall [s]", "wall", ".0f"))),
-    ("Tool size (case 1: the tool 5 t_u x 3 t_u; x2: 10 t_u x 6 t_u, 1 mm x 0.6 mm)", ("case 1", "case 1 tool x2"),
-     BASIC + (("removed at held faces [% of work]", "removed_of_work", ".1f"),)),
+    ("Tool and workpiece size (case 1: the tool 5 t_u x 3 t_u, the workpiece 1.25 x the cut long, 4 t_u left "
+     "uncut at the end; tool x2: 10 t_u x 6 t_u, 1 mm x 0.6 mm; workpiece +8 t_u: 12 t_u left uncut)",
+     ("case 1", "case 1 tool x2", "case 1 workpiece +8 t_u"),
+     BASIC + (("removed at held faces [% of work]", "removed_of_work", ".1f"), ("Fc drift [%]", "Fc_drift_pct", ".1f"),
+              ("T_RF drift [K]", "TRF_drift", ".0f"))),
     ("Contact and heat split (case 1: penalty contact, half the frictional heat into the chip)",
      ("case 1", "case 1 pinball", "case 1 all friction heat to the chip"),
      BASIC + (("friction heat [% of work]", "friction_of_work", ".1f"),

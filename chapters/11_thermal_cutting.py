@@ -254,7 +254,7 @@ print("Mean errors" + section)
 # contact and heat-split choices:
 
 # %%
-for title in ("## Mass scaling", "## Run-to-run scatter", "## Resolution", "## Tool size", "## Contact and heat"):
+for title in ("## Mass scaling", "## Run-to-run scatter", "## Resolution", "## Tool and workpiece", "## Contact and heat"):
     print(title[3:] + page.split(title)[1].split("## ")[0])
 
 # %% [markdown]

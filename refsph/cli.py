@@ -1,17 +1,22 @@
 """Command line: ``refsph list``, ``refsph run SCENE [--method {esph,tlsph,both}] ...``, ``refsph book``,
-``refsph oracle DIR``, ``refsph compare REF TEST`` and ``refsph export RUN_DIR --vtk``."""
+``refsph oracle DIR``, ``refsph compare REF TEST`` and ``refsph export RUN_DIR --vtk``.
+
+Exit codes (:data:`EXIT_CODES`): 0 done, 1 a comparison found a difference (or the book failed), 2 bad input (a
+message names the parameter or the file), 3 the run failed, 4 an internal error (a bug), 130 interrupted. Every
+subcommand's errors end in one boundary (:func:`main`): a message, never a traceback (``REFSPH_DEBUG=1``)."""
 from __future__ import annotations
 
 import argparse
 import dataclasses
-import subprocess
+import os
 import sys
+import zipfile
 
 import numpy as np
 
 from .scenes import SCENES, Numerics, parse_bool
 from .scenes.base import numerics_field_optional
-from .simulate import METHODS, SimulationError, run
+from .simulate import METHODS, SimulationError, check_run, run
 
 
 def _fmt(v):
@@ -62,7 +67,10 @@ def _parser() -> argparse.ArgumentParser:
     r.add_argument("--dp", type=float, default=None, help="particle spacing [m] (default: the scene's)")
     r.add_argument("--t-end", type=float, default=None, help="end time [s] (default: the scene's)")
     r.add_argument("--dt", type=float, default=None, help="fixed time step [s] (default: CFL)")
-    r.add_argument("--out", default=None, help="output directory (default: runs/SCENE-METHOD-DIMd)")
+    r.add_argument("--out", default=None, help="output directory (default: runs/SCENE-METHOD-DIMd); refused if it "
+                   "holds anything but a run of the same scene and method")
+    r.add_argument("--overwrite", action="store_true", help="write into --out whatever it holds: only the files "
+                   "refsph writes in a run folder are removed, every other file is kept")
     r.add_argument("--quick", action="store_true", help="coarse, fast version of the scene")
     r.add_argument("--quiet", action="store_true", help="no progress lines")
     r.add_argument("--option", action="append", default=[], metavar="NAME=VALUE",
@@ -74,9 +82,68 @@ def _parser() -> argparse.ArgumentParser:
     return ap
 
 
+NUMBER_FLAGS = ("--dp", "--t-end", "--dt")
+
+
+def _join_negative_numbers(argv: list) -> list:
+    """``--dp -1e-3`` as ``--dp=-1e-3``: argparse takes a token like -1e-3 for an option and says 'expected one
+    argument'; joined, the value reaches the check that names it (dp must be positive)."""
+    out, k = [], 0
+    while k < len(argv):
+        if argv[k] in NUMBER_FLAGS and k + 1 < len(argv) and argv[k + 1].startswith("-"):
+            try:
+                float(argv[k + 1])
+            except ValueError:
+                pass
+            else:
+                out.append(f"{argv[k]}={argv[k + 1]}")
+                k += 2
+                continue
+        out.append(argv[k])
+        k += 1
+    return out
+
+
+EXIT_CODES = {0: "done", 1: "compare found a difference / the book failed", 2: "bad input (a message says which)",
+              3: "the run failed (non-finite state, lost or unwritable output)", 4: "internal error (a bug in refsph)",
+              130: "interrupted"}
+
+
 def main(argv=None) -> int:
+    """``refsph``'s one error boundary: every subcommand's error ends as a message and an exit code
+    (:data:`EXIT_CODES`), never a traceback (``REFSPH_DEBUG=1`` shows it)."""
+    try:
+        return _main(argv)
+    except KeyboardInterrupt:
+        print("refsph: interrupted", file=sys.stderr)
+        return 130
+    except SystemExit:
+        raise
+    except MemoryError:
+        if os.environ.get("REFSPH_DEBUG"):
+            raise
+        print("refsph: out of memory: the problem is too large for this machine (choose a larger dp)",
+              file=sys.stderr)
+        return 2
+    except SimulationError as e:
+        print(f"refsph: run failed: {e}", file=sys.stderr)
+        return 3
+    except (ValueError, TypeError, KeyError, OSError, EOFError, zipfile.BadZipFile) as e:
+        if os.environ.get("REFSPH_DEBUG"):
+            raise
+        print(f"refsph: {e if isinstance(e, ValueError) else f'{type(e).__name__}: {e}'}", file=sys.stderr)
+        return 2
+    except Exception as e:                                  # noqa: BLE001 -- the boundary: a bug, said as one
+        if os.environ.get("REFSPH_DEBUG"):
+            raise
+        print(f"refsph: internal error (a bug in refsph; please report it with the command line): "
+              f"{type(e).__name__}: {e}  [REFSPH_DEBUG=1 shows the traceback]", file=sys.stderr)
+        return 4
+
+
+def _main(argv=None) -> int:
     ap = _parser()
-    args, extra = ap.parse_known_args(argv)
+    args, extra = ap.parse_known_args(_join_negative_numbers(list(sys.argv[1:] if argv is None else argv)))
     if extra and args.cmd != "run":
         ap.error(f"unrecognized arguments: {' '.join(extra)}")
     if args.cmd == "book":
@@ -85,12 +152,9 @@ def main(argv=None) -> int:
         from .crosscheck.golden import write_golden_cases
         try:
             names = write_golden_cases(args.dir, args.only)
-        except subprocess.CalledProcessError as e:
-            print(f"refsph: writing the golden cases failed ({e})", file=sys.stderr)
-            return 2
-        except ValueError as e:
+        except RuntimeError as e:
             print(f"refsph: {e}", file=sys.stderr)
-            return 2
+            return 3
         print(f"{len(names)} golden cases in {args.dir}: {', '.join(names)}")
         return 0
     if args.cmd == "compare":
@@ -125,11 +189,16 @@ def _attempt(fn):
         return None, 2
 
 
-def _restart(args) -> int:
+def _restart(args, extra=()) -> int:
     from .simulate import restart_run
-    if args.scene is not None:
-        print("refsph: --restart takes its scene and settings from RUN_DIR/summary.json; give no scene",
-              file=sys.stderr)
+    given = [flag for flag, value in (("a scene", args.scene), ("--from", args.particles), ("--method", args.method),
+                                      ("--dim", args.dim), ("--dp", args.dp), ("--t-end", args.t_end),
+                                      ("--dt", args.dt), ("--out", args.out), ("--overwrite", args.overwrite or None),
+                                      ("--quick", args.quick or None), ("--option", args.option or None),
+                                      ("--set", args.set or None)) if value is not None]
+    if given or extra:
+        print(f"refsph: --restart continues the run in RUN_DIR with the scene and settings of its summary.json; it "
+              f"takes no {', '.join(given + list(extra))} (only --quiet)", file=sys.stderr)
         return 2
     res, code = _attempt(lambda: restart_run(args.restart, progress=not args.quiet))
     if code:
@@ -168,7 +237,7 @@ def _book(args) -> int:
 def _run(args, extra) -> int:
     """``refsph run``: each method of the scene in turn, its metrics printed, then the scene's report."""
     if args.restart is not None:
-        return _restart(args)
+        return _restart(args, extra)
     if args.scene not in SCENES:
         print(f"refsph: unknown scene {args.scene!r}; available: {', '.join(sorted(SCENES))}", file=sys.stderr)
         return 2
@@ -183,13 +252,21 @@ def _run(args, extra) -> int:
     dim = args.dim if args.dim is not None else scene.default_dim
     methods = scene.methods if args.method is None else (METHODS if args.method == "both" else (args.method,))
     summaries = []
+    if len(methods) > 1:                               # both methods' refusals before either runs
+        for method in methods:
+            _, code = _attempt(lambda: check_run(args.scene, method, dim=dim, dp=args.dp, t_end=args.t_end,
+                                                 quick=args.quick, dt=args.dt, options=options, numerics=numerics,
+                                                 particles=args.particles))
+            if code:
+                return code
     for method in methods:
         out = args.out or f"runs/{args.scene}-{method}-{dim}d"
         if args.out and len(methods) > 1:
             out = f"{args.out}/{method}"
         res, code = _attempt(lambda: run(args.scene, method, dim=dim, dp=args.dp, t_end=args.t_end, out=out,
                                          quick=args.quick, dt=args.dt, progress=not args.quiet, options=options,
-                                         numerics=numerics, particles=args.particles))
+                                         numerics=numerics, particles=args.particles,
+                                         overwrite=args.overwrite))
         if code:
             return code
         s = res.summary

@@ -38,6 +38,7 @@ rigid body or clamp during it [N; 2D: N per metre of thickness] (sum of force x 
 from __future__ import annotations
 
 import json
+import zipfile
 import os
 from pathlib import Path
 
@@ -46,9 +47,9 @@ import numpy as np
 from .material import eos_pressure, von_mises
 from .state import FIELD_UNITS, PLASTIC_FIELDS, State
 
-__all__ = ["save_snapshot", "load_snapshot", "state_from_snapshot", "state_from_particles", "load_run",
-           "write_json", "json_ready", "save_reactions", "load_reactions", "analyse_cutting_run",
-           "SNAPSHOT_UNITS"]
+__all__ = ["run_files", "claim_run_folder", "save_snapshot", "load_snapshot", "state_from_snapshot",
+           "state_from_particles", "load_run", "write_json", "json_ready", "save_reactions", "load_reactions",
+           "analyse_cutting_run", "SNAPSHOT_UNITS"]
 
 SNAPSHOT_UNITS = dict(FIELD_UNITS, p="Pa", sigma_vm="Pa", F="1", id="1 (particle id)")
 
@@ -76,11 +77,36 @@ def save_snapshot(path, state: State, material, F: np.ndarray | None = None, ids
     os.replace(tmp, path)
 
 
+def read_npz(path, what: str = "file") -> dict:
+    """Every array of an ``.npz`` file; a file that is missing, truncated or not an npz is a ValueError naming it
+    (not NumPy's or zipfile's bare message)."""
+    try:
+        with np.load(path, allow_pickle=False) as z:
+            return {k: z[k] for k in z.files}
+    except FileNotFoundError:
+        raise ValueError(f"{path}: no such {what}") from None
+    except (OSError, ValueError, EOFError, zipfile.BadZipFile) as e:
+        raise ValueError(f"{path}: not a readable {what} (truncated or not an .npz: {type(e).__name__}: {e})") from None
+
+
+def read_json(path, what: str = "file"):
+    """A JSON file's content; missing or invalid is a ValueError naming the file."""
+    try:
+        return json.loads(Path(path).read_text())
+    except FileNotFoundError:
+        raise ValueError(f"{path}: no such {what}") from None
+    except (OSError, ValueError) as e:
+        raise ValueError(f"{path}: not a readable {what} (invalid JSON: {e})") from None
+
+
 def load_snapshot(path) -> dict:
-    """Snapshot as a dict of arrays (``t`` a float, ``units`` a dict)."""
-    with np.load(path, allow_pickle=False) as z:
-        out = {k: z[k] for k in z.files}
-    out["units"] = json.loads(str(out["units"]))
+    """Snapshot as a dict of arrays (``t`` a float, ``units`` a dict); ValueError naming the file if it cannot be
+    read or lacks ``t``, ``x``."""
+    out = read_npz(path, "snapshot")
+    missing = [k for k in ("t", "x") if k not in out]
+    if missing:
+        raise ValueError(f"{path}: not a refsph snapshot (no {', '.join(missing)})")
+    out["units"] = json.loads(str(out["units"])) if "units" in out else {}
     out["t"] = float(out["t"])
     return out
 
@@ -118,6 +144,12 @@ def state_from_particles(path, rho0: float, T0: float | None, clamp_names=()) ->
         if k in a and np.shape(a[k]) != shape:
             raise ValueError(f"{path}: array {k} has shape {np.shape(a[k])}, expected {shape} (N = {n} from x)")
     m = np.asarray(a["m"], dtype=float)
+    _, first, count = np.unique(x, axis=0, return_index=True, return_counts=True)
+    if np.any(count > 1):
+        k = int(first[np.argmax(count > 1)])
+        twin = int(np.flatnonzero(np.all(x == x[k], axis=1))[1])
+        raise ValueError(f"{path}: particles {k} and {twin} sit at the same position {x[k].tolist()} (and "
+                         f"{int(np.sum(count[count > 1] - 1)) - 1} more coincident); SPH needs distinct particles")
     plastic = T0 is not None
     state = State(x=x, v=np.asarray(a["v"], dtype=float), m=m, rho=np.asarray(a.get("rho", np.full(n, rho0)), float),
                   S=np.asarray(a.get("S", np.zeros((n, d, d))), float), S_zz=np.asarray(a.get("S_zz", np.zeros(n)),
@@ -145,8 +177,7 @@ def state_from_particles(path, rho0: float, T0: float | None, clamp_names=()) ->
 def load_run(directory) -> tuple[dict, list[Path]]:
     """(summary dict, sorted list of snapshot paths) of a run directory."""
     directory = Path(directory)
-    with open(directory / "summary.json") as f:
-        summary = json.load(f)
+    summary = read_json(directory / "summary.json", "run summary")
     snaps = sorted((directory / "snapshots").glob("snap_*.npz"))
     return summary, snaps
 
@@ -165,6 +196,55 @@ def json_ready(o):
     if isinstance(o, (np.integer, np.bool_)):
         return o.item()
     return o
+
+
+RUN_FILE_PATTERNS = ("summary.json", "summary.json.tmp", "reaction_forces.csv", "reaction_forces.csv.tmp",
+                     "snapshots/snap_[0-9][0-9][0-9][0-9][0-9].npz", "snapshots/*.tmp.npz", "snapshots/restart.npz",
+                     "snapshots/restart_prev.npz", "snapshots/last_good.npz",
+                     "vtk/snap_[0-9][0-9][0-9][0-9][0-9].vtu", "vtk/run.pvd", "vtk/units.json")
+
+
+def run_files(folder) -> list[Path]:
+    """The files of ``folder`` that refsph writes in a run folder (``RUN_FILE_PATTERNS``: the summary, the
+    reaction CSV, the snapshots and the restart checkpoint, ``refsph export``'s VTK files); nothing else."""
+    folder = Path(folder)
+    return sorted({p for pattern in RUN_FILE_PATTERNS for p in folder.glob(pattern) if p.is_file()})
+
+
+def claim_run_folder(out, scene: str, method: str, overwrite: bool = False) -> list[Path]:
+    """Make ``out`` ready for a run of ``scene`` with ``method``, losing nothing that refsph did not write: a
+    missing or empty folder is taken; a run folder of the same scene and method has its old run files removed
+    (:func:`run_files`; other files stay); anything else (another scene's or method's run, a folder that is not a
+    run, a file) is refused with a ValueError that says what is there, unless ``overwrite``, which removes only
+    refsph's run files and keeps every other file. Returns the files kept that refsph did not write."""
+    out = Path(out)
+    if out.exists() and not out.is_dir():
+        raise ValueError(f"--out {out} is a file, not a folder")
+    if not out.exists():
+        return []
+    everything = [p for p in out.rglob("*") if p.is_file()]
+    if not everything:
+        return []
+    ours = run_files(out)
+    foreign = sorted(set(everything) - set(ours))
+    summary = out / "summary.json"
+    try:
+        previous = json.loads(summary.read_text()) if summary.exists() else None
+    except (OSError, ValueError):
+        previous = None
+    same = isinstance(previous, dict) and (previous.get("scene"), previous.get("method")) == (scene, method)
+    if not same and not overwrite:
+        if isinstance(previous, dict):
+            what = f"a run of {previous.get('scene')!r} with {previous.get('method')!r}"
+        else:
+            what = f"{len(everything)} file(s) that are not a refsph run (e.g. {everything[0].relative_to(out)})"
+        raise ValueError(f"--out {out} holds {what}; refsph writes a run of {scene!r} with {method!r} only into an "
+                         "empty folder or a run folder of the same scene and method. Give another --out, or "
+                         "--overwrite (overwrite=True) to replace the run there: only the files refsph writes "
+                         f"are removed ({len(ours)} here), the other {len(foreign)} are kept")
+    for p in ours:
+        p.unlink()
+    return foreign
 
 
 def write_json(path, data: dict) -> None:

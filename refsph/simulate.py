@@ -14,7 +14,12 @@ summaries and the restart checkpoint ask each part for its own.
 Nothing is lost on a crash: snapshots are written as the run goes, ``summary.json`` is written at every snapshot
 (``status: "running"``), at the end *and* on failure (``status`` says which), and a run that produces NaN/inf
 stops, reports the field, particle, step and time, and writes ``snapshots/last_good.npz`` with the last finite
-state.
+state. Nor is anything a user keeps: a run writes only into an empty folder or a run folder of the same scene and
+method (:func:`refsph.io.claim_run_folder`; ``overwrite`` removes only refsph's own files), and a run whose folder
+vanishes (or its ``snapshots/``) stops with a SimulationError instead of writing it anew (the writers would create
+the folders again, and the summary would list snapshots that no longer exist); a write that fails (disk full) stops
+it the same way. Every snapshot keeps the checkpoint before it too (``restart_prev.npz``), so a restart whose last
+checkpoint or snapshot a crash spoilt continues from the one before (saying so).
 """
 from __future__ import annotations
 
@@ -25,6 +30,7 @@ import os
 import sys
 import time
 import warnings
+import zipfile
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable
@@ -40,7 +46,8 @@ from .stability import warnings_for
 from .strength import heat_capacity, heats
 from .thermal import HeatFlow
 from .boundaries import Clamp
-from .io import json_ready, save_reactions, save_snapshot, state_from_particles, state_from_snapshot, write_json
+from .io import (claim_run_folder, json_ready, save_reactions, save_snapshot, state_from_particles,
+                 state_from_snapshot, write_json)
 from .kernels import get_kernel
 from .neighbours import check_threads
 from .scenes import Scene, Setup, get_scene
@@ -48,11 +55,12 @@ from .solvers import ESPHSolver, TLSPHSolver
 from .state import State
 from .tlsph import TLSPHParams
 
-__all__ = ["SimulationError", "RunResult", "RunRecord", "make_solver", "step_physics", "run", "simulate",
+__all__ = ["SimulationError", "RunResult", "RunRecord", "make_solver", "step_physics", "run", "check_run", "simulate",
            "snapshot_times", "step_or_fail", "provenance", "restart_run", "METHODS"]
 
 METHODS = ("esph", "tlsph")
 CHECKPOINT = "restart.npz"          # snapshots/restart.npz: how to continue from the last snapshot (see simulate)
+PREVIOUS_CHECKPOINT = "restart_prev.npz"    # the checkpoint before it (a restart falls back on it)
 
 
 class SimulationError(RuntimeError):
@@ -81,6 +89,9 @@ def make_solver(method: str, setup: Setup) -> Solver:
                              "sums and have no friction model (run TLSPH, or set friction=None)")
         if setup.dissipation_heat:
             raise ValueError("dissipation_heat is a TLSPH option (ESPH's artificial viscosity heat is not computed)")
+        if nm.contact != "pinball" and setup.rigid:
+            raise ValueError(f"contact={nm.contact!r} is a TLSPH contact; ESPH's tools act on the workpiece through "
+                             "the SPH sums (run TLSPH, or leave contact at its default)")
         if nm.hourglass:
             raise ValueError("hourglass control is a TLSPH option (ESPH's neighbours change every step, its zig-zag "
                              "modes are the tensile instability's, see gamma)")
@@ -183,13 +194,24 @@ def _as_dict(obj) -> dict:
     return dict(model=type(obj).__name__, **fields)
 
 
+def _open_run_folder(out: Path, name: str, method: str, overwrite: bool, kept: list | None) -> None:
+    """A fresh run (``kept`` None) claims ``out`` (:func:`refsph.io.claim_run_folder`: refused unless it is empty or
+    a run of the same scene and method); a restart removes the snapshots after those it continues from."""
+    if kept is None:
+        claim_run_folder(out, name, method, overwrite)
+    (out / "snapshots").mkdir(parents=True, exist_ok=True)
+    for old in (out / "snapshots").glob("snap_*.npz"):
+        if kept is not None and old.name not in kept:
+            old.unlink()
+
+
 class RunRecord:
     """What a run leaves: ``summary`` (summary.json), ``history`` (the recorded scalars), snapshots and the
     reaction-force CSV in ``out`` (None: nothing is written). ``parts``: the run's parts that keep records of their
     own (:class:`RunParts`)."""
 
     def __init__(self, setup: Setup, parts: "RunParts", out, dt, name: str, record: Callable | None, times,
-                 resume: dict | None = None):
+                 resume: dict | None = None, overwrite: bool = False):
         self.setup, self.parts, self.solver, self.record_fn = setup, parts, parts.solver, record
         self.out = Path(out) if out is not None else None
         self.history: dict[str, list] = {}
@@ -197,13 +219,11 @@ class RunRecord:
         self.times, self.next_snap = times, 0
         self.n_steps, self.dts, self.record_every = 0, [], 1
         self.t0, self.c0 = time.perf_counter(), time.process_time()
+        self.lost = False                                   # the run folder vanished during the run
         if resume is not None:
             self._resume(resume)
         if self.out is not None:
-            (self.out / "snapshots").mkdir(parents=True, exist_ok=True)
-            for old in (self.out / "snapshots").glob("*.npz"):
-                if old.name not in self.snapshots and old.name != CHECKPOINT:
-                    old.unlink()
+            _open_run_folder(self.out, name, parts.solver.method, overwrite, self.snapshots if resume else None)
         self.summary = self._initial_summary(setup, parts.solver, dt, name)
         if resume is not None:
             self.summary["restarts"] = int(resume["run"]["restarts"]) + 1
@@ -223,6 +243,8 @@ class RunRecord:
         the uninterrupted run (the parts' own states, the history, the counters), written atomically."""
         if self.out is None:
             return
+        if not self.present():
+            raise SimulationError(self.summary["error"])
         run = dict(snapshot=snapshot, history={k: v for k, v in self.history.items() if k != "reaction"},
                    snapshots=self.snapshots, next_snap=self.next_snap, n_steps=self.n_steps,
                    record_every=self.record_every, wall_time_s=time.perf_counter() - self.t0,
@@ -231,6 +253,8 @@ class RunRecord:
         tmp = path.with_name("restart.tmp.npz")
         np.savez(tmp, run=json.dumps(json_ready(run)), dts=np.asarray(self.dts, dtype=float),
                  **self.parts.checkpoint())
+        if path.exists():                                   # the one before stays, for a restart whose last
+            os.replace(path, path.with_name(PREVIOUS_CHECKPOINT))   # checkpoint or snapshot a crash has spoilt
         os.replace(tmp, path)
 
     def _initial_summary(self, setup: Setup, solver: Solver, dt, name: str) -> dict:
@@ -257,7 +281,17 @@ class RunRecord:
         for k, val in values.items():
             self.history.setdefault(k, []).append(val)
 
+    def present(self) -> bool:
+        """The run folder is still there; else the run is marked lost and nothing more is written (module text)."""
+        if self.out is not None and not self.lost and not (self.out / "snapshots").is_dir():
+            self.lost = True
+            self.summary.update(status="error", error=f"the run folder {self.out} (or its snapshots/) vanished "
+                                                      "during the run")
+        return self.out is not None and not self.lost
+
     def save(self, name: str, state: State) -> Path:
+        if not self.present():
+            raise SimulationError(self.summary["error"])
         path = self.out / "snapshots" / name
         save_snapshot(path, state, self.setup.material, self.solver.deformation_gradient(state),
                       ids=self.setup.arrays.get("id"))
@@ -276,10 +310,11 @@ class RunRecord:
                 self.snapshots.append(name)
                 if 0 < self.next_snap < len(self.times) - 1:
                     self.update(state)
-                    write_json(self.out / "summary.json", self.summary)
+                    if self.present():
+                        write_json(self.out / "summary.json", self.summary)
             self.next_snap += 1
             if self.out is not None:
-                self.checkpoint(name)
+                self.checkpoint(name)                       # (a vanished folder: SimulationError)
             if state.t < self.setup.t_end * (1 - 1e-12):
                 break
 
@@ -297,24 +332,27 @@ class RunRecord:
         reactions = self.solver.reaction_history()
         if reactions:
             self.history["reaction"] = reactions
-            if self.out is not None:
+            if self.present():
                 save_reactions(self.out / "reaction_forces.csv", reactions, state.dim)
                 self.summary["reaction_forces_file"] = "reaction_forces.csv"
 
     def fail(self, status: str, msg: str, last_good: State) -> SimulationError:
         """Record a failed step (``last_good.npz``, status and message); the error to raise."""
-        if self.out is not None:
+        if self.present():
             path = self.save("last_good.npz", last_good)
             msg += f"; last good state written to {path}"
         self.summary.update(status=status, error=msg)
         return SimulationError(msg)
 
     def finish(self, state: State, metrics: Callable | None) -> None:
+        """The final summary (and its file, unless the run folder vanished: then a SimulationError)."""
         self.update(state)
         if metrics is not None and self.history and self.summary["status"] == "ok":
             self.summary["metrics"] = metrics(self.history, state, self.setup)
-        if self.out is not None:
+        if self.present():
             write_json(self.out / "summary.json", self.summary)
+        elif self.lost:
+            raise SimulationError(self.summary["error"])
 
 
 @dataclass
@@ -398,20 +436,39 @@ class _Progress:
             self.last = now
 
 
-def _begin(setup: Setup, parts: RunParts, out, dt, name: str, record, record_every, restart: bool):
+def _readable_checkpoint(folder: Path):
+    """(checkpoint arrays, its run record, its snapshot's state) of the last checkpoint in ``folder`` that can be
+    read with its snapshot; the one before (``restart_prev.npz``) if a crash spoilt the last or its snapshot (a
+    warning says so: the run then continues from the snapshot before, to the same bits); ValueError if neither."""
+    failures = []
+    for name in (CHECKPOINT, PREVIOUS_CHECKPOINT):
+        path = folder / name
+        if not path.exists():
+            failures.append(f"{path} does not exist")
+            continue
+        try:
+            with np.load(path) as z:
+                ck = {k: z[k] for k in z.files}
+            run_ck = json.loads(str(ck["run"]))
+            state = state_from_snapshot(folder / run_ck["snapshot"])
+        except (OSError, ValueError, KeyError, EOFError, zipfile.BadZipFile) as e:
+            failures.append(f"{path} (or its snapshot) cannot be read: {type(e).__name__}: {e}")
+            continue
+        if failures:
+            warnings.warn(f"{failures[0]}; continuing from the checkpoint before it, at {run_ck['snapshot']}",
+                          UserWarning, stacklevel=3)
+        return ck, run_ck, state
+    raise ValueError("nothing to restart from (a run writes a checkpoint at every snapshot): " + "; ".join(failures))
+
+
+def _begin(setup: Setup, parts: RunParts, out, dt, name: str, record, record_every, restart: bool,
+           overwrite: bool = False):
     """The initial record: a fresh start (the setup's state, recorded and written at t = 0), or with ``restart``
     the checkpoint of the run folder ``out`` (its snapshot, the history and counters, the parts' own states)."""
     if restart:
         if out is None:
             raise ValueError("restart needs the run folder (out=...)")
-        path = Path(out) / "snapshots" / CHECKPOINT
-        if not path.exists():
-            raise FileNotFoundError(f"{path} does not exist: nothing to restart from (a run writes it at every "
-                                    "snapshot)")
-        with np.load(path) as z:
-            ck = {k: z[k] for k in z.files}
-        run_ck = json.loads(str(ck["run"]))
-        state = state_from_snapshot(Path(out) / "snapshots" / run_ck["snapshot"])
+        ck, run_ck, state = _readable_checkpoint(Path(out) / "snapshots")
         parts.bind(setup.state)                             # (the initial temperatures of the heat ledger)
         if run_ck.get("heat") and not any(k.startswith("physics/") for k in ck):
             ck.update({f"physics/heat/{k}": v for k, v in run_ck["heat"].items()})   # a checkpoint before RunParts
@@ -423,7 +480,7 @@ def _begin(setup: Setup, parts: RunParts, out, dt, name: str, record, record_eve
     state.check()
     parts.solver.check_state(state)
     parts.bind(state)
-    rec = RunRecord(setup, parts, out, dt, name, record, snapshot_times(setup))
+    rec = RunRecord(setup, parts, out, dt, name, record, snapshot_times(setup), overwrite=overwrite)
     rec.record_every = record_every or max(1, int(setup.t_end / _time_step(setup, dt, state, parts.physics) / 400))
     _warn_fixed_dt(setup, dt, state)
     rec.record(state)
@@ -451,7 +508,7 @@ def simulate(setup: Setup, method: str | None = None, *, scene: Scene | None = N
              metrics: Callable[[dict, State, Setup], dict] | None = None, solver: Solver | None = None,
              hook: Callable[[State, Solver], State | None] | None = None, out=None, dt: float | None = None,
              progress: bool = True, label: str = "", record_every: int | None = None, restart: bool = False,
-             meta: dict | None = None) -> RunResult:
+             meta: dict | None = None, overwrite: bool = False) -> RunResult:
     """Run a prepared setup with ``method`` ('esph' | 'tlsph'), or with a ``solver`` of one's own (any
     :class:`~refsph.integrate.Solver`, e.g. one that wraps ``make_solver(method, setup)`` to add a force, or a
     :class:`~refsph.integrate.SelfAdvancing` method, e.g. an implicit one).
@@ -466,7 +523,9 @@ def simulate(setup: Setup, method: str | None = None, *, scene: Scene | None = N
     step before each snapshot time is shortened to land on it, so snapshots are at their nominal times (to
     round-off). With ``out``, every snapshot also writes ``snapshots/restart.npz``; ``restart=True`` continues the
     run in ``out`` from there (same setup, solver and callbacks), and gives the same bits as the uninterrupted run.
-    ``meta``: extra entries for summary.json."""
+    ``meta``: extra entries for summary.json. ``out`` must be missing, empty or a run folder of the same scene and
+    method (:func:`refsph.io.claim_run_folder`; ``overwrite=True``: any folder, of which only refsph's run files are
+    removed). A run whose folder vanishes, or whose output cannot be written, stops with a SimulationError."""
     if solver is not None and method is not None and method != solver.method:
         raise ValueError(f"method {method!r} does not match the solver's ({solver.method!r}); give one of them")
     method = method if solver is None else solver.method
@@ -479,7 +538,7 @@ def simulate(setup: Setup, method: str | None = None, *, scene: Scene | None = N
     name = scene.name if scene is not None else label
     for message in warnings_for(scene.name if scene is not None else None, method, setup.numerics):
         warnings.warn(message, UserWarning, stacklevel=2)
-    state, rec = _begin(setup, parts, out, dt, name, record, record_every, restart)
+    state, rec = _begin(setup, parts, out, dt, name, record, record_every, restart, overwrite)
     rec.summary.update(meta or {})
     show = _Progress(label or f"{name} {method} {state.dim}D", setup.t_end, progress)
     try:
@@ -492,6 +551,9 @@ def simulate(setup: Setup, method: str | None = None, *, scene: Scene | None = N
     except KeyboardInterrupt:
         rec.summary["status"] = "interrupted"
         raise
+    except OSError as e:                                    # the output could not be written (disk full, ...)
+        rec.summary.update(status="error", error=f"writing the run's output failed: {e}")
+        raise SimulationError(rec.summary["error"]) from e
     except Exception as e:
         if rec.summary["status"] == "running":
             rec.summary.update(status="error", error=f"{type(e).__name__}: {e}")
@@ -525,13 +587,22 @@ def _one_step(setup: Setup, parts: RunParts, rec: RunRecord, state: State, dt: f
 def run(scene_name: str, method: str, *, dim: int | None = None, dp: float | None = None,
         t_end: float | None = None, out=None, quick: bool = False, dt: float | None = None, progress: bool = True,
         numerics: dict | None = None, options: dict | None = None, restart: bool = False,
-        particles=None) -> RunResult:
+        particles=None, overwrite: bool = False) -> RunResult:
     """Build scene ``scene_name`` and run it. ``dim``: None = the scene's default; ``numerics`` overrides
     fields of the scene's Numerics; ``options`` sets the scene's own options (``Scene.options``); ``restart``:
     continue the run in ``out`` from its last checkpoint (:func:`restart_run` takes the arguments from it);
     ``particles``: an ``.npz`` of external particles that replace the scene's own (the scene keeps its material,
     numerics, boundaries and end time; :func:`refsph.io.state_from_particles` says what the file holds). Metrics
-    that need the scene's own particle layout are then reported as ``metrics_error``."""
+    that need the scene's own particle layout are then reported as ``metrics_error``. ``overwrite``: see
+    :func:`simulate` (``out`` of another scene, method or not a run)."""
+    setup, scene, metrics, args = _prepare(scene_name, method, dim, dp, t_end, quick, dt, numerics, options, particles)
+    return simulate(setup, method, scene=scene, out=out, dt=dt, progress=progress, restart=restart,
+                    meta=dict(run_args=args), metrics=metrics, overwrite=overwrite)
+
+
+def _prepare(scene_name, method, dim, dp, t_end, quick, dt, numerics, options, particles):
+    """The setup of a run (scene, numerics and options applied, external particles read), its scene, metrics and
+    the arguments that rebuild it (summary.json's run_args)."""
     scene = get_scene(scene_name)
     dim = scene.default_dim if dim is None else dim
     _validate(method, dim, dp, None, t_end, dt)
@@ -550,8 +621,22 @@ def run(scene_name: str, method: str, *, dim: int | None = None, dp: float | Non
         args["particles"] = str(Path(particles).resolve())
         _use_particles(setup, particles)
         metrics = _tolerant(scene.metrics)
-    return simulate(setup, method, scene=scene, out=out, dt=dt, progress=progress, restart=restart,
-                    meta=dict(run_args=args), metrics=metrics)
+    return setup, scene, metrics, args
+
+
+def check_run(scene_name: str, method: str, *, dim: int | None = None, dp: float | None = None,
+              t_end: float | None = None, quick: bool = False, dt: float | None = None, numerics: dict | None = None,
+              options: dict | None = None, particles=None) -> None:
+    """Everything :func:`run` checks before its first step, without running: the scene and its options, the
+    numerics, the method's solver, stepper and physics, the initial state. ``refsph run --method both`` checks both
+    methods so that the second one's refusal comes before the first one runs (ValueError/TypeError naming what)."""
+    setup, _, _, _ = _prepare(scene_name, method, dim, dp, t_end, quick, dt, numerics, options, particles)
+    solver = make_solver(method, setup)
+    make_stepper(setup.numerics.integrator, solver)
+    step_physics(setup)
+    state = setup.state.copy()
+    state.check()
+    solver.check_state(state)
 
 
 def _use_particles(setup: Setup, path) -> None:
@@ -580,7 +665,23 @@ def _tolerant(metrics):
 def restart_run(run_dir, progress: bool = True) -> RunResult:
     """Continue the run in ``run_dir`` (made by :func:`run` / ``refsph run``) from its last checkpoint, with the
     arguments it was started with (``summary.json``'s ``run_args``)."""
-    summary = json.loads((Path(run_dir) / "summary.json").read_text())
-    if "run_args" not in summary:
-        raise ValueError(f"{run_dir}/summary.json has no run_args: only runs made by refsph run can be restarted")
-    return run(**summary["run_args"], out=run_dir, progress=progress, restart=True)
+    path = Path(run_dir) / "summary.json"
+    try:
+        summary = json.loads(path.read_text())
+    except FileNotFoundError:
+        raise ValueError(f"{path} does not exist: {run_dir} is not a refsph run folder") from None
+    except ValueError as e:
+        raise ValueError(f"{path} is not valid JSON ({e})") from None
+    args = summary.get("run_args") if isinstance(summary, dict) else None
+    if not isinstance(args, dict):
+        raise ValueError(f"{path} has no run_args: only runs made by refsph run can be restarted")
+    known = set(inspect.signature(run).parameters) - {"out", "progress", "restart", "overwrite"}
+    unknown = sorted(set(args) - known)
+    if unknown or "scene_name" not in args or "method" not in args:
+        what = f"unknown entries {', '.join(unknown)}" if unknown else "no scene_name or method"
+        raise ValueError(f"{path}: run_args has {what}; it must hold the arguments of refsph.simulate.run "
+                         f"({', '.join(sorted(known))})")
+    try:
+        return run(**args, out=run_dir, progress=progress, restart=True)
+    except TypeError as e:
+        raise ValueError(f"{path}: run_args do not fit refsph.simulate.run ({e})") from None

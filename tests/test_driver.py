@@ -114,9 +114,13 @@ def test_cli_list_and_run(tmp_path, capsys):
     assert main(["run", "nope"]) == 2
     assert main(["run", "bar", "--dp", "-1", "--out", str(tmp_path / "x")]) == 2
     assert "dp" in capsys.readouterr().err
-    # a whole-number numerical parameter from --set: threads
-    assert main(["run", "bar", "--method", "esph", "--quick", "--t-end", "1e-6", "--out", str(out), "--quiet",
-                 "--set", "threads=1"]) == 0
+    # a whole-number numerical parameter from --set: threads; --out of the TLSPH run refused for ESPH (issue 23)
+    # unless --overwrite
+    args = ["run", "bar", "--method", "esph", "--quick", "--t-end", "1e-6", "--out", str(out), "--quiet", "--set",
+            "threads=1"]
+    assert main(args) == 2 and "--overwrite" in capsys.readouterr().err
+    assert json.loads((out / "summary.json").read_text())["method"] == "tlsph"
+    assert main(args + ["--overwrite"]) == 0
     assert json.loads((out / "summary.json").read_text())["threads"] == 1
     assert main(["run", "bar", "--quick", "--set", "threads=1.5", "--out", str(tmp_path / "y")]) == 2
     assert "whole number" in capsys.readouterr().err

@@ -99,8 +99,88 @@ def test_compare_golden_cases(tmp_path, capsys):
     savez_fixed(test / "esph_rates" / "output.npz", **out)
     capsys.readouterr()
     assert main(["compare", str(GOLDEN), str(test)]) == 1
-    bad = [line for line in capsys.readouterr().out.splitlines() if line.endswith("NO")]
-    assert len(bad) == 1 and bad[0].startswith("esph_rates/v_dot")
+    lines = capsys.readouterr().out.splitlines()
+    bad = [k for k, line in enumerate(lines) if line.endswith("NO")]
+    assert len(bad) == 1 and lines[bad[0]].startswith("esph_rates/v_dot")
+    worst = np.unravel_index(np.argmax(np.abs(out["v_dot"])), out["v_dot"].shape)      # where 0.1 % is most
+    assert lines[bad[0] + 1].startswith(f"    worst at particle {worst[0]} component [{worst[1]}]: REF ")
+
+
+def _golden_copy(tmp_path, cases) -> Path:
+    test = tmp_path / "t"
+    for case in cases:
+        shutil.copytree(GOLDEN / case, test / case)
+    return test
+
+
+def _outputs(path: Path) -> dict:
+    with np.load(path) as z:
+        return {k: z[k] for k in z.files}
+
+
+def test_compare_labels_what_a_number_would_hide(tmp_path):
+    """Golden cases: a case TEST lacks, an array it lacks, one of another shape, a float32 backend and a nan are
+    each labelled (missing, shape mismatch, dtype with the digits float32 keeps, not finite) and counted in the
+    last line; the cases TEST lacks are said up front."""
+    test = _golden_copy(tmp_path, ["kernel_cubic_2d", "esph_rates", "esph_pair_terms"])
+    out = _outputs(test / "kernel_cubic_2d" / "output.npz")
+    np.savez(test / "kernel_cubic_2d" / "output.npz", **{k: v.astype(np.float32) for k, v in out.items()})
+    out = _outputs(test / "esph_rates" / "output.npz")
+    del out["l"]
+    out["v_dot"] = out["v_dot"][:, :1]
+    out["rho_dot"][7] = np.nan
+    np.savez(test / "esph_rates" / "output.npz", **out)
+    rows = compare(GOLDEN, test, only=["kernel_cubic_2d", "esph_rates*", "esph_pair_terms"])
+    by = {r.quantity: r for r in rows}
+    assert all(by[f"kernel_cubic_2d/{k}"].labels == ("dtype",) and not by[f"kernel_cubic_2d/{k}"].passed
+               for k in ("W", "dW_dr", "grad_W"))
+    assert "float32 keeps 6 digits" in by["kernel_cubic_2d/W"].note
+    assert by["esph_rates/l"].labels == ("missing",) and "has no array l" in by["esph_rates/l"].note
+    assert by["esph_rates/v_dot"].labels == ("shape mismatch",) and "(120, 1)" in by["esph_rates/v_dot"].note
+    assert by["esph_rates/rho_dot"].labels == ("not finite",) and by["esph_rates/rho_dot"].where == "particle 7"
+    assert all(by[f"{c}/v_dot"].labels == ("missing",) for c in ("esph_rates_no_viscosity", "esph_rates_stress_only"))
+    assert all(r.passed for r in rows if r.quantity.startswith("esph_pair_terms/"))
+    table = format_table(rows)
+    assert table.splitlines()[0].startswith("NOTE: TEST has no output.npz for 3 of the 6 cases")
+    assert table.count("TEST has no esph_rates_stress_only/output.npz") == 1          # said once, not per array
+    assert table.splitlines()[-1].endswith("(16 missing, 1 shape mismatch, 3 dtype, 1 not finite)")
+
+
+def test_compare_runs_localises_and_labels(tmp_path):
+    """Run folders: different methods are said first; a TEST snapshot missing is interpolated from its neighbours
+    and labelled so; a particle TEST lacks is missing; a float32 field is labelled dtype; a failing field names the
+    particle id, component, time and both values; a snapshot without refsph's units entry is read."""
+    kw = dict(quick=True, t_end=2e-6, progress=False, numerics={"threads": 1})
+    run("bar", "tlsph", out=tmp_path / "ref", **kw)
+    run("bar", "esph", out=tmp_path / "esph", **kw)
+    notes = compare(tmp_path / "ref", tmp_path / "esph").notes
+    assert "different method: REF tlsph, TEST esph" in notes
+    test = tmp_path / "t"
+    shutil.copytree(tmp_path / "ref", test)
+    snaps = sorted((test / "snapshots").glob("snap_*.npz"))
+    snaps[3].unlink()                                           # TEST has no snapshot at REF's 4th time
+    z = _outputs(snaps[5])
+    del z["units"]
+    z["S"] = z["S"].astype(np.float32)
+    z["v"][11, 1] += 1.0
+    np.savez(snaps[5], **z)
+    z = _outputs(snaps[7])
+    np.savez(snaps[7], **{k: (v[1:] if np.ndim(v) and len(v) == len(z["x"]) else v) for k, v in z.items()})
+    rows = compare(tmp_path / "ref", test)
+    assert rows.notes == []
+
+    def at(snap):
+        return {r.quantity.split()[-1]: r for r in rows if r.quantity.startswith(snap.stem)}
+    assert all("interpolated" in r.labels for r in at(snaps[3]).values())
+    assert "interpolated between its snapshots" in at(snaps[3])["x"].note
+    s5 = at(snaps[5])
+    assert s5["S"].labels == ("dtype",) and s5["x"].passed
+    assert not s5["v"].passed and s5["v"].where == "particle id 11 component [1]"
+    assert s5["v"].time == float(_outputs(tmp_path / "ref" / "snapshots" / snaps[5].name)["t"])
+    assert s5["v"].test_value - s5["v"].ref_value == pytest.approx(1.0)
+    assert all(r.labels == ("missing",) and "lacks 1 of REF's particles (ids 0)" in r.note
+               for r in at(snaps[7]).values())
+    assert f"worst at particle id 11 component [1], t = {s5['v'].time:.6g} s" in format_table(rows)
 
 
 @pytest.mark.parametrize("case, array, change, passes", [

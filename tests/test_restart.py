@@ -66,7 +66,44 @@ def test_restart_is_bit_for_bit(tmp_path, monkeypatch, scene, method, kw):
 def test_restart_input_errors(tmp_path, capsys):
     assert main(["run", "--restart", str(tmp_path / "nothing"), "--quiet"]) == 2
     assert main(["run", "bar", "--restart", str(tmp_path), "--quiet"]) == 2
-    assert "no scene" in capsys.readouterr().err
+    assert "takes no a scene" in capsys.readouterr().err
+    for flags in (["--t-end", "1e-6"], ["--from", "p.npz"], ["--set", "beta1=1"], ["--out", "x"]):
+        assert main(["run", "--restart", str(tmp_path), "--quiet"] + flags) == 2      # not silently ignored
+        assert flags[0] in capsys.readouterr().err
+
+
+KW = dict(quick=True, t_end=0.2e-6)
+
+
+@pytest.mark.parametrize("spoil", ["checkpoint", "snapshot"])
+def test_restart_falls_back_to_the_checkpoint_before_a_spoilt_one(tmp_path, monkeypatch, spoil):
+    """A crash can leave the last checkpoint or the last snapshot truncated: --restart says so and continues from
+    the checkpoint before it (restart_prev.npz), to the same bits as the run that was never stopped."""
+    whole = run("pressing", "tlsph", out=tmp_path / "whole", progress=False, **KW)
+    _killed(monkeypatch, "pressing", "tlsph", tmp_path / "cut", KW)
+    snaps = tmp_path / "cut" / "snapshots"
+    last = json.loads(str(np.load(snaps / "restart.npz")["run"]))["snapshot"]
+    victim = snaps / ("restart.npz" if spoil == "checkpoint" else last)
+    victim.write_bytes(victim.read_bytes()[:200])                  # truncated
+    with pytest.warns(UserWarning, match="checkpoint before"):
+        assert main(["run", "--restart", str(tmp_path / "cut"), "--quiet"]) == 0
+    a, b = (load_snapshot(load_run(tmp_path / d)[1][-1]) for d in ("whole", "cut"))
+    assert all(np.array_equal(a[k], b[k]) for k in ("x", "v", "S", "eps_p"))
+    again = json.loads((tmp_path / "cut" / "summary.json").read_text())
+    assert again["n_steps"] == whole.summary["n_steps"] and again["snapshots"] == whole.summary["snapshots"]
+
+
+def test_restart_refuses_a_hand_edited_summary(tmp_path, capsys):
+    run("bar", "tlsph", out=tmp_path / "r", progress=False, quick=True, t_end=0.2e-6)
+    path = tmp_path / "r" / "summary.json"
+    s = json.loads(path.read_text())
+    s["run_args"]["colour"] = "red"
+    path.write_text(json.dumps(s))
+    assert main(["run", "--restart", str(tmp_path / "r"), "--quiet"]) == 2
+    assert "unknown entries colour" in capsys.readouterr().err
+    path.write_text("{not json")
+    assert main(["run", "--restart", str(tmp_path / "r"), "--quiet"]) == 2
+    assert "summary.json is not valid JSON" in capsys.readouterr().err
 
 
 def test_run_from_external_particles(tmp_path, capsys):
@@ -92,6 +129,11 @@ def test_run_from_external_particles(tmp_path, capsys):
     np.savez(f, x=s.x, v=s.v, m=s.m, body=s.body)
     assert main(["run", "pressing", "--quick", "--quiet", "--from", str(f), "--out", str(tmp_path / "q")]) == 2
     assert "clamp_left_side" in capsys.readouterr().err
+    twins = s.x.copy()
+    twins[5] = twins[4]
+    np.savez(f, x=twins, v=s.v, m=s.m, body=s.body, clamp_left_side=setup.clamps[0].index)
+    assert main(["run", "pressing", "--quick", "--quiet", "--from", str(f), "--out", str(tmp_path / "q")]) == 2
+    assert "particles 4 and 5 sit at the same position" in capsys.readouterr().err
     np.savez(f, x=s.x, v=s.v[:10], m=s.m)
     assert main(["run", "pressing", "--quick", "--quiet", "--from", str(f), "--out", str(tmp_path / "q")]) == 2
     assert "array v has shape" in capsys.readouterr().err

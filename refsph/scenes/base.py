@@ -13,6 +13,7 @@ from typing import Callable
 import numpy as np
 
 from ..boundaries import MirrorPlanes
+from ..kernels import KERNELS
 from ..material import ElasticMaterial
 from ..state import State
 from ..strength import Elastic, StrengthModel
@@ -59,6 +60,39 @@ class Numerics:
     contact: str = "pinball"
     penalty_alpha: float = 0.1
     penalty_damping: float = 0.5
+
+    def __post_init__(self):
+        """Every parameter checked when the Numerics is made (a scene's, or ``--set``'s replacement of it), so that
+        a bad value is refused by name before anything runs, not at step N."""
+        def real(name, lo=None, hi=None, lo_open=False, optional=False):
+            v = getattr(self, name)
+            if v is None and optional:
+                return
+            ok = isinstance(v, (int, float)) and not isinstance(v, bool) and np.isfinite(v)
+            ok = ok and (lo is None or (v > lo if lo_open else v >= lo)) and (hi is None or v <= hi)
+            if not ok:
+                span = ("" if lo is None else f"{'>' if lo_open else '>='} {lo!r}") + \
+                       ("" if hi is None else f"{' and ' if lo is not None else ''}<= {hi!r}")
+                raise ValueError(f"numerical parameter {name} must be a finite number {span}"
+                                 f"{' (or none)' if optional else ''}, got {v!r}")
+        real("h_over_dp", 1.0, 4.0)
+        for name in ("beta1", "beta2", "gamma", "skin_factor", "hourglass", "penalty_damping"):
+            real(name, 0.0)
+        for name in ("n_ap", "eps", "contact_Kp"):
+            real(name, 0.0, lo_open=True)
+        real("courant", 0.0, 1.0, lo_open=True)
+        real("ref_update_strain", 0.0, lo_open=True, optional=True)
+        real("contact_k", 0.0, lo_open=True, optional=True)
+        real("penalty_alpha", 0.0, 4.0, lo_open=True)
+        if not (isinstance(self.threads, int) and not isinstance(self.threads, bool) and self.threads >= 0):
+            raise ValueError(f"numerical parameter threads must be a whole number >= 0, got {self.threads!r}")
+        for name, choices in (("kernel", tuple(KERNELS)), ("contact", ("pinball", "penalty"))):
+            if getattr(self, name) not in choices:
+                raise ValueError(f"numerical parameter {name} must be one of {', '.join(choices)}, got "
+                                 f"{getattr(self, name)!r}")
+        for name in ("corrected", "esph_correction"):
+            if not isinstance(getattr(self, name), (bool, np.bool_)):
+                raise ValueError(f"numerical parameter {name} must be true or false, got {getattr(self, name)!r}")
 
 
 def numerics_field_optional(name: str) -> bool:

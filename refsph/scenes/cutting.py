@@ -44,6 +44,7 @@ from ..paper_data import CUTTING_GEOMETRY, CUTTING_OBSERVED, CUTTING_TABLE5
 from ..state import concatenate_states, make_state
 from .base import Numerics, Scene, Setup
 from .measure import (N_FORCE_BINS, TOOL_BODY, aisi4340_johnson_cook, aisi4340_material, binned_mean, box_outline,
+                      check_particle_count,
                       block_lattice, time_mean)
 
 __all__ = ["SCENE", "cutting_particles", "chip_thickness", "lattice_shape", "shear_bands", "cutting_metrics",
@@ -70,6 +71,7 @@ def cutting_particles(dp: float, feed: float, n_tool_layers: int):
     xw, i, j = block_lattice(nx, ny, dx, dy)
     clamp = np.flatnonzero((i == 0) | (j == 0))
     y0 = Ly - feed
+    check_particle_count(round(Wt / dx), round(Ht / dy), dp=dx)
     ti, tj = np.meshgrid(np.arange(round(Wt / dx)), np.arange(round(Ht / dy)), indexing="ij")
     surface = (ti.ravel() < n_tool_layers) | (tj.ravel() < n_tool_layers)
     xt = np.stack([Lx + (ti.ravel() + 0.5) * dx, y0 + (tj.ravel() + 0.5) * dy], axis=1)[surface]

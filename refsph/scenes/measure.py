@@ -21,6 +21,21 @@ TOOL_BODY = 1           # body id of the tool in the scenes with one (0 is the w
 N_FORCE_BINS = 400      # force histories in summary.json: time averages over this many equal bins
 
 
+MAX_PARTICLES = 10_000_000   # a lattice larger than this is refused before it is allocated (pure NumPy: ~1 kB each)
+
+
+def check_particle_count(*counts, dp: float | None = None) -> None:
+    """Refuse (ValueError) a lattice of prod(counts) points above ``MAX_PARTICLES`` before any array is made (a
+    spacing of 1e-8 m would otherwise ask for terabytes)."""
+    n = 1
+    for c in counts:
+        n *= max(int(c), 0)
+    if n > MAX_PARTICLES:
+        raise ValueError(f"{'the spacing dp = ' + repr(dp) + ' m' if dp is not None else 'this resolution'} would "
+                         f"make {n:.3g} lattice points, more than refsph builds ({MAX_PARTICLES:.0e}; a pure-NumPy "
+                         "code needs about 1 kB per particle): choose a larger dp")
+
+
 # ----------------------------------------------------------------------------- particles and materials
 def lattice(lengths, dp: float) -> np.ndarray:
     """Particle centres of a box [0, L_0] x ... on a square/cubic lattice of spacing dp (cell centres)."""
@@ -29,7 +44,9 @@ def lattice(lengths, dp: float) -> np.ndarray:
         n = int(round(L / dp))
         if n < 1:
             raise ValueError(f"spacing dp={dp!r} is larger than the body ({L!r} m)")
-        axes.append((np.arange(n) + 0.5) * dp)
+        axes.append(n)
+    check_particle_count(*axes, dp=dp)
+    axes = [(np.arange(n) + 0.5) * dp for n in axes]
     grids = np.meshgrid(*axes, indexing="ij")
     return np.stack([g.ravel() for g in grids], axis=1)
 
@@ -37,6 +54,7 @@ def lattice(lengths, dp: float) -> np.ndarray:
 def block_lattice(nx: int, ny: int, dx: float, dy: float):
     """Cell centres ((i + 1/2) dx, (j + 1/2) dy) of an nx x ny block, particle k = i ny + j (column i, row j),
     with the (i, j) of every particle: the layout of the pressing block and of the cutting workpiece."""
+    check_particle_count(nx, ny, dp=min(dx, dy))
     i, j = np.meshgrid(np.arange(nx), np.arange(ny), indexing="ij")
     i, j = i.ravel(), j.ravel()
     return np.stack([(i + 0.5) * dx, (j + 0.5) * dy], axis=1), i, j
@@ -137,6 +155,7 @@ def annulus(r_inner: float, r_outer: float, dp: float, centre=(0.0, 0.0)) -> np.
     if not (0 <= r_inner < r_outer and dp > 0):
         raise ValueError(f"need 0 <= r_inner < r_outer and dp > 0, got {r_inner!r}, {r_outer!r}, {dp!r}")
     n = int(np.ceil(r_outer / dp)) + 1
+    check_particle_count(2 * n + 1, 2 * n + 1, dp=dp)
     a = np.arange(-n, n + 1) * dp
     X, Y = np.meshgrid(a, a, indexing="ij")
     pts = np.stack([X.ravel(), Y.ravel()], axis=1)

@@ -36,7 +36,7 @@ from ..paper_data import TAYLOR_GEOMETRY, TAYLOR_RESULTS, TAYLOR_TABLE1, TAYLOR_
 from ..plasticity import JohnsonCook
 from ..state import make_state
 from .base import Numerics, Scene, Setup
-from .measure import kinetic_energy
+from .measure import check_particle_count, kinetic_energy
 
 __all__ = ["SCENE", "comparison_table", "taylor_material", "taylor_johnson_cook", "taylor_particles",
            "lattice_cylinder", "bar_length",
@@ -74,6 +74,7 @@ def taylor_particles(dim: int, dp: float, symmetry: bool, length: float, diamete
     nr = max(1, int(round(R / dp)))
     nz = max(1, int(round(length / dp)))
     dr, dz = R / nr, length / nz
+    check_particle_count(2 * nr, nz, *((2 * nr,) if dim == 3 else ()), dp=dp)
     zs = (np.arange(nz) + 0.5) * dz
     if dim == 2:
         xs = (np.arange(nr) + 0.5) * dr
@@ -104,6 +105,7 @@ def lattice_cylinder(dp: float, symmetry: bool, length: float, diameter: float):
     LAMMPS's order (x fastest, then y, then z); its surface is a staircase (see the module text)."""
     R = 0.5 * diameter
     n = int(np.ceil(R / dp))
+    check_particle_count(2 * n, 2 * n, np.ceil(length / dp), dp=dp)
     a = (np.arange(-n, n) + 0.5) * dp
     if symmetry:
         a = a[a > 0]

@@ -74,7 +74,7 @@ from ..penalty import RoundedPolygon
 from ..state import concatenate_states, make_state
 from ..thermal import Conduction, FrictionHeat, SurfaceLoss
 from .base import Numerics, Scene, Setup, parse_bool
-from .measure import N_FORCE_BINS, TOOL_BODY, binned_mean, block_lattice, time_mean
+from .measure import N_FORCE_BINS, TOOL_BODY, binned_mean, block_lattice, check_particle_count, time_mean
 
 __all__ = ["SCENE", "MATERIALS", "tool_particles", "tool_shape", "mass_scale_for", "rake_frame", "chip_measures",
            "drift", "thermal_cutting_metrics", "thermal_cutting_table", "STEADY_FROM"]
@@ -117,6 +117,7 @@ def tool_particles(dx: float, tu: float, apex, length: float = 5.0, depth: float
     and the rounded edge, placed with the edge at ``apex``; and a mask of the held rows (top and back layers)."""
     g, beta = math.radians(RAKE_DEG), math.radians(90.0 - RAKE_DEG - CLEARANCE_DEG)
     nu_, nw = round(length * tu / dx), round(depth * tu / dx)
+    check_particle_count(nu_, nw, dp=dx)
     u, w = [a.ravel() * dx for a in np.meshgrid(np.arange(nu_) + 0.5, np.arange(nw) + 0.5, indexing="ij")]
     keep = np.arctan2(w, u) <= beta
     rc = EDGE_RADIUS / math.sin(beta / 2)                 # the edge circle's centre, on the bisector
@@ -146,6 +147,15 @@ def tool_shape(tu: float, apex, centroid, length: float = 5.0, depth: float = 3.
 
 
 def _case_values(case, material, vc, tu):
+    if not (np.isfinite(case) and float(case) == int(case)):
+        raise ValueError(f"option case must be a whole number 0-18, got {case!r}")
+    if int(case) != 0:
+        given = [f"{k} = {v!r}" for k, v, default in (("material", material, OPTIONS["material"][0]),
+                                                      ("vc", vc, OPTIONS["vc"][0]), ("tu", tu, OPTIONS["tu"][0]))
+                 if v != default]
+        if given:
+            raise ValueError(f"option case {int(case)} sets material, vc and tu from the paper's table; give either "
+                             f"the case or {', '.join(given)} (case 0)")
     if int(case) == 0:
         if material not in MATERIALS:
             raise ValueError(f"material must be one of {', '.join(MATERIALS)}, got {material!r}")

@@ -228,40 +228,53 @@ def main(argv=None):
     if args.timing:
         res = STORE.set(timing=clean_timing(), machine=machine())
     else:
-        sweep(args.only or list(CASES), args.redo, args.jobs)
+        ran = sweep(args.only or list(CASES), args.redo, args.jobs)
+        if not ran:                                         # nothing new: the committed files stay as they are
+            print("nothing ran (every case asked for is recorded, or cannot run here); the JSON and the report are "
+                  "unchanged (--redo runs cases again, --report rewrites the report)")
+            return 0
         done = STORE.load()
-        res = STORE.set(comparisons=comparisons(done["cases"], done.get("comparisons", {})), machine=machine())
+        res = STORE.set(comparisons=comparisons(done["cases"], done.get("comparisons", {}), ran), machine=machine())
     REPORT.write_text(report(res))
     print(f"wrote {OUT_JSON} and {REPORT}")
     return 0
 
 
-def sweep(names: list, redo: bool, jobs: int) -> None:
-    """The cases not yet done (all of ``names`` with ``redo``): the LAMMPS ones first (they write the particles)."""
+def sweep(names: list, redo: bool, jobs: int) -> list:
+    """The cases not yet done (all of ``names`` with ``redo``): the LAMMPS ones first (they write the particles).
+    Returns the names that ran (a failed run never replaces a good record: study.RunStore)."""
     from refsph.crosscheck import lammps
     todo = STORE.pending(names, redo=names if redo else (), retry_failed=True)
     if lammps.find_lmp() is None:
         print(lammps.INSTALL_HINT)
         todo = [n for n in todo if CASES[n][0] == "refsph" and (RUNS / CASES[n][3] / "particles.npz").exists()]
+    ran = []
     for code in ("lammps", "refsph"):
         wave = {n: (n,) for n in todo if CASES[n][0] == code}
         for name, rec in study.execute(run_case, wave, jobs):
-            STORE.commit(name, rec)
-            STORE.set(machine=machine())
+            if STORE.commit(name, rec):
+                ran.append(name)
             print(f"{name:24s} {rec['status'][:70]}  {rec.get('wall_time_s', float('nan')):8.1f} s", flush=True)
+    return ran
 
 
-def comparisons(cases: dict, old: dict) -> dict:
-    """``refsph compare`` of each pair of PAIRS whose cases are both done; where their run folders are gone, the
-    comparison ``old`` holds (made with them) is kept."""
-    out = {}
+def comparisons(cases: dict, old: dict, ran=None) -> dict:
+    """``refsph compare`` of each pair of PAIRS whose cases are both done and one of which ran now (``ran``; None:
+    every pair), with its run folders here; every other pair keeps the comparison ``old`` holds, and so does a
+    pair whose comparison now ends in an error (exit 2: a run folder incomplete), so a partial rerun never
+    replaces a committed comparison with an error."""
+    out = dict(old)
     for a, b in PAIRS:
-        if all(cases.get(n, {}).get("status") == "ok" for n in (a, b)):
-            if all((RUNS / n / "run").exists() for n in (a, b)):
-                rc, table = compare_pair(a, b)
-                out[f"{a} vs {b}"] = dict(exit_code=rc, table=table)
-            elif f"{a} vs {b}" in old:
-                out[f"{a} vs {b}"] = old[f"{a} vs {b}"]
+        key = f"{a} vs {b}"
+        fresh = ran is None or a in ran or b in ran
+        if fresh and all(cases.get(n, {}).get("status") == "ok" for n in (a, b)) and \
+                all((RUNS / n / "run").exists() for n in (a, b)):
+            rc, table = compare_pair(a, b)
+            if rc == 2 and key in old:
+                print(f"{key}: the comparison failed ({table.strip().splitlines()[-1][:100] if table.strip() else ''})"
+                      "; the committed one is kept", flush=True)
+                continue
+            out[key] = dict(exit_code=rc, table=table)
     return out
 
 

@@ -414,7 +414,10 @@ def main(argv=None) -> int:
     if args.quick and args.json == OUT_JSON:
         _parser().error("--quick writes try-out records: give them their own --json file")
     if not args.report:
-        sweep(store(args.json), jobs(args.study or STUDY_NAMES, args.only), args)
+        if not sweep(store(args.json), jobs(args.study or STUDY_NAMES, args.only), args):
+            print("nothing ran: every run asked for is recorded; the JSON, the page and the figures are unchanged "
+                  "(--redo KEY runs one again, --report rewrites the page)")
+            return 0
     res = load(args.json)                                 # with what another sweep on the same file added
     if args.json != OUT_JSON:
         print(report(res))
@@ -439,18 +442,22 @@ def _parser():
     return ap
 
 
-def sweep(runs: study.RunStore, todo: dict, args) -> None:
-    """Run the keys of ``todo`` not yet recorded (or in ``--redo``), each record stored as it comes."""
+def sweep(runs: study.RunStore, todo: dict, args) -> list:
+    """Run the keys of ``todo`` not yet recorded (or in ``--redo``), each record stored as it comes (a failed run
+    never replaces a good record: study.RunStore); the keys that ran."""
     todo = {k: todo[k] for k in runs.pending(todo, redo=args.redo)}
     print(f"{len(todo)} runs to do ({len(runs.records())} recorded)", flush=True)
     t0 = time.perf_counter()
     tasks = {k: (k, o, nm, args.quick) for k, (o, nm) in todo.items()}
+    ran = []
     for k, (key, rec) in enumerate(study.execute(run_case, tasks, args.jobs, args.scheduler)):
         runs.commit(key, rec)
+        ran.append(key)
         m = rec.get("metrics", {})
         print(f"[{k + 1}/{len(todo)}] {key:24s} {rec['status']:6s} Fp/Fc {_f(m.get('force_ratio'), '.2f')} "
               f"T_RF {_f(m.get('rake_face_temperature_K'), '.0f')} K, {_f(rec.get('wall_time_s'), '.0f')} s "
               f"({(time.perf_counter() - t0) / 60:.1f} min elapsed)", flush=True)
+    return ran
 
 
 if __name__ == "__main__":

@@ -122,3 +122,42 @@ def test_page_fills_its_sections():
     assert page("cost_of_dt", steps="3.7", wall="5.2") == "; 3.7 times the steps, 5.2 times the wall time"
     with pytest.raises(KeyError):
         page("cost_of_dt", steps="3.7")
+
+
+def _bench(name):
+    import importlib.util
+    spec = importlib.util.spec_from_file_location(f"bench_{name}", BENCH / f"{name}.py")
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod
+
+
+def test_a_partial_rerun_that_runs_nothing_changes_no_file(tmp_path, monkeypatch, capsys):
+    """issue 23: `lammps_crosscheck.py --only bar-lammps bar-refsph` in a fresh clone (no run folders, no LAMMPS or
+    the cases recorded) leaves the committed JSON and report as they are, byte for byte."""
+    mod = _bench("lammps_crosscheck")
+    json_copy, report_copy = tmp_path / "x.json", tmp_path / "x.md"
+    json_copy.write_bytes(mod.OUT_JSON.read_bytes())
+    report_copy.write_bytes(mod.REPORT.read_bytes())
+    monkeypatch.setattr(mod, "STORE", _study().RunStore(json_copy, section="cases"))
+    monkeypatch.setattr(mod, "REPORT", report_copy)
+    monkeypatch.setattr(mod, "RUNS", tmp_path / "no_runs")
+    assert mod.main(["--only", "bar-lammps", "bar-refsph"]) == 0
+    assert json_copy.read_bytes() == mod.OUT_JSON.read_bytes()
+    assert report_copy.read_bytes() == mod.REPORT.read_bytes()
+    assert "nothing ran" in capsys.readouterr().out
+
+
+def test_a_comparison_that_fails_now_keeps_the_committed_one(monkeypatch, tmp_path):
+    mod = _bench("lammps_crosscheck")
+    a, b = mod.PAIRS[0]
+    for n in (a, b):
+        (tmp_path / n / "run").mkdir(parents=True)
+    monkeypatch.setattr(mod, "RUNS", tmp_path)
+    monkeypatch.setattr(mod, "compare_pair", lambda x, y: (2, "refsph: a run folder is incomplete"))
+    old = {f"{a} vs {b}": dict(exit_code=0, table="the committed table")}
+    cases = {a: dict(status="ok"), b: dict(status="ok")}
+    assert mod.comparisons(cases, old, ran=[a]) == old
+    monkeypatch.setattr(mod, "compare_pair", lambda x, y: (1, "a new table"))
+    assert mod.comparisons(cases, old, ran=[a])[f"{a} vs {b}"] == dict(exit_code=1, table="a new table")
+    assert mod.comparisons(cases, old, ran=["something else"]) == old

@@ -87,6 +87,26 @@ CASES = [
     ["oracle", "/proc/x"], ["oracle", "{d}/foreign"], ["oracle", "{d}/a_file"],
     ["oracle", "{d}/new_golden", "--only", "no_such_case"],
     ["list", "--extra"], ["frobnicate"],
+    # scene options of every scene
+    *[["run", sc, "--quick", "--option", o] for sc, o in (
+        ("spinning_disc", "speed=-1"), ("spinning_disc", "speed=nan"), ("spinning_disc", "turns=0"),
+        ("rings", "speed=-0.1"), ("rings", "gap=-3"), ("rings", "gap=abc"),
+        ("taylor", "T_melt=100"), ("taylor", "T_melt=-1"), ("taylor", "symmetry=perhaps"),
+        ("taylor", "eps_dot_0=0"), ("taylor", "heating=2"), ("taylor", "speed_factor=-1"),
+        ("taylor", "layout=hexagonal"), ("pressing", "travel=-1e-4"), ("pressing", "travel=5"),
+        ("pressing", "speed_factor=0"), ("pressing", "eps_dot_0=nan"), ("cutting", "feed=0"), ("cutting", "feed=2e-3"),
+        ("cutting", "travel=-1"), ("cutting", "travel=10"), ("thermal_cutting", "material=steel"),
+        ("thermal_cutting", "vc=0"), ("thermal_cutting", "tu=-1e-4"), ("thermal_cutting", "n_tu=0"),
+        ("thermal_cutting", "n_tu=1"), ("thermal_cutting", "travel=100"), ("thermal_cutting", "length=1e-5"),
+        ("thermal_cutting", "mass_scale=-1"), ("thermal_cutting", "inertia_ratio=0"),
+        ("thermal_cutting", "detector=eye"), ("thermal_cutting", "chip_fraction=2"),
+        ("thermal_cutting", "dissipation_heat=sometimes"), ("thermal_cutting", "tool_length=0"),
+        ("thermal_cutting", "tool_depth=nan"), ("thermal_cutting", "friction=1.5"), ("thermal_cutting", "case=-1"),
+        ("thermal_cutting", "seed=x"), ("bar", "speed=1"))],
+    # numbers every scene takes
+    *[["run", sc, "--quick"] + flags for sc in ("spinning_disc", "pressing", "cutting", "thermal_cutting")
+      for flags in (["--dp", "0"], ["--dt", "-1e-9"], ["--t-end", "inf"], ["--set", "courant=nan"])],
+    ["run", "taylor", "--dim", "3", "--dp", "1e-9"], ["run", "rings", "--dp", "1e-9"],
 ]
 
 

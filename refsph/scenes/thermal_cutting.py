@@ -186,6 +186,8 @@ def _build(dim, dp, quick, *, case, material, vc, tu, n_tu, travel, length, mass
                     ("inertia_ratio", inertia_ratio), ("tool_length", tool_length), ("tool_depth", tool_depth)):
         if not (np.isfinite(v) and v > 0):
             raise ValueError(f"option {name} must be positive, got {v!r}")
+    if not (np.isfinite(mass_scale) and mass_scale >= 0):
+        raise ValueError(f"option mass_scale must be >= 0 (0: chosen from inertia_ratio), got {mass_scale!r}")
     if not (np.isfinite(jitter) and 0.0 <= jitter <= 0.1):
         raise ValueError(f"option jitter must lie in [0, 0.1] (units of dx), got {jitter!r}")
     mat = MATERIALS[material]

@@ -163,6 +163,9 @@ def main(argv=None) -> int:
         todo = [k for k in STORE.pending(keys(), retry_failed=True)
                 if args.only is None or k.split("|")[0] in args.only]
         print(f"{len(todo)} runs to do ({len(STORE.records())} done)", flush=True)
+        if not todo:                                        # a rerun with nothing to do leaves every file as it was
+            print("nothing to run; the JSON, the page and the figure are unchanged (--report rewrites them)")
+            return 0
         for k, (key, rec) in enumerate(study.execute(run_one, {key: (key,) for key in todo}, args.jobs)):
             STORE.commit(key, rec)
             print(f"[{k + 1}/{len(todo)}] {key:40s} {'survived' if rec.get('survived') else 'FAILED':9s} "

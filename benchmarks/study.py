@@ -122,6 +122,28 @@ class RunStore:
 
 
 # ----------------------------------------------------------------------------- running
+def merge_records(committed: list, fresh: list, key: str = "name") -> list:
+    """A list-of-records JSON after a partial rerun: the committed records in their order, each replaced by the
+    fresh one of the same ``key`` (a fresh failed one never replaces a good one), fresh ones not committed before
+    appended. A run folder missing here (a fresh clone) therefore never drops its committed record."""
+    new = {r[key]: r for r in fresh}
+    out = []
+    for r in committed:
+        f = new.pop(r[key], None)
+        out.append(r if f is None or (_is_good(r) and not _is_good(f)) else f)
+    return out + list(new.values())
+
+
+def write_if_changed(path: Path, text: str) -> bool:
+    """Write ``text`` to ``path`` unless it already holds exactly that (a rerun that changed nothing leaves the file,
+    and git status, as they were); True if it wrote."""
+    path = Path(path)
+    if path.exists() and path.read_text() == text:
+        return False
+    path.write_text(text)
+    return True
+
+
 def failed_record(key, error: BaseException) -> dict:
     return dict(key=key, status=f"failed: {type(error).__name__}: {error}"[:600])
 

@@ -370,10 +370,12 @@ def main(argv=None):
         for name, done in study.execute(run_job, {j["name"]: (dict(j, threads=threads),) for j in jobs}, args.jobs):
             if done != name:
                 print(f"{name}: {done['status']}", flush=True)
-    # every run that exists (the 0.375 mm ones too, if an earlier call made them with --finest)
+    # every run that exists (the 0.375 mm ones too, if an earlier call made them with --finest), merged into the
+    # committed records: a run whose folder is not here (a fresh clone, a partial rerun) keeps its record
     names = [j["name"] for j in job_list(args.finest or 0.375e-3) if (RUNS / j["name"] / "summary.json").exists()]
-    records = [record(n) for n in names]
-    OUT_JSON.write_text(json.dumps(records, indent=1) + "\n")
+    committed = json.loads(OUT_JSON.read_text()) if OUT_JSON.exists() else []
+    records = study.merge_records(committed, [record(n) for n in names])
+    study.write_if_changed(OUT_JSON, json.dumps(records, indent=1) + "\n")
     print(table(records))
     if all((RUNS / f"conv-{m}-0.5mm" / "summary.json").exists() for m in METHODS):
         plots(records)

@@ -82,14 +82,18 @@ def jobs(studies=STUDY_NAMES, only=None) -> dict:
     add("scaling", "case 1 s/2", converged(1, mass_scale=_s(1) / 2))
     add("cases", "case 10", converged(10))
     add("scaling", "case 10 s/2", converged(10, mass_scale=_s(10) / 2))
+    for seed in (1, 2, 3):                                   # the scatter: first at t_u/5 (an eighth of the cost)
+        add("scatter", f"case 1 n_tu 5 jitter {seed}", converged(1, n_tu=5.0, jitter=0.01, seed=seed))
     for seed in (1, 2, 3):
         add("scatter", f"case 1 jitter {seed}", converged(1, jitter=0.01, seed=seed))
     add("resolution", "case 1 n_tu 5", converged(1, n_tu=5.0))
     add("resolution", "case 10 n_tu 5", converged(10, n_tu=5.0))
     for n in list(range(2, 10)) + list(range(11, 19)):
         add("cases", f"case {n}", converged(n))
-    add("tool", "case 1 tool x2", converged(1, tool_length=10.0, tool_depth=6.0))
-    add("tool", "case 1 workpiece +8 t_u", converged(1, length=(TRAVEL + 8.0) * 1e-4))
+    add("tool", "case 1 n_tu 5", converged(1, n_tu=5.0))              # the tool and workpiece checks: at t_u/5
+    add("tool", "case 1 n_tu 5 tool x2", converged(1, n_tu=5.0, tool_length=10.0, tool_depth=6.0))
+    add("tool", "case 1 n_tu 5 workpiece +8 t_u", converged(1, n_tu=5.0, length=(TRAVEL + 8.0) * 1e-4))
+    add("tool", "case 1 tool x2", converged(1, tool_length=10.0, tool_depth=6.0))     # (then at t_u/10)
     add("contact", "case 1 pinball", converged(1), dict(contact="pinball"))
     add("contact", "case 1 all friction heat to the chip", converged(1, chip_fraction=1.0))
     add("resolution", "case 1 n_tu 15", converged(1, n_tu=15.0))
@@ -317,13 +321,16 @@ STUDIES = (
         ("wall [s]", "wall", ".0f"))),
     ("Run-to-run scatter: case 1 and three runs with the workpiece's particles moved at random by up to 0.01 dx",
      ("case 1", "case 1 jitter 1", "case 1 jitter 2", "case 1 jitter 3"), BASIC),
+    ("Run-to-run scatter at t_u/5 (the same, where a run costs an eighth)",
+     ("case 1 n_tu 5", "case 1 n_tu 5 jitter 1", "case 1 n_tu 5 jitter 2", "case 1 n_tu 5 jitter 3"), BASIC),
     ("Resolution (particles across t_u)",
      ("case 1 n_tu 5", "case 1", "case 1 n_tu 15", "case 10 n_tu 5", "case 10", "case 10 n_tu 15"),
      (("across t_u", "across", ".0f"), ("dx [um]", "dx_um", ".1f"), ("particles", "n_particles", "d")) + BASIC
      + (("steps", "n_steps", "d"), ("wall [s]", "wall", ".0f"))),
     ("Tool and workpiece size (case 1: the tool 5 t_u x 3 t_u, the workpiece 1.25 x the cut long, 4 t_u left "
-     "uncut at the end; tool x2: 10 t_u x 6 t_u, 1 mm x 0.6 mm; workpiece +8 t_u: 12 t_u left uncut)",
-     ("case 1", "case 1 tool x2", "case 1 workpiece +8 t_u"),
+     "uncut at the end; tool x2: 10 t_u x 6 t_u, 1 mm x 0.6 mm; workpiece +8 t_u: 12 t_u left uncut; checked at "
+     "t_u/5, where a run costs an eighth)",
+     ("case 1 n_tu 5", "case 1 n_tu 5 tool x2", "case 1 n_tu 5 workpiece +8 t_u", "case 1", "case 1 tool x2"),
      BASIC + (("removed at held faces [% of work]", "removed_of_work", ".1f"), ("Fc drift [%]", "Fc_drift_pct", ".1f"),
               ("T_RF drift [K]", "TRF_drift", ".0f"))),
     ("Contact and heat split (case 1: penalty contact, half the frictional heat into the chip)",
@@ -333,10 +340,11 @@ STUDIES = (
 )
 
 
-def scatter(res: dict) -> dict:
+def scatter(res: dict, keys=None) -> dict:
     """Mean and sample standard deviation (percent of the mean) of each basic quantity over case 1 and its jittered
-    runs (those recorded ok)."""
-    runs = [res["runs"][k] for k in STUDIES[1][1] if k in res["runs"] and res["runs"][k]["status"] == "ok"]
+    runs (``keys``: the runs of a scatter study; default the first), those recorded ok."""
+    keys = STUDIES[1][1] if keys is None else keys
+    runs = [res["runs"][k] for k in keys if k in res["runs"] and res["runs"][k]["status"] == "ok"]
     out = {}
     for _, key, _ in BASIC:
         v = np.array([_values(r)[key] for r in runs], dtype=float)
@@ -359,8 +367,8 @@ def _study_lines(res: dict) -> list[str]:
                 continue
             v = _values(r)
             lines.append(f"| {k} " + _row((v.get(key), fmt) for _, key, fmt in columns))
-        if keys is STUDIES[1][1]:
-            sc = scatter(res)
+        if "jitter" in " ".join(keys):
+            sc = scatter(res, keys)
             if sc:
                 lines += ["", "Spread (sample standard deviation over the runs, percent of their mean): " + ", ".join(
                     f"{name} {sc[key]['std_pct']:.1f} %" for name, key, _ in BASIC if key in sc)

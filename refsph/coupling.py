@@ -44,14 +44,6 @@ class PinballCoupling:
     def thickness(self, dim: int) -> float:
         return self.dp if dim == 2 else 1.0
 
-    def candidates(self, x: np.ndarray, shape, shift: np.ndarray) -> np.ndarray:
-        """The rows of x that can touch the tool: within its bounding circle grown by the contact's offset (the
-        others have no contact force; leaving them out of :func:`~refsph.penalty.penalty_contact` changes no
-        number, and saves the exact distance of every particle of a large workpiece)."""
-        centre, radius = shape.bounding_circle(shift)
-        d = x - centre
-        return np.flatnonzero(np.einsum("nd,nd->n", d, d) <= (radius + self.contact.offset) ** 2)
-
     def with_tools(self, state: State, n: int, dt: float) -> ContactResult:
         """The contact of the deformable rows [0, n) with the rigid rows [n, N) for a step dt."""
         _check_dt(dt)

@@ -161,3 +161,23 @@ def test_a_comparison_that_fails_now_keeps_the_committed_one(monkeypatch, tmp_pa
     monkeypatch.setattr(mod, "compare_pair", lambda x, y: (1, "a new table"))
     assert mod.comparisons(cases, old, ran=[a])[f"{a} vs {b}"] == dict(exit_code=1, table="a new table")
     assert mod.comparisons(cases, old, ran=["something else"]) == old
+
+
+def test_merge_records_keeps_what_a_partial_rerun_did_not_redo():
+    study = _study()
+    committed = [dict(name="a", status="ok", v=1), dict(name="b", status="ok", v=2), dict(name="c", status="ok", v=3)]
+    fresh = [dict(name="b", status="ok", v=20), dict(name="c", status="failed: boom"), dict(name="d", status="ok")]
+    merged = study.merge_records(committed, fresh)
+    assert merged == [dict(name="a", status="ok", v=1), dict(name="b", status="ok", v=20),
+                      dict(name="c", status="ok", v=3), dict(name="d", status="ok")]
+
+
+def test_a_taylor_rerun_in_a_fresh_clone_drops_no_record(tmp_path, monkeypatch):
+    """taylor.py --plot-only with no run folders (a fresh clone): the committed JSON stays byte for byte."""
+    mod = _bench("taylor")
+    copy = tmp_path / "taylor.json"
+    copy.write_bytes(mod.OUT_JSON.read_bytes())
+    monkeypatch.setattr(mod, "OUT_JSON", copy)
+    monkeypatch.setattr(mod, "RUNS", tmp_path / "no_runs")
+    assert mod.main(["--plot-only"]) == 0
+    assert copy.read_bytes() == (BENCH / "taylor.json").read_bytes()

@@ -128,6 +128,8 @@ class ReferenceOperator:
                                    else (identity(n, d), np.zeros(0, dtype=np.intp)))
         if ghosts is not None:
             self.degenerate = self.degenerate[self.degenerate < ghosts.n_real]
+        # the directions a degenerate particle's neighbours do not span: I - M+ M (F is completed there, below)
+        self.unspanned = np.eye(d)[None] - np.linalg.pinv(self.M[self.degenerate]) @ self.M[self.degenerate]
         gc = np.einsum("pab,pb->pa", self.L[rows], g)     # corrected gradient L_row grad W
         Vgc = self.V[cols][:, None] * gc
         self.G = [sp.csr_matrix((Vgc[:, k], (rows, cols)), shape=(n, n)) for k in range(d)]
@@ -167,8 +169,15 @@ class ReferenceOperator:
         return out.transpose(2, 1, 0)
 
     def deformation_gradient(self, x: np.ndarray) -> np.ndarray:
-        """Eq. (18): F_i = sum_j V_j (x_j - x_i) (x) grad~_i W(X_ij)."""
-        return self.gradient(x)
+        """Eq. (18): F_i = sum_j V_j (x_j - x_i) (x) grad~_i W(X_ij). A degenerate particle (its neighbours do not
+        span every direction: a chain, a lone particle torn off a chip) knows F only in the directions they span;
+        there it is Eq. (18) with the pseudo-inverse correction (:func:`refsph.kernels.correction_matrix`), and in
+        the others F is completed with the identity, F_i += I - M_i^+ M_i (no stretch where nothing is known; the
+        paper is silent; without it det F = 0 and the particle's density and reference volume are undefined)."""
+        F = self.gradient(x)
+        if len(self.degenerate):
+            F[self.degenerate] += self.unspanned
+        return F
 
     def momentum_sum(self, Q: np.ndarray, m: np.ndarray) -> np.ndarray:
         """sum_j m_j (Q_i grad~_i W_ij - Q_j grad~_j W_ji) for Q of shape (N, d, d).

@@ -258,6 +258,13 @@ def test_singular_correction_matrix_stays_finite():
     F = op.deformation_gradient(2.0 * X)
     np.testing.assert_allclose(F[:10, 0, 0], 2.0, rtol=1e-12)
     np.testing.assert_allclose(F[11:], np.broadcast_to(2.0 * np.eye(2), F[11:].shape), atol=1e-12)
+    # across the row, and for the lone particle, nothing is known: F is completed with the identity there, so
+    # det F is the stretch along the row (2), not 0, and a reference update stays possible (issue 22's cuts)
+    np.testing.assert_allclose(F[:10, 1], np.broadcast_to([0.0, 1.0], (10, 2)), atol=1e-12)
+    np.testing.assert_allclose(F[10], np.eye(2), atol=1e-12)
+    np.testing.assert_allclose(np.linalg.det(F[:10]), 2.0, rtol=1e-12)
+    new = reference_update(make_state(X, 0.0, 7800.0, dp * dp), F)
+    assert np.all(new.V0 > 0)
 
 
 def test_blocks_and_threads_give_the_same_rates(block):

@@ -1,24 +1,32 @@
 """The second paper's 18 measured orthogonal cuts (Rodriguez Prieto, Larsson & Afrasiabi 2023, Appendix B) with
-refsph's thermomechanical cutting scene, next to the measurements and the paper's own SPH and PFEM.
+refsph's thermomechanical cutting scene, next to the measurements and the paper's own SPH and PFEM; and the studies
+that say which digits of them mean something (issue 22).
 
-    python benchmarks/thermal_cutting.py                     # the cases not yet done, 2 processes on this machine
-    python benchmarks/thermal_cutting.py --jobs 4 --only 1 4 7
-    python benchmarks/thermal_cutting.py --scheduler tcp://HOST:8786   # the same on a dask.distributed cluster
-    python benchmarks/thermal_cutting.py --scaling           # case 1 at mass-scaling factors s/4, s, 4 s, 16 s
-    python benchmarks/thermal_cutting.py --detector          # case 1 with the alpha-shape surface detector
-    python benchmarks/thermal_cutting.py --resolution        # case 1 at 4 and 7 particles across t_u (5: case 1)
-    python benchmarks/thermal_cutting.py --report            # table, page and figures from the committed JSON only
-    python benchmarks/thermal_cutting.py --quick --json /tmp/q.json --only 1 2   # a try-out (quick cuts, seconds)
+    python benchmarks/thermal_cutting.py                     # every run not yet recorded, in jobs() order, 2 processes
+    python benchmarks/thermal_cutting.py --jobs 1 --study tool scatter   # only these studies, one process
+    python benchmarks/thermal_cutting.py --study cases --only 1 4 7      # some of the 18 cases
+    python benchmarks/thermal_cutting.py --scheduler tcp://HOST:8786     # the same on a dask.distributed cluster
+    python benchmarks/thermal_cutting.py --redo "case 3"     # run one again (a failed record is kept until then)
+    python benchmarks/thermal_cutting.py --report            # page and figures from the committed JSON only
+    python benchmarks/thermal_cutting.py --quick --json /tmp/q.json --only 1 2   # a try-out (quick cuts)
 
-Each run is ``refsph run thermal_cutting --case N`` at the scene's default resolution (dx = t_u / 5, mass
-scaling to 1 % of A, 8 t_u of cut) in ``runs/thermal_cutting/<key>/`` on one core. Resumable twice over: a
-finished run is a record in ``benchmarks/thermal_cutting.json`` and is skipped; a run that was killed continues
-from its last snapshot (``refsph run --restart``). A run that fails (non-finite state, lost chip) is a record
-with its status and error, and stays in the table.
+Each run is ``refsph run thermal_cutting --case N`` with the sweep's numerics (:func:`converged`: dx = t_u / 10,
+16 t_u of cut on a workpiece 20 t_u long, the mass-scaling rule s rho vc^2 = 0.01 A, the penalty contact, the
+numerical dissipation turned into heat; means over the last quarter of the cut) in ``runs/thermal_cutting/<key>/``
+on one core (about half an hour for a steel case). The studies (``--study``): ``scaling`` (s halved: cases 1 and
+10), ``scatter`` (case 1 with its particles jittered by 0.01 dx, three seeds; first at t_u/5), ``resolution``
+(t_u/5 and t_u/15 for cases 1 and 10), ``tool`` (a tool twice as large and a longer workpiece, at t_u/5, then the
+tool at t_u/10), ``contact`` (the pinball; all the frictional heat to the chip). Resumable twice over: a finished run
+is a record in ``benchmarks/thermal_cutting.json`` and is skipped; a run that was killed continues from its last
+snapshot (``refsph run --restart``). A run that fails (non-finite state, lost chip) is a record with its status and
+error; it stays in the table until ``--redo`` runs it again, and a failed rerun never replaces a good record. A
+rerun with nothing to do writes nothing.
 
 The experimental values are not printed in the paper: ``refsph.paper_data.RLA_CUTTING_CASES`` recovers them from
 each printed prediction and its printed percent error. The paper does not state the width of cut, so forces are
 per mm of width; the table compares Fp/Fc and gives the width at which refsph's Fc equals the measured one.
+Issue 19's sweep (pinball, t_u/5, 8 t_u) is kept in ``benchmarks/thermal_cutting_pinball_tu5.json`` for the page's
+'before' column.
 
 Writes benchmarks/thermal_cutting.json, benchmarks/thermal_cutting_report.md and figures/11_thermal_cutting_*.png.
 The dask path needs ``pip install -e '.[dask]'`` on the client and every worker (refsph importable there).

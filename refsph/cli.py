@@ -210,11 +210,10 @@ def _restart(args, extra=()) -> int:
 
 
 def _compare(args) -> int:
-    import json
-
     from .crosscheck.compare import compare, format_table
+    from .io import read_json
     try:
-        tol = json.loads(open(args.tolerances).read()) if args.tolerances else None
+        tol = read_json(args.tolerances, "tolerances file") if args.tolerances else None
         rows = compare(args.ref, args.test, tol, only=args.only)
     except (OSError, ValueError, KeyError) as e:
         print(f"refsph: {e}", file=sys.stderr)

@@ -6,6 +6,9 @@
     python benchmarks/cutting.py --plot-only --rerun-of DIR --rerun-label "commit abc1234"
                                                    # ... and vs_rerun: the paper runs against the same runs in DIR
     python benchmarks/cutting.py --report          # benchmarks/cutting_report.md from cutting.json (runs nothing)
+    taskset -c 0 python benchmarks/cutting.py --only penalty- --add
+                                                   # run only those, one core, and add their records to cutting.json
+                                                   # (the other records stay as they are; no run folders needed)
     python benchmarks/cutting.py --strain-figure 0.3   # only figures/08_cutting_strain_f0.3.png, from the run folders
 
 Runs (2D plane strain, the scene `refsph.scenes.cutting`, 1 mm of cut = 20 us unless stated):
@@ -13,6 +16,9 @@ Runs (2D plane strain, the scene `refsph.scenes.cutting`, 1 mm of cut = 20 us un
   coarse-...           the same at dp = 0.025 mm and 0.0167 mm (feed 0.3 mm), for the work-precision plot
   noupdate-tlsph       TLSPH without reference-configuration updates, dp = 0.025 mm, feed 0.3 mm, 0.5 mm of
                        cut (reduced size), against the same run with updates (coarse-tlsph-f0.3-25um)
+  penalty-tlsph-fFEED  the TLSPH paper runs with the penalty tool contact (Numerics.contact = 'penalty') in
+                       place of the paper's pinballs; ESPH has no tool contact of that kind (its tool acts
+                       through the SPH sums)
 Each run is one process; its folder runs/benchmarks/cutting/NAME keeps summary.json, reaction_forces.csv and all
 snapshots (every 1/8 of the cut). BLAS/OpenMP pools are pinned to one thread; refsph's pair sums run on the run's
 share of the cores (Numerics.threads: all of them with --jobs 1, one each with --jobs 2). Wall times are what the
@@ -62,7 +68,15 @@ def job_list():
     for m in METHODS:
         jobs.append(dict(name=f"coarse-{m}-f0.3-{dp_tag(1e-3 / 60)}", method=m, dp=1e-3 / 60, feed=0.3e-3,
                          travel=1e-3, numerics=None))
+    for f in FEEDS:                     # the paper runs with the penalty tool contact (TLSPH only: ESPH has none)
+        jobs.append(dict(name=f"penalty-tlsph-f{f * 1e3:g}", method="tlsph", dp=DP_PAPER, feed=f, travel=1e-3,
+                         numerics=dict(contact="penalty")))
     return jobs
+
+
+def is_penalty(r) -> bool:
+    """A run (job or record) with the penalty tool contact; the other TLSPH runs have the paper's pinballs."""
+    return r["name"].startswith("penalty-")
 
 
 def run_job(job):
@@ -111,9 +125,12 @@ def record(job, runs=None):
                threads=s.get("threads", s["numerics"].get("threads", 1)), status=s["status"], error=s.get("error"),
                t_final_us=1e6 * s["t_final"], cut_length_mm=50.0 * s["t_final"] * 1e3,
                ref_update_strain=s["numerics"]["ref_update_strain"],
+               contact=s["numerics"].get("contact", "pinball") if s["method"] == "tlsph" else None,
                reference_updates=diag.get("reference_updates"),
                max_pinball_penetration_over_dp=(diag["max_pinball_penetration_m"] / s["dp"]
-                                                if "max_pinball_penetration_m" in diag else None))
+                                                if "max_pinball_penetration_m" in diag else None),
+               max_penalty_penetration_over_dp=(diag["max_penalty_penetration_m"] / s["dp"]
+                                                if "max_penalty_penetration_m" in diag else None))
     if last is not None:
         eps, T = last["eps_p"][:n], last["T"][:n]
         rec.update(max_plastic_strain_last_snapshot=float(eps.max()), plastic_strain_p99=float(np.percentile(eps, 99)),
@@ -156,7 +173,7 @@ def add_differences(records):
     ref = {(r["method"], r["feed_mm"]): r for r in records if r["name"].startswith("paper-") and r["status"] == "ok"}
     for r in records:
         p = ref.get((r["method"], r["feed_mm"]))
-        if p is None or r is p or r["status"] != "ok" or r["ref_update_strain"] is None:
+        if p is None or r is p or r["status"] != "ok" or r["ref_update_strain"] is None or is_penalty(r):
             continue
         r["vs_paper"] = dict(ref=p["name"],
                              cutting_force_rel=r["cutting_force_mean_MN_per_m"] / p["cutting_force_mean_MN_per_m"] - 1,
@@ -301,6 +318,7 @@ def plots(records):
     bands_figure(by)
     work_precision_figure(records)
     reference_updates_figure(by)
+    contact_figure(records)
 
 
 COLORS = dict(esph="C0", tlsph="C3")
@@ -460,6 +478,42 @@ def reference_updates_figure(by):
         plt.close(fig)
 
 
+def _contact_pairs(records):
+    """(paper-tlsph run, penalty-tlsph run) of each feed both have, the pinball run first."""
+    by = {r["name"]: r for r in records}
+    return [(by[r["name"].replace("penalty-", "paper-")], r) for r in records
+            if is_penalty(r) and r["name"].replace("penalty-", "paper-") in by]
+
+
+def contact_figure(records):
+    """figures/08_cutting_contact_forces.png: TLSPH's cutting and thrust force with the paper's pinball contact and
+    with the penalty contact, both feeds, dp = 0.01 mm (from the records alone)."""
+    pairs = [(a, b) for a, b in _contact_pairs(records) if "cutting_force_history_mm_MN_per_m" in b]
+    if not pairs:
+        return
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, axs = plt.subplots(1, 2, figsize=(12, 4.2), constrained_layout=True, sharey=True)
+    for ax, key, label in ((axs[0], "cutting_force_history_mm_MN_per_m", "cutting force Fc"),
+                           (axs[1], "thrust_force_history_mm_MN_per_m", "thrust force Ft")):
+        for pair in pairs:
+            for r, c, contact in zip(pair, ("C3", "C2"), ("pinball", "penalty")):
+                h = np.asarray(r[key])
+                k = min(9, len(h))
+                ax.plot(h[:, 0], np.convolve(h[:, 1], np.ones(k) / k, mode="same"), color=c,
+                        ls="-" if r["feed_mm"] < 0.4 else "--", lw=1.3, label=f"{contact}, feed {r['feed_mm']:g} mm")
+        ax.set_xlabel("cut length [mm]")
+        ax.set_title(f"{label} on the tool (running mean over 9 bins of 2.5 um)", fontsize=9)
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=8)
+    axs[0].set_ylabel("force per unit thickness [MN/m = kN/mm]")
+    fig.suptitle("Orthogonal cutting, TLSPH, dp = 0.01 mm: the paper's pinball contact against the penalty contact",
+                 fontsize=10)
+    fig.savefig(FIG / "08_cutting_contact_forces.png", dpi=120)
+    plt.close(fig)
+
+
 TARGET_S = 30 * 60      # the issue's target: 1 mm of cut at the paper's resolution in 30 minutes (two cores)
 
 
@@ -486,13 +540,55 @@ def report(records) -> str:
     ok = [r for r in records if r["status"] == "ok"]
     paper = [r for r in ok if r["name"].startswith("paper-")]
     out = _report_runs(P, records, ok, paper)
-    out += _report_feed(P, {r["name"]: r for r in records}, ok)
-    out += _report_thrust(P, ok)
+    pinball = [r for r in ok if not is_penalty(r)]        # the penalty runs have a section of their own
+    out += _report_feed(P, {r["name"]: r for r in records if not is_penalty(r)}, pinball)
+    out += _report_thrust(P, pinball)
     out += _report_noupdate(P, {r["name"]: r for r in records})
     out += _report_rerun(P, paper)
     out += _report_cost(P, paper)
     out += _report_coarse(P, ok)
+    out += _report_contact(P, records)
     return "\n".join(out)
+
+
+def _pair(a, b, key, spec, scale=1.0) -> str:
+    """'pinball / penalty' of one measure."""
+    return f"{_v(a.get(key), spec, scale)} / {_v(b.get(key), spec, scale)}"
+
+
+def _report_contact(P, records) -> list[str]:
+    """TLSPH's tool contact: the paper runs (pinballs) against the same runs with the penalty contact."""
+    pairs = _contact_pairs(records)
+    if not pairs:
+        return []
+    rel = lambda a, b: None if _ratio(b, a) is None else _ratio(b, a) - 1  # noqa: E731
+    rows = [[_v(b["feed_mm"], "g"), f"{a['status']} / {b['status']}", _pair(a, b, "cut_length_mm", ".2f"),
+             _pair(a, b, "cutting_force_mean_MN_per_m", ".3f"),
+             _pct(rel(a.get("cutting_force_mean_MN_per_m"), b.get("cutting_force_mean_MN_per_m"))),
+             _pair(a, b, "thrust_force_mean_MN_per_m", ".3f"), _pair(a, b, "chip_thickness_mm", ".3f"),
+             _pair(a, b, "n_shear_bands", "d"), _pair(a, b, "max_plastic_strain", ".1f"),
+             _pair(a, b, "plastic_strain_p99", ".2f"), _pair(a, b, "flank_gap_over_dp", ".2f"),
+             _pair(a, b, "n_steps", "d"), _pair(a, b, "threads", "d"), _pair(a, b, "wall_time_s", ".1f", 1 / 60),
+             _pair(a, b, "cpu_time_s", ".1f", 1 / 60)] for a, b in pairs]
+    out = [P("contact"), "", _md_table(
+        ["feed [mm]", "status", "cut [mm]", "Fc", "Fc penalty / pinball - 1 [%]", "Ft", "chip [mm]", "bands",
+         "eps_p max", "eps_p p99", "flank gap / dp", "steps", "threads", "wall [min]", "CPU [min]"], rows)]
+    good = [(a, b) for a, b in pairs if a["status"] == "ok" and b["status"] == "ok"]
+    if not good:
+        return out + ["", P("contact_failed"), ""]
+    fc = [b["cutting_force_mean_MN_per_m"] / a["cutting_force_mean_MN_per_m"] - 1 for a, b in good]
+    ft = [b["thrust_force_mean_MN_per_m"] / a["thrust_force_mean_MN_per_m"] - 1 for a, b in good]
+    ch = [b["chip_thickness_mm"] / a["chip_thickness_mm"] - 1 for a, b in good]
+    cpu = [_time(b) / _time(a) for a, b in good]
+    span = lambda xs: f"{_pct(xs[0])} %" if len(xs) == 1 else f"{_pct(min(xs))} % to {_pct(max(xs))} %"  # noqa: E731
+    each = lambda key, spec: ", ".join(f"{_v(a.get(key), spec)} -> {_v(b.get(key), spec)}"  # noqa: E731
+                                       for a, b in good)
+    return out + ["", P("contact_end", fc=span(fc), ft=span(ft), chip=span(ch), bands=each("n_shear_bands", "d"),
+                        ft_each=each("thrust_force_mean_MN_per_m", ".3f"), gap=each("flank_gap_over_dp", ".2f"),
+                        eps_max=each("max_plastic_strain", ".1f"), p99=each("plastic_strain_p99", ".2f"),
+                        cpu=", ".join(_v(c, ".2f") for c in cpu),
+                        figure=_fig("08_cutting_contact_forces.png", "forces, pinball against penalty contact")),
+                  ""]
 
 
 def _report_runs(P, records, ok, paper) -> list[str]:
@@ -664,6 +760,9 @@ def main(argv=None):
         for name, done in study.execute(run_job, {j["name"]: (dict(j, threads=threads),) for j in jobs}, args.jobs):
             if done != name:
                 print(f"{name}: {done['status']}", flush=True)
+    if args.add:
+        add_records(jobs)
+        return
     done = [j for j in job_list() if (RUNS / j["name"] / "summary.json").exists()]
     records = add_differences([record(j) for j in done])
     if args.rerun_of is not None:
@@ -678,8 +777,26 @@ def main(argv=None):
     plots(records)
 
 
+def add_records(jobs):
+    """--add: the records of ``jobs`` (those with a run folder) go into cutting.json, replacing a record of the same
+    name, after the others (job order); every other record is kept as it was, byte for byte, so no other run's
+    folder is needed. Draws only the contact figure."""
+    old = json.loads(OUT_JSON.read_text()) if OUT_JSON.exists() else []
+    new = {j["name"]: record(j) for j in jobs if (RUNS / j["name"] / "summary.json").exists()}
+    order = [j["name"] for j in job_list()]
+    kept = [r for r in old if r["name"] not in new]
+    added = sorted(new.values(), key=lambda r: order.index(r["name"]))
+    write_json(kept + added)
+    print(table(added))
+    contact_figure(kept + added)
+    print(f"added {', '.join(new) or 'nothing'} to {OUT_JSON.relative_to(ROOT)}")
+
+
 def _parser():
     ap = study.parser(__doc__, "jobs", "plot_only", "only")
+    ap.add_argument("--add", action="store_true",
+                    help="record only the jobs of --only (after running them, or from their folders with "
+                         "--plot-only) and add them to the JSON: the other records stay as they are")
     ap.add_argument("--runs", default=None, help=f"folder of the run folders (default {RUNS.relative_to(ROOT)})")
     ap.add_argument("--rerun-of", default=None, metavar="DIR",
                     help="folder of the same paper runs made by other code (e.g. an earlier commit): store how far "

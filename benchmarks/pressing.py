@@ -5,11 +5,16 @@
     python benchmarks/pressing.py --only conv-    # only the jobs whose name contains 'conv-'
     python benchmarks/pressing.py --plot-only     # JSON, table and figures again from runs/benchmarks/pressing/
     python benchmarks/pressing.py --report        # benchmarks/pressing_report.md from the committed JSON only
+    python benchmarks/pressing.py --only penalty- --add
+                                                  # run only those and add their records to the JSON (the other
+                                                  # records stay as they are; no other run folders needed)
 
 Runs (2D plane strain, the scene `refsph.scenes.pressing`, tool travel 0.2 mm = 1 us, both methods unless stated):
   conv       dp = 0.0167, 0.0133, 0.01, 0.00667 mm (the paper's Fig. 10; h/dp = 1.5), CFL step (Courant 0.3)
   dt1e-10    dp = 0.01 mm with the paper's fixed dt = 1e-10 s (Table 4)
   kp10/kp200 TLSPH at dp = 0.01 mm with the pinball scaling factor K_p = 10 and 200 (default 50)
+  penalty    TLSPH at the four spacings with the penalty tool contact (Numerics.contact = 'penalty') in place of
+             the paper's pinballs (ESPH has no such contact: its tool acts through the SPH sums)
 Each run is one process; its run folder runs/benchmarks/pressing/NAME keeps summary.json, reaction_forces.csv
 and the final snapshot (the others are deleted). Writes benchmarks/pressing.json, one record per run (a line
 each): method, spacing, particle count, steps, wall time, the scalar metrics of the scene, the binned tool
@@ -19,6 +24,7 @@ Figures:
   figures/07_pressing_work_precision.png   difference to the finest run against wall time (work-precision)
   figures/07_pressing_resolution.png       final plastic strain at the four spacings, both methods (Fig. 10)
   figures/07_pressing_force.png            tool force against time at the four spacings
+  figures/07_pressing_contact_force.png    TLSPH's tool force, pinball against penalty contact, finest spacing
 Report: `--report` reads only benchmarks/pressing.json (it runs nothing and rewrites neither the JSON nor a
 figure) and writes benchmarks/pressing_report.md: what was run, the result tables, the sensitivity to the time
 step and to K_p, the cost, and the figures above (chapter 07 teaches the lesson and links the report).
@@ -70,7 +76,15 @@ def job_list():
     for kp in (10.0, 200.0):
         jobs.append(dict(name=f"kp{kp:g}-tlsph-{dp_tag(DP_SENS)}", method="tlsph", dp=DP_SENS, dt=None,
                          numerics=dict(contact_Kp=kp)))
+    for dp in resolutions():            # the penalty tool contact (TLSPH only: ESPH's tool has no contact law)
+        jobs.append(dict(name=f"penalty-tlsph-{dp_tag(dp)}", method="tlsph", dp=dp, dt=None,
+                         numerics=dict(contact="penalty")))
     return jobs
+
+
+def is_penalty(r) -> bool:
+    """A run (job or record) with the penalty tool contact; the other TLSPH runs have the paper's pinballs."""
+    return r["name"].startswith("penalty-")
 
 
 def run_job(job):
@@ -106,12 +120,15 @@ def record(job):
     fh = np.asarray(m["tool_force_history"])
     line = np.asarray(m["plastic_strain_line"])
     imp = s["diagnostics"]["reaction_impulse"]
+    contact = nm.get("contact", "pinball") if s["method"] == "tlsph" else None
+    pen = s["diagnostics"].get("max_penalty_penetration_m")
     return dict(
         name=name, method=s["method"], dp_nominal_mm=1e3 * job["dp"], dp_mm=1e3 * s["dp"], h_mm=1e3 * s["h"],
         n_particles=s["n_particles"], n_block=int(block.sum()), n_steps=s["n_steps"],
-        wall_time_s=s["wall_time_s"], dt_mode=s["dt_mode"], dt_s=s["dt_max"] if s["dt_mode"] == "fixed" else None,
+        wall_time_s=s["wall_time_s"], cpu_time_s=s.get("cpu_time_s"), dt_mode=s["dt_mode"],
+        dt_s=s["dt_max"] if s["dt_mode"] == "fixed" else None,
         dt_max_s=s["dt_max"], dt_min_s=s["dt_min"], courant=s["courant"],
-        contact_Kp=nm["contact_Kp"] if s["method"] == "tlsph" else None, status=s["status"],
+        contact=contact, contact_Kp=nm["contact_Kp"] if contact == "pinball" else None, status=s["status"],
         t_final_us=1e6 * s["t_final"], tool_travel_mm=m["tool_travel_mm"],
         tool_force_peak_MN_per_m=1e-6 * m["tool_force_peak_N_per_m"],
         tool_force_mean_MN_per_m=1e-6 * m["tool_force_mean_N_per_m"],
@@ -125,6 +142,7 @@ def record(job):
         reference_updates=s["diagnostics"].get("reference_updates"),
         max_pinball_penetration_over_dp=(s["diagnostics"]["max_pinball_penetration_m"] / s["dp"]
                                          if "max_pinball_penetration_m" in s["diagnostics"] else None),
+        max_penalty_penetration_over_dp=None if pen is None else pen / s["dp"],
         tool_force_history_ns_MN_per_m=np.column_stack([_r(1e9 * fh[:, 0], 3), _r(1e-6 * fh[:, 1], 5)]).tolist(),
         plastic_strain_line_mm=np.column_stack([_r(line[:, 0], 6), _r(line[:, 1], 5)]).tolist(),
     )
@@ -166,9 +184,16 @@ def differences(r, ref) -> dict:
 
 def add_differences(records):
     """vs_finest: against the finest conv run of the method; vs_base: against the conv run of the method at
-    the same nominal spacing (for the dt and K_p runs)."""
+    the same nominal spacing (for the dt and K_p runs). The penalty runs: vs_finest against the finest penalty run,
+    vs_base against the (pinball) conv run at the same spacing."""
     conv = {(r["method"], r["dp_nominal_mm"]): r for r in records if r["name"].startswith("conv-")}
+    penalty = [r for r in records if is_penalty(r)]
     for r in records:
+        if is_penalty(r):           # vs_finest: the finest penalty run; vs_base: the pinball run at the same dp
+            r["vs_finest"] = differences(r, min(penalty, key=lambda c: c["dp_nominal_mm"]))
+            if (r["method"], r["dp_nominal_mm"]) in conv:
+                r["vs_base"] = differences(r, conv[(r["method"], r["dp_nominal_mm"])])
+            continue
         own = [c for (m, _), c in conv.items() if m == r["method"]]
         if own:
             finest = min(own, key=lambda c: c["dp_nominal_mm"])
@@ -221,6 +246,7 @@ def plots(records, json_only: bool = False):
     conv = {m: sorted([r for r in records if r["name"].startswith("conv-") and r["method"] == m],
                       key=lambda r: -r["dp_mm"]) for m in METHODS}
     _plot_work_precision(records, conv)
+    _plot_contact(records)
     if json_only:                                       # the rest needs the run folders
         return
     _plot_resolution(conv)
@@ -336,6 +362,60 @@ def _plot_force(conv):
     plt.close(fig)
 
 
+def _contact_pairs(records):
+    """(pinball conv-tlsph run, penalty run) at each spacing both have, coarsest first."""
+    pin = {r["dp_nominal_mm"]: r for r in records if r["name"].startswith("conv-tlsph-")}
+    return [(pin[r["dp_nominal_mm"]], r) for r in sorted([r for r in records if is_penalty(r)],
+                                                        key=lambda r: -r["dp_nominal_mm"]) if r["dp_nominal_mm"] in pin]
+
+
+def _plot_contact(records):
+    """figures/07_pressing_contact_force.png: TLSPH's tool force with the pinball and the penalty contact at the
+    finest spacing both have (from the records alone)."""
+    pairs = _contact_pairs(records)
+    if not pairs:
+        return
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, ax = plt.subplots(figsize=(8, 4.2), constrained_layout=True)
+    for r, c, label in ((pairs[-1][0], "C3", "pinball (the paper's)"), (pairs[-1][1], "C2", "penalty")):
+        h = np.asarray(r["tool_force_history_ns_MN_per_m"])
+        ax.plot(h[:, 0], h[:, 1], color=c, lw=0.5, alpha=0.35)
+        ax.plot(h[:, 0], _moving_average(h[:, 1], 9), color=c, lw=1.4,
+                label=f"{label}: mean 2nd half {r['tool_force_mean_MN_per_m']:.3f}, peak "
+                      f"{r['tool_force_peak_MN_per_m']:.2f} MN/m")
+    ax.set_xlabel("t [ns]")
+    ax.set_ylabel("tool force [MN/m]")
+    ax.set_ylim(bottom=0)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    ax.set_title(f"Metal pressing, TLSPH, dp = {_um(pairs[-1][1])} um: force of the block on the tool, two tool "
+                 "contacts\n(thin: 2.5 ns bins, thick: 22.5 ns running mean)", fontsize=9)
+    fig.savefig(FIG / "07_pressing_contact_force.png", dpi=120)
+    plt.close(fig)
+
+
+def observed_order(h, f):
+    """The order p of f(h) = f0 + C h^p through three values at h1 > h2 > h3 (any ratios): the root of
+    (h1^p - h2^p) / (h2^p - h3^p) = (f1 - f2) / (f2 - f3); None where the differences change sign or grow (no
+    convergence to be seen), inf beyond p = 20."""
+    (h1, h2, h3), (f1, f2, f3) = h, f
+    if (f1 - f2) * (f2 - f3) <= 0:
+        return None
+    ratio = (f1 - f2) / (f2 - f3)
+    g = lambda p: (h1**p - h2**p) / (h2**p - h3**p)  # noqa: E731   (grows with p from its limit at p -> 0)
+    lo, hi = 1e-9, 20.0
+    if ratio <= g(lo):
+        return None
+    if ratio >= g(hi):
+        return float("inf")
+    for _ in range(100):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if g(mid) < ratio else (lo, mid)
+    return 0.5 * (lo + hi)
+
+
 def _pct(x, signed=True) -> str:
     """A relative difference (not percent) as a percentage with one decimal."""
     return f"{100 * x:+.1f} %" if signed else f"{100 * x:.1f} %"
@@ -370,6 +450,7 @@ def report(records) -> str:
     L += _report_convergence(P, records, conv_m)
     L += _report_cost(P, records, conv, conv_m)
     L += _report_sensitivity(P, records, conv)
+    L += _report_contact(P, records)
     L += [P("snapshots"), ""]
     return "\n".join(L)
 
@@ -414,7 +495,7 @@ def _report_convergence(P, records, conv_m) -> list[str]:
     rows = []
     for r in records:
         d = r.get("vs_finest")
-        if d is None or d["ref"] == r["name"]:
+        if d is None or d["ref"] == r["name"] or is_penalty(r):     # the penalty runs: their own section
             continue
         rows.append([r["name"], d["ref"], f"{r['wall_time_s']:.1f}", _pct(d["force_mean_rel"]),
                      _pct(d["line_peak_rel"]), _pct(d["line_L2_rel"], False), _pct(d["line_width_rel"])])
@@ -464,12 +545,89 @@ def _report_sensitivity(P, records, conv) -> list[str]:
     return L
 
 
+def add_records(jobs):
+    """--add: the records of ``jobs`` (those with a run folder) go into pressing.json, replacing a record of the
+    same name, after the others (job order); every other record is written as it was (byte for byte), so no other
+    run's folder is needed; the new records' differences are taken against the records in the JSON. Draws only
+    the contact figure."""
+    import copy
+    old = json.loads(OUT_JSON.read_text()) if OUT_JSON.exists() else []
+    new = {j["name"]: record(j) for j in jobs if (RUNS / j["name"] / "summary.json").exists()}
+    order = [j["name"] for j in job_list()]
+    kept = [r for r in old if r["name"] not in new]
+    added = sorted(new.values(), key=lambda r: order.index(r["name"]))
+    add_differences(copy.deepcopy(kept) + added)        # fills the new records' vs_finest / vs_base only
+    write_json(kept + added)
+    print(table(added))
+    _plot_contact(kept + added)
+    print(f"added {', '.join(new) or 'nothing'} to {OUT_JSON.relative_to(ROOT)}")
+
+
+def _pair_cell(a, b, key, spec, scale=1.0) -> str:
+    """'pinball / penalty' of one measure."""
+    return f"{study.fmt(a.get(key), spec, scale)} / {study.fmt(b.get(key), spec, scale)}"
+
+
+def _orders(pairs, k) -> str:
+    """The observed orders of the mean force of contact k (0 pinball, 1 penalty) from each three successive
+    spacings."""
+    rs = [p[k] for p in pairs]
+    out = []
+    for a, b, c in zip(rs, rs[1:], rs[2:]):
+        p = observed_order([r["dp_mm"] for r in (a, b, c)], [r["tool_force_mean_MN_per_m"] for r in (a, b, c)])
+        word = "none (the differences change sign or grow)" if p is None else study.fmt(p, ".1f")
+        out.append(f"{_um(a)}, {_um(b)}, {_um(c)} um: {word}")
+    return "; ".join(out)
+
+
+def _report_contact(P, records) -> list[str]:
+    """TLSPH's tool contact: the paper's pinballs (conv-tlsph) against the penalty contact, spacing by spacing."""
+    pairs = _contact_pairs(records)
+    if not pairs:
+        return []
+    rows = [[_um(b), _pair_cell(a, b, "tool_force_mean_MN_per_m", ".3f"),
+             _pct(b["tool_force_mean_MN_per_m"] / a["tool_force_mean_MN_per_m"] - 1),
+             _pair_cell(a, b, "tool_force_peak_MN_per_m", ".2f"),
+             _pair_cell(a, b, "clamp_force_mean_MN_per_m", ".3f", -1),
+             _pair_cell(a, b, "line_peak", ".3f"), _pair_cell(a, b, "line_peak_x_mm", ".2f"),
+             _pair_cell(a, b, "line_peak_width_mm", ".3f"), _pair_cell(a, b, "plastic_strain_p99", ".3f"),
+             _pair_cell(a, b, "max_plastic_strain", ".2f"), _pair_cell(a, b, "max_temperature_K", ".0f"),
+             _pair_cell(a, b, "min_tool_gap_over_dp", ".2f"),
+             f"{study.fmt(a.get('max_pinball_penetration_over_dp'), '.3f')} / "
+             f"{study.fmt(b.get('max_penalty_penetration_over_dp'), '.3f')}",
+             _pair_cell(a, b, "n_steps", "d"), _pair_cell(a, b, "wall_time_s", ".1f"),
+             _pair_cell(a, b, "cpu_time_s", ".1f")] for a, b in pairs]
+    L = [P("contact"), "", _aligned(["dp [um]", "F mean", "penalty / pinball - 1", "F peak", "clamp", "line peak",
+                                     "at x [mm]", "width [mm]", "eps p99", "eps max", "T max [K]", "gap/dp",
+                                     "penetration/dp", "steps", "wall [s]", "CPU [s]"], rows), ""]
+    diff = [b["tool_force_mean_MN_per_m"] / a["tool_force_mean_MN_per_m"] - 1 for a, b in pairs]
+    cost = [b["cpu_time_s"] / a["wall_time_s"] for a, b in pairs if b.get("cpu_time_s")]
+
+    def span(k, key, spec):            # the first (coarsest) and last (finest) value of contact k
+        return f"{format(pairs[0][k][key], spec)} to {format(pairs[-1][k][key], spec)}"
+    a, b = pairs[-1]
+    L += [P("contact_end", dp_fine=_um(b), f_pin=f"{a['tool_force_mean_MN_per_m']:.3f}",
+            f_pen=f"{b['tool_force_mean_MN_per_m']:.3f}", diff_min=_pct(min(diff)), diff_max=_pct(max(diff)),
+            peak_pin=span(0, "tool_force_peak_MN_per_m", ".2f"), peak_pen=span(1, "tool_force_peak_MN_per_m", ".2f"),
+            max_pin=span(0, "max_plastic_strain", ".2f"), max_pen=span(1, "max_plastic_strain", ".2f"),
+            x_pin=f"{a['line_peak_x_mm']:.2f}", x_pen=f"{b['line_peak_x_mm']:.2f}",
+            line_l2=_pct(b["vs_base"]["line_L2_rel"], False) if b.get("vs_base") else "-",
+            cost=f"{min(cost):.1f} to {max(cost):.1f}" if cost else "-",
+            figure=_fig("07_pressing_contact_force.png", "tool force, pinball against penalty contact")), ""]
+    if len(pairs) >= 3:
+        L += [P("contact_order", order_pen=_orders(pairs, 1), order_pin=_orders(pairs, 0)), ""]
+    return L
+
+
 def main(argv=None):
     ap = study.parser(__doc__, "jobs", "plot_only", "only", "json_figures", "report",
                       json_figures=dict(help="only redraw the figures made from the committed JSON alone "
                                              "(figures/07_pressing_work_precision.png)"),
                       report=dict(help=f"no runs: write {OUT_REPORT.name} from the committed {OUT_JSON.name} "
                                        "(nothing else)"))
+    ap.add_argument("--add", action="store_true",
+                    help="record only the jobs of --only (after running them, or from their folders with "
+                         "--plot-only) and add them to the JSON: the other records stay as they are")
     args = ap.parse_args(argv)
     if args.json_figures:
         plots(json.loads(OUT_JSON.read_text()), json_only=True)
@@ -489,6 +647,9 @@ def main(argv=None):
         for name, done in study.execute(run_job, {j["name"]: (dict(j, threads=threads),) for j in todo}, args.jobs):
             if done != name:
                 print(f"{name}: {done['status']}", flush=True)
+    if args.add:
+        add_records(todo)
+        return 0
     have = [j for j in jobs if (RUNS / j["name"] / "summary.json").exists()]
     records = add_differences([record(j) for j in have])
     write_json(records)

@@ -151,18 +151,32 @@ def failed_record(key, error: BaseException) -> dict:
 def execute(fn, tasks: dict, jobs: int = 1, scheduler: str | None = None, fresh: bool = True):
     """Yield ``(key, fn(*tasks[key]))`` as the runs finish (``tasks``: key -> argument tuple). Local processes,
     ``jobs`` at a time, each run in a fresh (spawned) process if ``fresh``; or a dask.distributed cluster at
-    ``scheduler``. A run that raises yields ``failed_record(key, error)``."""
+    ``scheduler``. A run that raises yields ``failed_record(key, error)``; a run whose process was killed (and with
+    it the pool) yields nothing, nor do the runs still waiting: they stay to run, nothing is recorded for them."""
     if not tasks:
         return
     if scheduler:
         yield from _execute_dask(fn, tasks, scheduler)
         return
     from concurrent.futures import ProcessPoolExecutor, as_completed
+    from concurrent.futures.process import BrokenProcessPool
     options = dict(max_tasks_per_child=1) if fresh else {}
+    broken = []
     with ProcessPoolExecutor(max_workers=max(1, jobs), **options) as pool:
         futures = {pool.submit(fn, *args): key for key, args in tasks.items()}
         for f in as_completed(futures):
+            try:
+                f.result()
+            except BrokenProcessPool:                       # a run's process was killed: the pool is gone, and
+                broken.append(futures[f])                   # every run still waiting with it; none is a result
+                continue
+            except Exception:                                # noqa: BLE001 (recorded by _result below)
+                pass
             yield futures[f], _result(f, futures[f])
+    if broken:
+        print(f"the process pool broke (a run's process was killed): {len(broken)} run(s) not recorded, still to "
+              f"run ({', '.join(map(str, broken[:5]))}{' ...' if len(broken) > 5 else ''}); a killed run continues "
+              "from its checkpoint next time", flush=True)
 
 
 def _result(future, key):

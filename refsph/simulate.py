@@ -395,8 +395,8 @@ def step_or_fail(state: State, parts: RunParts, dt: float, rec: RunRecord) -> St
         raise rec.fail("error", f"step {rec.n_steps + 1} (t = {state.t:.6e} s) failed: {e}", state) from e
     rec.n_steps += 1
     new = step.state
-    if not (np.isfinite(new.v).all() and np.isfinite(new.x).all()):
-        bad = new.first_nonfinite() or ("x/v", -1)
+    bad = new.first_nonfinite()                             # every evolved field, T and the plastic ones too
+    if bad is not None:
         raise rec.fail("nan", f"non-finite {bad[0]} at particle {bad[1]} in step {rec.n_steps} "
                               f"(t = {state.t:.6e} s -> {new.t:.6e} s)", state)
     return step
@@ -572,7 +572,12 @@ def _one_step(setup: Setup, parts: RunParts, rec: RunRecord, state: State, dt: f
     prev, step = state, step_or_fail(state, parts, step_dt, rec)
     state = step.state
     for p in parts.physics:                                 # heat after the mechanical step
-        state = p.advance(prev, Step(state, step.rates), step_dt)
+        with np.errstate(over="ignore", invalid="ignore"):  # a blow-up is caught just below, with its particle
+            state = p.advance(prev, Step(state, step.rates), step_dt)
+        if state.T is not None and not np.isfinite(state.T).all():
+            k = int(np.flatnonzero(~np.isfinite(state.T))[0])
+            raise rec.fail("nan", f"non-finite T at particle {k} after the {p.name} step of step {rec.n_steps} "
+                                  f"(t = {prev.t:.6e} s)", prev)
     if hook is not None:
         state = hook(state, parts.solver) or state
         if not (np.isfinite(state.v).all() and np.isfinite(state.x).all()):

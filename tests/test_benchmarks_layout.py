@@ -181,3 +181,11 @@ def test_a_taylor_rerun_in_a_fresh_clone_drops_no_record(tmp_path, monkeypatch):
     monkeypatch.setattr(mod, "RUNS", tmp_path / "no_runs")
     assert mod.main(["--plot-only"]) == 0
     assert copy.read_bytes() == (BENCH / "taylor.json").read_bytes()
+
+
+def test_a_killed_run_process_records_nothing(capsys):
+    """A run whose process dies (killed, out of memory) breaks the pool: neither it nor the runs waiting behind it
+    get a record (a record would make the sweep skip them); they stay to run, and the sweep says so."""
+    import os
+    assert list(_study().execute(os._exit, {"a": (1,), "b": (1,)}, jobs=1)) == []
+    assert "still to run" in capsys.readouterr().out

@@ -354,7 +354,7 @@ for method in METHODS:
 #
 # ## The quick case: 2D plane strain
 #
-# Now the whole impact: both methods, the half slab, for 80 µs (65 µs in quick mode); the bar has stopped and
+# Now the whole impact: both methods, the half slab, for 80 µs (50 µs in quick mode); the bar has stopped and
 # left the wall well before. Snapshots are kept at 15 and 30 µs, the times of the paper's Figs. 4–5.
 
 # %%
@@ -376,7 +376,7 @@ def bar_2d(method="tlsph", dp=1e-3, v0=V0, t_end=None, out=None, **options):
 
 
 DP_2D = 0.5e-3 if ch.quick else 0.25e-3
-T_END = 65e-6 if ch.quick else 80e-6                   # the bar is at rest after about 35 us
+T_END = 50e-6 if ch.quick else 80e-6                   # the bar is at rest after about 35 us
 res2 = {m: bar_2d(m, DP_2D, t_end=T_END, out=ch.tmp / f"2d_{m}") for m in METHODS}
 for m in METHODS:
     mt = res2[m].summary["metrics"]

@@ -162,7 +162,8 @@ plt.show()
 # %% [markdown]
 # The SPH detector marks a layer about two particles deep (the support is cut there too); the α-shape marks one.
 # Both see the chip–tool interface as inside, because the tool's particles take part.
-#
+
+# %% [markdown]
 # ## 4. One cut, and where its heat went
 #
 # The case: AISI 1045, 60 m/min, $t_u$ = 0.1 mm. The model is the paper's (module text of
@@ -172,7 +173,8 @@ plt.show()
 # exact outline (the 10 µm edge radius included), and Coulomb friction $\mu(T)$ as a return map, so that a particle
 # can stick to the rake face or slide along it. The pinball of the first paper is one switch away
 # (`numerics=dict(contact="pinball")`). Two more changes:
-#
+
+# %% [markdown]
 # * **mass scaling** makes it affordable on a laptop. The density is multiplied by $s$ and $c_p$ divided by $s$,
 #   so $\rho c_p$ — conduction and heating — is unchanged; the wave speed drops by $\sqrt s$ and the step grows by
 #   as much. Inertia grows by $s$; refsph picks $s$ so that $s\rho v_c^2$ stays at 1 % of the yield stress $A$

@@ -131,7 +131,7 @@ def test_analyse_run_matches_the_run(coarse, method):
     for k, v in res.summary["metrics"].items():
         assert np.allclose(np.asarray(again[k], dtype=float), np.asarray(v, dtype=float), rtol=1e-6,
                            equal_nan=True), k
-    with pytest.raises(FileNotFoundError):
+    with pytest.raises(ValueError, match="nowhere/summary.json: no such run summary"):    # the file named
         analyse_cutting_run(out / "nowhere")
 
 

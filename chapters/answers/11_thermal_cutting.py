@@ -2,15 +2,18 @@
 runs a very short quick cut (case 1, a 0.5 mm workpiece, one t_u of cut: a few seconds; the chip has only begun)
 and compares with the same cut with everything on. Measured (this key's runs):
 
-* answer_1: without conduction the rake face's *mean* temperature is lower (363 against 429 K): the scene's
-  ``conduction=false`` is the first paper's adiabatic model, so it switches the frictional heat off too
-  (``Setup.friction_heat``, its own switch in a Setup of one's own), and that heat is made right at the rake face.
-  But the hottest particle is hotter (564 against 507 K): the heat of the shear zone stays where it is made.
-* answer_2: the split of the frictional heat hardly matters: all of it into the chip raises T_RF by ~8 K over
-  all of it into the tool, because conduction across the interface (harmonic-mean k) moves it on within a few
-  steps; the tool stores more heat when it gets the whole share (0.70 against 0.52 J/m).
-* answer_3: frictionless, Fp/Fc falls from 0.34 to about 0.02 (the thrust at this early stage is nearly all
-  friction) and the frictional heat is zero; the rake face is ~45 K colder.
+* answer_1: without conduction the rake face's *mean* temperature hardly moves (405 against 404 K): the scene's
+  ``conduction=false`` is the first paper's adiabatic model, so it switches the frictional heat and the heat of the
+  numerical dissipation off too (``Setup.friction_heat``, ``Setup.dissipation_heat``), but with the penalty
+  contact the chip's contact particles mostly stick at this early stage and friction makes little heat (0.12 of
+  17 J/m). The hottest particle is much hotter (568 against 490 K): without conduction the heat of the shear zone
+  stays where it is made.
+* answer_2: the split of the frictional heat hardly matters: all of it into the chip raises T_RF by ~1 K over all
+  of it into the tool (there is little of it, and conduction across the interface, harmonic-mean k, moves it on
+  within a few steps); the tool stores more heat when it gets the whole share (0.33 against 0.32 J/m).
+* answer_3: frictionless, Fp/Fc falls from 0.44 to about 0 (the thrust at this early stage is friction) and the
+  frictional heat is zero; the rake face's mean temperature moves by about 1 K, the plastic heat falls by a
+  quarter (11.6 against 15.9 J/m: the sticking chip is sheared less).
 """
 from functools import lru_cache
 
@@ -30,7 +33,8 @@ def _cut(**changes):
 def answer_1():
     on, off = _cut()[0], _cut(conduction=False)
     assert off[1] is None                                   # no heat flow: no ledger, no frictional heat
-    assert off[0]["rake_face_temperature_K"] < on["rake_face_temperature_K"]
+    assert abs(off[0]["rake_face_temperature_K"] - on["rake_face_temperature_K"]) < 0.02 * on[
+        "rake_face_temperature_K"]
     assert off[0]["max_temperature_K"] > on["max_temperature_K"] + 20.0
 
 
@@ -42,7 +46,8 @@ def answer_2():
 
 
 def answer_3():
-    on, (off, heat, _) = _cut()[0], _cut(friction=False)
-    assert off["force_ratio"] < 0.6 * on["force_ratio"]
+    (on, heat_on, _), (off, heat, _) = _cut(), _cut(friction=False)
+    assert off["force_ratio"] < 0.2 * on["force_ratio"]
     assert heat["friction_J"] == 0.0
-    assert off["rake_face_temperature_K"] < on["rake_face_temperature_K"]
+    assert abs(off["rake_face_temperature_K"] - on["rake_face_temperature_K"]) < 0.02 * on["rake_face_temperature_K"]
+    assert heat["plastic_J"] < 0.9 * heat_on["plastic_J"]

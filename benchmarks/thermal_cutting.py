@@ -11,16 +11,16 @@ that say which digits of them mean something (issue 22).
     python benchmarks/thermal_cutting.py --quick --json /tmp/q.json --only 1 2   # a try-out (quick cuts)
 
 Each run is ``refsph run thermal_cutting --case N`` with the sweep's numerics (:func:`converged`: dx = t_u / 10,
-16 t_u of cut on a workpiece 20 t_u long, the mass-scaling rule s rho vc^2 = 0.01 A, the penalty contact, the
-numerical dissipation turned into heat; means over the last quarter of the cut) in ``runs/thermal_cutting/<key>/``
-on one core (about half an hour for a steel case). The studies (``--study``): ``scaling`` (s halved: cases 1 and
-10), ``scatter`` (case 1 with its particles jittered by 0.01 dx, three seeds; first at t_u/5), ``resolution``
-(t_u/5 and t_u/15 for cases 1 and 10), ``tool`` (a tool twice as large and a longer workpiece, at t_u/5, then the
-tool at t_u/10), ``contact`` (the pinball; all the frictional heat to the chip). Resumable twice over: a finished run
-is a record in ``benchmarks/thermal_cutting.json`` and is skipped; a run that was killed continues from its last
-snapshot (``refsph run --restart``). A run that fails (non-finite state, lost chip) is a record with its status and
-error; it stays in the table until ``--redo`` runs it again, and a failed rerun never replaces a good record. A
-rerun with nothing to do writes nothing.
+16 t_u of cut on a workpiece 28 t_u long, a tool 10 t_u x 6 t_u, the mass-scaling rule s rho vc^2 = 0.01 A, the
+penalty contact, the numerical dissipation turned into heat; means over the last quarter of the cut) in
+``runs/thermal_cutting/<key>/`` on one core (about 40 minutes for a steel case). The studies (``--study``):
+``scaling`` (s halved: cases 1 and 10), ``scatter`` (case 1 with its particles jittered by 0.01 dx, three seeds;
+first at t_u/5), ``resolution`` (t_u/5 and t_u/15 for cases 1 and 10), ``tool`` (the first sweep's tool 5 t_u x 3 t_u
+and 4 t_u left uncut, one change at a time, at t_u/5 and t_u/10), ``contact`` (the pinball; all the frictional heat
+to the chip). Resumable twice over: a finished run is a record in ``benchmarks/thermal_cutting.json`` and is
+skipped; a run that was killed continues from its last snapshot (``refsph run --restart``). A run that fails
+(non-finite state, lost chip) is a record with its status and error; it stays in the table until ``--redo`` runs it
+again, and a failed rerun never replaces a good record. A rerun with nothing to do writes nothing.
 
 The experimental values are not printed in the paper: ``refsph.paper_data.RLA_CUTTING_CASES`` recovers them from
 each printed prediction and its printed percent error. The paper does not state the width of cut, so forces are
@@ -53,6 +53,9 @@ REPORT = ROOT / "benchmarks" / "thermal_cutting_report.md"
 RUNS = ROOT / "runs" / "thermal_cutting"
 FIG = ROOT / "figures"
 N_TU, TRAVEL = 10.0, 16.0                  # the sweep: dx = t_u / 10, 16 t_u of cut (means over the last quarter)
+UNCUT = 12.0                               # t_u of workpiece left uncut at the end (4 t_u: the Fc drift was 21 %)
+TOOL = dict(tool_length=10.0, tool_depth=6.0)   # t_u; 5 x 3 t_u: the contact (4 t_u) reached the held back face
+SMALL = dict(tool_length=5.0, tool_depth=3.0)   # the first sweep's tool (the scene's default)
 INERTIA = 0.01                             # the mass-scaling rule: s rho vc^2 = 0.01 A (module text)
 KEEP = ("cutting_force_N_per_m", "passive_force_N_per_m", "force_ratio", "rake_face_temperature_K",
         "rake_face_temperature_max_K", "free_chip_surface_temperature_K", "chip_thickness_mm", "contact_length_mm",
@@ -61,10 +64,12 @@ KEEP = ("cutting_force_N_per_m", "passive_force_N_per_m", "force_ratio", "rake_f
 
 
 def converged(case: int, **more) -> dict:
-    """The sweep's options for a case: dx = t_u / N_TU, TRAVEL t_u of cut on a workpiece 1.25 TRAVEL t_u long."""
+    """The sweep's options for a case: dx = t_u / N_TU, TRAVEL t_u of cut on a workpiece (TRAVEL + UNCUT) t_u long,
+    the tool TOOL; ``uncut``: other t_u left uncut."""
     from refsph.paper_data import rla_cutting_case
     tu = rla_cutting_case(case)["tu_mm"] * 1e-3
-    return dict(dict(case=case, n_tu=N_TU, travel=TRAVEL, length=1.25 * TRAVEL * tu), **more)
+    uncut = more.pop("uncut", UNCUT)
+    return dict(dict(case=case, n_tu=N_TU, travel=TRAVEL, length=(TRAVEL + uncut) * tu, **TOOL), **more)
 
 
 def _s(case: int) -> float:
@@ -87,21 +92,22 @@ def jobs(studies=STUDY_NAMES, only=None) -> dict:
         if study_name in studies and (study_name != "cases" or only is None or options["case"] in only):
             todo[key] = (options, dict(numerics or {}))
     add("cases", "case 1", converged(1))
+    add("resolution", "case 1 n_tu 5", converged(1, n_tu=5.0))
+    for seed in (1, 2, 3):                                   # the scatter: first at t_u/5 (an eighth of the cost)
+        add("scatter", f"case 1 n_tu 5 jitter {seed}", converged(1, n_tu=5.0, jitter=0.01, seed=seed))
     add("scaling", "case 1 s/2", converged(1, mass_scale=_s(1) / 2))
     add("cases", "case 10", converged(10))
     add("scaling", "case 10 s/2", converged(10, mass_scale=_s(10) / 2))
-    for seed in (1, 2, 3):                                   # the scatter: first at t_u/5 (an eighth of the cost)
-        add("scatter", f"case 1 n_tu 5 jitter {seed}", converged(1, n_tu=5.0, jitter=0.01, seed=seed))
     for seed in (1, 2, 3):
         add("scatter", f"case 1 jitter {seed}", converged(1, jitter=0.01, seed=seed))
-    add("resolution", "case 1 n_tu 5", converged(1, n_tu=5.0))
     add("resolution", "case 10 n_tu 5", converged(10, n_tu=5.0))
     for n in list(range(2, 10)) + list(range(11, 19)):
         add("cases", f"case {n}", converged(n))
-    add("tool", "case 1 n_tu 5", converged(1, n_tu=5.0))              # the tool and workpiece checks: at t_u/5
-    add("tool", "case 1 n_tu 5 tool x2", converged(1, n_tu=5.0, tool_length=10.0, tool_depth=6.0))
-    add("tool", "case 1 n_tu 5 workpiece +8 t_u", converged(1, n_tu=5.0, length=(TRAVEL + 8.0) * 1e-4))
-    add("tool", "case 1 tool x2", converged(1, tool_length=10.0, tool_depth=6.0))     # (then at t_u/10)
+    # the tool and workpiece checks (the first sweep's tool 5 x 3 t_u and 4 t_u uncut, one change at a time)
+    add("tool", "case 1 n_tu 5 tool 5x3, 4 t_u uncut", converged(1, n_tu=5.0, uncut=4.0, **SMALL))
+    add("tool", "case 1 n_tu 5 tool 5x3, 8 t_u uncut", converged(1, n_tu=5.0, uncut=8.0, **SMALL))
+    add("tool", "case 1 n_tu 5 4 t_u uncut", converged(1, n_tu=5.0, uncut=4.0))
+    add("tool", "case 1 tool 5x3, 4 t_u uncut", converged(1, uncut=4.0, **SMALL))
     add("contact", "case 1 pinball", converged(1), dict(contact="pinball"))
     add("contact", "case 1 all friction heat to the chip", converged(1, chip_fraction=1.0))
     add("resolution", "case 1 n_tu 15", converged(1, n_tu=15.0))
@@ -335,10 +341,11 @@ STUDIES = (
      ("case 1 n_tu 5", "case 1", "case 1 n_tu 15", "case 10 n_tu 5", "case 10", "case 10 n_tu 15"),
      (("across t_u", "across", ".0f"), ("dx [um]", "dx_um", ".1f"), ("particles", "n_particles", "d")) + BASIC
      + (("steps", "n_steps", "d"), ("wall [s]", "wall", ".0f"))),
-    ("Tool and workpiece size (case 1: the tool 5 t_u x 3 t_u, the workpiece 1.25 x the cut long, 4 t_u left "
-     "uncut at the end; tool x2: 10 t_u x 6 t_u, 1 mm x 0.6 mm; workpiece +8 t_u: 12 t_u left uncut; checked at "
-     "t_u/5, where a run costs an eighth)",
-     ("case 1 n_tu 5", "case 1 n_tu 5 tool x2", "case 1 n_tu 5 workpiece +8 t_u", "case 1", "case 1 tool x2"),
+    ("Tool and workpiece size (the sweep: the tool 10 t_u x 6 t_u, 12 t_u left uncut at the end of the cut; the "
+     "first sweep's tool 5 t_u x 3 t_u, whose back face the chip's contact (4 t_u) nearly reached, and 4 t_u "
+     "uncut, one change at a time; at t_u/5, where a run costs an eighth, and at t_u/10)",
+     ("case 1 n_tu 5 tool 5x3, 4 t_u uncut", "case 1 n_tu 5 tool 5x3, 8 t_u uncut", "case 1 n_tu 5 4 t_u uncut",
+      "case 1 n_tu 5", "case 1 tool 5x3, 4 t_u uncut", "case 1"),
      BASIC + (("removed at held faces [% of work]", "removed_of_work", ".1f"), ("Fc drift [%]", "Fc_drift_pct", ".1f"),
               ("T_RF drift [K]", "TRF_drift", ".0f"))),
     ("Contact and heat split (case 1: penalty contact, half the frictional heat into the chip)",
@@ -458,9 +465,23 @@ def _parser():
     return ap
 
 
+def _same_options(recorded: dict, asked: dict) -> bool:
+    """Whether a record's scene options are the job's (the scene's defaults filled in, lengths to 1e-12 m)."""
+    from refsph.scenes.thermal_cutting import OPTIONS
+    defaults = {k: v for k, (v, _) in OPTIONS.items()}
+    a, b = dict(defaults, **recorded), dict(defaults, **asked)
+    return a.keys() == b.keys() and all(
+        a[k] == b[k] or (isinstance(a[k], float) and isinstance(b[k], float) and abs(a[k] - b[k]) < 1e-12) for k in a)
+
+
 def sweep(runs: study.RunStore, todo: dict, args) -> list:
     """Run the keys of ``todo`` not yet recorded (or in ``--redo``), each record stored as it comes (a failed run
     never replaces a good record: study.RunStore); the keys that ran."""
+    stale = [k for k, r in runs.records().items() if k in todo and k not in args.redo
+             and not _same_options(r.get("options", {}), todo[k][0])]
+    if stale:
+        raise SystemExit(f"error: the records of {stale} were made with other scene options than jobs() gives "
+                         "now; --redo them (their old runs are kept until a good one replaces them)")
     todo = {k: todo[k] for k in runs.pending(todo, redo=args.redo)}
     print(f"{len(todo)} runs to do ({len(runs.records())} recorded)", flush=True)
     t0 = time.perf_counter()

@@ -1,0 +1,10 @@
+"""The Particle Finite Element Method of Rodriguez Prieto, Larsson & Afrasiabi (2023, Section 2.3): the second
+paper's other method, beside refsph's SPH (issue 24). Particles are the nodes of a mesh made anew from them
+(Delaunay and the alpha-shape, :mod:`.mesh`); the solid is an updated-Lagrangian mixed displacement-pressure
+linear triangle with the polynomial-pressure-projection stabilisation (:mod:`.element`), implicit in time and
+solved by Newton-Raphson (:mod:`.solid`); the heat step is a backward-Euler finite element step on the same mesh
+(:mod:`.thermal`). The strength laws are the SPH solvers' (:mod:`refsph.strength`).
+
+Status: the mechanics and the heat step with their checks (``tests/test_pfem.py``, ``tests/test_pfem_thermal.py``);
+the tool contact, the cutting scene (``--method pfem``) and chapter 12 are still to come (issue 24).
+"""

@@ -1,0 +1,365 @@
+"""The PFEM's mechanical step (Rodriguez Prieto, Larsson & Afrasiabi 2023, Sections 2.3.1-2.3.3): an updated
+Lagrangian mixed displacement-pressure solid on linear triangles, implicit in time, solved by Newton-Raphson.
+
+    Eq. (12)  rho d2u/dt2 = div sigma + b
+    Eq. (13)  p = K ln(J) / J - 3 K alpha (1 - ln J) / J (T - T0)          (as printed; p the mean stress)
+    Eq. (15)  sigma = p I + s
+    Eq. (19)  M a_{n+1} + F_int(u_{n+1}, p_{n+1}) = F_ext
+    Eq. (20)  M_p p_{n+1} - F_vol(u_{n+1}) + F_stab p_{n+1} = 0
+    Eq. (21)  v_{n+1} = -v_n + 2 / dt (u_{n+1} - u_n),
+              a_{n+1} = -a_n - 4 / dt v_n + 4 / dt^2 (u_{n+1} - u_n)          (trapezoidal rule, Newmark 1/4, 1/2)
+
+(the minus signs of Eq. (21) are lost in the paper's typesetting; these are the trapezoidal rule's). On each
+triangle e, with the mesh at t_n (x_n), the displacement increment du of the step and the nodal pressures p:
+
+* **kinematics** (Hughes & Winget 1980, incrementally objective): L = grad_{n+1/2} du, the gradient on the
+  midpoint configuration x_n + du/2; d = sym L, w = skew L; the rotation Q = (I - w/2)^{-1} (I + w/2);
+  J_{n+1} = J_n det f, det f = A_{n+1} / A_n = 1 + tr H + det H with H = grad_n du (written so, not as the area
+  ratio, ln J keeps its digits at small strains);
+* **deviatoric stress**: the trial s* = Q s_n Q^T + 2 G dev(d) (plane strain: d_zz = 0, s_zz carried), returned by
+  the strength model of :mod:`refsph.strength` (the same seam as the SPH solvers: Johnson-Cook, the modified
+  Johnson-Cook of the paper, elastic) with the step's equivalent strain rate sqrt(2/3 dev d : dev d) / dt;
+* **pressure**: Eq. (13) at the element, p_hat(J_{n+1}, T);
+* **residuals** (forces per metre of width):
+
+      r_u,a = A_{n+1} (s + pbar I) grad_{n+1} N_a                     pbar = the element mean of the nodal p
+      r_p   = (M_e p - A_{n+1} / 3 p_hat) / K + S_e p / G               (M_e, S_e of :mod:`refsph.pfem.element`)
+
+  so that Eq. (20) reads M_p p - F_vol + F_stab p = 0 with M_p = int N N / K, F_vol = int N p_hat / K.
+
+**Mass.** Each node is a particle with a fixed mass m_i (the lumped mass matrix, M = diag(m_i)); the paper's
+M_{n+1} is the consistent one of the current mesh. With fixed nodal masses a remeshing neither creates nor loses
+mass (the standard PFEM mass error is the change of the meshed area; here that change is a density change instead).
+
+**Tangent.** The Newton-Raphson matrix is the exact derivative of the discrete residual: the pressure columns are
+linear and written out; the displacement columns are the element residual's central differences (12 evaluations of
+all the elements at once, step 1e-7 of the element size: truncation ~1e-10 relative), so the tangent includes the
+geometric stiffness, the return map and the strain-rate dependence without deriving them (stated as the issue
+allows). Newton then converges quadratically (``tests/test_pfem.py`` prints the residual norms).
+
+**History.** Between remeshings each triangle keeps its own history (s, s_zz, eps_p, W_p, J); at a remeshing
+(Algorithm 1) the history is projected to the nodes (area-weighted means, :func:`project_to_nodes`) and each new
+triangle starts from the mean of its nodes (:func:`history_from_nodes`). This averaging is the PFEM's only
+smoothing; a run that never remeshes is a plain updated-Lagrangian finite element run.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+import scipy.sparse as sp
+from scipy.sparse.linalg import spsolve
+
+from .element import ppp_stabilisation, pressure_mass, shape_gradients
+from .mesh import Mesh
+
+__all__ = ["SolidLaw", "Nodes", "History", "Loads", "StepResult", "element_response", "element_residual",
+           "volumetric_pressure", "assemble", "newton_step", "commit", "project_to_nodes", "history_from_nodes",
+           "make_nodes", "NewtonFailed"]
+
+
+class NewtonFailed(RuntimeError):
+    """Newton-Raphson did not converge in the allowed iterations (the step should be cut)."""
+
+
+@dataclass(frozen=True)
+class SolidLaw:
+    """The workpiece's constitutive data, SI units, no defaults: ``rho0`` [kg/m^3], shear modulus ``G`` and bulk
+    modulus ``K`` [Pa], thermal expansion ``alpha_T`` [1/K] and its reference temperature ``T_ref`` [K] (Eq. (13)),
+    and the deviatoric ``strength`` law (a :mod:`refsph.strength` model)."""
+
+    rho0: float
+    G: float
+    K: float
+    alpha_T: float
+    T_ref: float
+    strength: object
+
+    def __post_init__(self):
+        for name in ("rho0", "G", "K", "alpha_T", "T_ref"):
+            v = getattr(self, name)
+            if isinstance(v, bool) or not isinstance(v, (int, float)) or not np.isfinite(v):
+                raise ValueError(f"SolidLaw.{name} must be a finite number, got {v!r}")
+        for name in ("rho0", "G", "K", "T_ref"):
+            if not getattr(self, name) > 0:
+                raise ValueError(f"SolidLaw.{name} must be positive, got {getattr(self, name)!r}")
+        if self.alpha_T < 0:
+            raise ValueError(f"SolidLaw.alpha_T must not be negative, got {self.alpha_T!r}")
+        if not hasattr(self.strength, "return_map"):
+            raise ValueError("SolidLaw.strength must be a strength model (refsph.strength: return_map, heat)")
+
+    @classmethod
+    def from_elastic(cls, material, strength, alpha_T: float, T_ref: float) -> "SolidLaw":
+        """From an :class:`refsph.material.ElasticMaterial` (rho0, E, nu)."""
+        return cls(rho0=material.rho0, G=material.G, K=material.K, alpha_T=alpha_T, T_ref=T_ref, strength=strength)
+
+
+@dataclass
+class Nodes:
+    """The particles, which are the nodes: x, v, a (N, 2) [m, m/s, m/s^2], m (N,) [kg/m], p (N,) [Pa] (mean
+    stress), T (N,) [K], and the history projected to them at the last remeshing: S (N, 2, 2), S_zz (N,) [Pa],
+    eps_p (N,), W_p (N,) [J/m^3], J (N,) (the volume ratio); t [s]."""
+
+    x: np.ndarray
+    v: np.ndarray
+    a: np.ndarray
+    m: np.ndarray
+    p: np.ndarray
+    T: np.ndarray
+    S: np.ndarray
+    S_zz: np.ndarray
+    eps_p: np.ndarray
+    W_p: np.ndarray
+    J: np.ndarray
+    t: float = 0.0
+
+    @property
+    def n(self) -> int:
+        return len(self.x)
+
+
+@dataclass
+class History:
+    """Per triangle, at the start of the step: S (M, 2, 2), S_zz, eps_p, W_p, J (M,)."""
+
+    S: np.ndarray
+    S_zz: np.ndarray
+    eps_p: np.ndarray
+    W_p: np.ndarray
+    J: np.ndarray
+
+
+@dataclass
+class Loads:
+    """What acts on the nodes in a step: ``fixed`` (N, 2) bool, the prescribed displacement components, and
+    ``du_fixed`` (N, 2) [m] their increments in the step; ``f_ext`` (N, 2) [N/m] nodal forces (None: none);
+    ``contact``: None, or a function x_{n+1} (N, 2) -> (f (N, 2) [N/m], k (N, 2, 2) [N/m^2]) giving the contact
+    force on each node and its derivative df/dx (the Newton matrix adds -k)."""
+
+    fixed: np.ndarray
+    du_fixed: np.ndarray
+    f_ext: np.ndarray | None = None
+    contact: object = None
+
+
+@dataclass
+class StepResult:
+    """A converged step: du (N, 2), p (N,), the triangles' new history and heat, the Newton record."""
+
+    du: np.ndarray
+    p: np.ndarray
+    history: History
+    d_eps_p: np.ndarray
+    d_w_p: np.ndarray
+    area: np.ndarray
+    residuals: list = field(default_factory=list)
+    contact_force: np.ndarray | None = None
+
+    @property
+    def iterations(self) -> int:
+        return len(self.residuals) - 1
+
+
+def make_nodes(x: np.ndarray, m: np.ndarray, T: np.ndarray | float) -> Nodes:
+    """Nodes at rest and stress free at positions x (N, 2) with masses m (N,) and temperature T."""
+    x = np.asarray(x, dtype=float)
+    n = len(x)
+    z = np.zeros(n)
+    return Nodes(x=x.copy(), v=np.zeros((n, 2)), a=np.zeros((n, 2)), m=np.asarray(m, dtype=float).copy(),
+                 p=z.copy(), T=np.broadcast_to(np.asarray(T, dtype=float), (n,)).copy(), S=np.zeros((n, 2, 2)),
+                 S_zz=z.copy(), eps_p=z.copy(), W_p=z.copy(), J=np.ones(n))
+
+
+def volumetric_pressure(J: np.ndarray, T: np.ndarray, law: SolidLaw, lnJ: np.ndarray | None = None) -> np.ndarray:
+    """Eq. (13) as printed: p_hat = K ln J / J - 3 K alpha (1 - ln J) / J (T - T0) (``lnJ``: ln J if known more
+    accurately than np.log(J))."""
+    lnJ = np.log(J) if lnJ is None else lnJ
+    return law.K * lnJ / J - 3.0 * law.K * law.alpha_T * (1.0 - lnJ) / J * (T - law.T_ref)
+
+
+def element_response(xe: np.ndarray, due: np.ndarray, hist: History, Te: np.ndarray, dt: float,
+                     law: SolidLaw) -> dict:
+    """The triangles' state at t_{n+1} for the increment du (module text): S, S_zz, d_eps_p, d_w_p, J, p_hat, the
+    gradients and areas at n+1. xe, due (M, 3, 2); Te (M,) [K]."""
+    g_half, _ = shape_gradients(xe + 0.5 * due)
+    g_end, A_end = shape_gradients(xe + due)
+    g_n, A_n = shape_gradients(xe)
+    H = np.einsum("mai,maj->mij", due, g_n)                        # grad_n du: det f - 1 = tr H + det H, exactly
+    dJ = H[:, 0, 0] + H[:, 1, 1] + H[:, 0, 0] * H[:, 1, 1] - H[:, 0, 1] * H[:, 1, 0]
+    L = np.einsum("mai,maj->mij", due, g_half)                    # L_ij = sum_a du_a,i dN_a/dx_j
+    d = 0.5 * (L + np.swapaxes(L, 1, 2))
+    w = 0.5 * (L[:, 0, 1] - L[:, 1, 0])
+    q = 1.0 / (1.0 + 0.25 * w * w)                                 # Q = (I - W/2)^-1 (I + W/2), W = [[0, w], [-w, 0]]
+    c, s = (1.0 - 0.25 * w * w) * q, w * q
+    Q = np.stack([np.stack([c, s], -1), np.stack([-s, c], -1)], -2)
+    tr = d[:, 0, 0] + d[:, 1, 1]
+    dev = d - (tr / 3.0)[:, None, None] * np.eye(2)
+    dev_zz = -tr / 3.0
+    S_trial = np.einsum("mik,mkl,mjl->mij", Q, hist.S, Q) + 2.0 * law.G * dev
+    S_zz_trial = hist.S_zz + 2.0 * law.G * dev_zz
+    eps_dot = np.sqrt(np.maximum(2.0 / 3.0 * (np.einsum("mij,mij->m", dev, dev) + dev_zz * dev_zz), 0.0)) / dt
+    S_new, S_zz_new, d_eps_p, d_w_p = law.strength.return_map(S_trial, S_zz_trial, hist.eps_p, eps_dot, Te, law.G)
+    J = hist.J * (1.0 + dJ)
+    lnJ = np.log(hist.J) + np.log1p(dJ)                          # no cancellation at small strains
+    return dict(S=S_new, S_zz=S_zz_new, d_eps_p=d_eps_p, d_w_p=d_w_p, J=J,
+                p_hat=volumetric_pressure(J, Te, law, lnJ), grad=g_end, area=A_end)
+
+
+def element_residual(xe, due, pe, hist, Te, dt, law) -> tuple[np.ndarray, np.ndarray, dict]:
+    """(r_u (M, 3, 2), r_p (M, 3), the response): the element residuals of Eqs. (19)-(20) without inertia."""
+    r = element_response(xe, due, hist, Te, dt, law)
+    A = r["area"]
+    sigma = r["S"] + pe.mean(axis=1)[:, None, None] * np.eye(2)
+    r_u = A[:, None, None] * np.einsum("mij,maj->mai", sigma, r["grad"])
+    r_p = (np.einsum("mab,mb->ma", pressure_mass(A), pe) - (A / 3.0 * r["p_hat"])[:, None]) / law.K \
+        + np.einsum("mab,mb->ma", ppp_stabilisation(A), pe) / law.G
+    return r_u, r_p, r
+
+
+def _element_dofs(tri: np.ndarray, n: int) -> np.ndarray:
+    """(M, 9): u_x, u_y of the three nodes, then their three pressures (global numbering: u 2i + k, p 2N + i)."""
+    u = np.stack([2 * tri, 2 * tri + 1], axis=-1).reshape(len(tri), 6)
+    return np.concatenate([u, 2 * n + tri], axis=1)
+
+
+def _element_tangent(xe, due, pe, hist, Te, dt, law, r) -> np.ndarray:
+    """(M, 9, 9) d(r_u, r_p)/d(du, p): central differences in du (module text), the pressure columns exactly."""
+    m = len(xe)
+    h = np.sqrt(np.abs(shape_gradients(xe)[1]))
+    eps = 1e-7 * h
+    K = np.empty((m, 9, 9))
+    for k in range(6):
+        a, i = divmod(k, 2)
+        d = np.zeros_like(due)
+        d[:, a, i] = eps
+        up, pp, _ = element_residual(xe, due + d, pe, hist, Te, dt, law)
+        um, pm, _ = element_residual(xe, due - d, pe, hist, Te, dt, law)
+        K[:, :, k] = np.concatenate([(up - um).reshape(m, 6), pp - pm], axis=1) / (2.0 * eps[:, None])
+    A, g = r["area"], r["grad"]
+    K[:, :6, 6:] = np.repeat((A[:, None, None] * g / 3.0).reshape(m, 6, 1), 3, axis=2)
+    K[:, 6:, 6:] = pressure_mass(A) / law.K + ppp_stabilisation(A) / law.G
+    return K
+
+
+def assemble(nodes: Nodes, mesh: Mesh, hist: History, law: SolidLaw, du: np.ndarray, p: np.ndarray, dt: float,
+             dynamic: bool, tangent: bool = True):
+    """The global residual R (3N,) = (F_int - F_ext + M a_{n+1}, Eq. (19); Eq. (20)) without loads, its matrix
+    (sparse (3N, 3N), or None), the element response, and the scales of the displacement and pressure rows (the
+    norms of the sums of the magnitudes of their terms: the tolerance is relative to them)."""
+    n, tri = nodes.n, mesh.tri
+    xe, due, pe, Te = nodes.x[tri], du[tri], p[tri], nodes.T[tri].mean(axis=1)
+    r_u, r_p, resp = element_residual(xe, due, pe, hist, Te, dt, law)
+    dofs = _element_dofs(tri, n)
+    loc = np.concatenate([r_u.reshape(len(tri), 6), r_p], axis=1)
+    R = np.bincount(dofs.ravel(), loc.ravel(), minlength=3 * n)
+    scale = np.bincount(dofs[:, :6].ravel(), np.abs(loc[:, :6]).ravel(), minlength=3 * n)[:2 * n]
+    area = np.abs(resp["area"])[:, None] / 3.0 * np.ones(3)              # the pressure rows' scale: int N |p| / K
+    scale_p = np.linalg.norm(np.bincount(tri.ravel(), (area * (np.abs(resp["p_hat"])[:, None] + np.abs(pe)
+                                                                 + 1e-12 * law.G)).ravel() / law.K, minlength=n))
+    if dynamic:
+        a_new = 4.0 / dt**2 * (du - dt * nodes.v) - nodes.a                 # Eq. (21)
+        R[:2 * n] += (nodes.m[:, None] * a_new).ravel()
+        scale = scale + np.abs(nodes.m[:, None] * a_new).ravel()
+    Kg = None
+    if tangent:
+        Ke = _element_tangent(xe, due, pe, hist, Te, dt, law, resp)
+        rows = np.repeat(dofs, 9, axis=1).ravel()
+        cols = np.tile(dofs, (1, 9)).ravel()
+        Kg = sp.coo_matrix((Ke.ravel(), (rows, cols)), shape=(3 * n, 3 * n)).tocsr()
+        if dynamic:
+            Kg = Kg + sp.diags(np.concatenate([np.repeat(4.0 * nodes.m / dt**2, 2), np.zeros(n)]))
+    return R, Kg, resp, (float(np.linalg.norm(scale)), float(scale_p))
+
+
+def newton_step(nodes: Nodes, mesh: Mesh, hist: History, law: SolidLaw, dt: float, loads: Loads,
+                dynamic: bool = True, tol: float = 1e-10, max_iter: int = 25) -> StepResult:
+    """Solve Eqs. (19)-(20) for the step's du and p by Newton-Raphson. Converged when the residual of the free
+    displacement rows and that of the pressure rows are below ``tol`` times their scales (:func:`assemble`).
+    Nodes without a triangle keep p = 0 (and, quasi-static, du = 0). Raises :class:`NewtonFailed`."""
+    n = nodes.n
+    fixed = np.asarray(loads.fixed, dtype=bool).copy()
+    meshed = mesh.meshed
+    if not dynamic:
+        fixed[~meshed] = True
+    du = dt * nodes.v + 0.5 * dt * dt * nodes.a if dynamic else np.zeros((n, 2))
+    target = np.where(fixed, np.where(meshed[:, None] | dynamic, loads.du_fixed, 0.0), du).ravel()
+    p = nodes.p.copy()
+    p[~meshed] = 0.0
+    fix = np.concatenate([fixed.ravel(), ~meshed])
+    f_ext = np.zeros(2 * n) if loads.f_ext is None else np.asarray(loads.f_ext, dtype=float).ravel()
+    history, step = [], None
+    for _ in range(max_iter + 1):
+        R, Kg, resp, scale, fc = _residual(nodes, mesh, hist, law, du, p, dt, dynamic, f_ext, loads.contact)
+        if step is not None and not np.all(np.isfinite(R)):       # an inverted triangle: halve the last correction
+            for _ in range(8):
+                step = 0.5 * step
+                du, p = du - step[:2 * n].reshape(n, 2), p - step[2 * n:]
+                R, Kg, resp, scale, fc = _residual(nodes, mesh, hist, law, du, p, dt, dynamic, f_ext, loads.contact)
+                if np.all(np.isfinite(R)):
+                    break
+        lift = np.zeros(3 * n)
+        lift[:2 * n] = target - du.ravel()                        # the prescribed part of the correction
+        lift[~fix] = 0.0
+        R_free = np.where(fix, 0.0, R)
+        res_u = float(np.linalg.norm(R_free[:2 * n])) / max(scale[0], np.finfo(float).tiny)
+        res_p = float(np.linalg.norm(R_free[2 * n:])) / scale[1]
+        history.append((res_u, res_p))
+        if res_u < tol and res_p < tol and not np.any(lift):
+            return StepResult(du=du, p=p, history=History(resp["S"], resp["S_zz"], hist.eps_p + resp["d_eps_p"],
+                                                           hist.W_p + resp["d_w_p"], resp["J"]),
+                              d_eps_p=resp["d_eps_p"], d_w_p=resp["d_w_p"], area=resp["area"], residuals=history,
+                              contact_force=fc)
+        if not np.all(np.isfinite(R)):
+            break
+        keep = sp.diags((~fix).astype(float))
+        Kf = (keep @ Kg @ keep + sp.diags(fix.astype(float))).tocsc()
+        step = spsolve(Kf, -(R_free + keep @ (Kg @ lift))) + lift
+        if not np.all(np.isfinite(step)):
+            break
+        du = du + step[:2 * n].reshape(n, 2)
+        p = p + step[2 * n:]
+    raise NewtonFailed(f"Newton-Raphson did not converge in {max_iter} iterations (residuals {history[-3:]})")
+
+
+def _residual(nodes, mesh, hist, law, du, p, dt, dynamic, f_ext, contact):
+    """assemble() with the nodal forces and the contact (its force and stiffness) added."""
+    n = nodes.n
+    with np.errstate(invalid="ignore", divide="ignore"):
+        R, Kg, resp, scale = assemble(nodes, mesh, hist, law, du, p, dt, dynamic)
+    R[:2 * n] -= f_ext
+    scale = (float(np.hypot(scale[0], np.linalg.norm(f_ext))), scale[1])
+    fc = None
+    if contact is not None:
+        fc, kc = contact(nodes.x + du)
+        R[:2 * n] -= fc.ravel()
+        Kg = Kg - sp.block_diag([sp.block_diag(list(kc)), sp.csr_matrix((n, n))], format="csr")
+    return R, Kg, resp, scale, fc
+
+
+def commit(nodes: Nodes, step: StepResult, dt: float, dynamic: bool = True) -> Nodes:
+    """The nodes at t_{n+1}: x += du, v and a by Eq. (21) (quasi-static: v = du / dt, a = 0), p."""
+    if dynamic:
+        v = 2.0 / dt * step.du - nodes.v
+        a = 4.0 / dt**2 * (step.du - dt * nodes.v) - nodes.a
+    else:
+        v, a = step.du / dt, np.zeros_like(step.du)
+    return replace(nodes, x=nodes.x + step.du, v=v, a=a, p=step.p.copy(), t=nodes.t + dt)
+
+
+def project_to_nodes(mesh: Mesh, area: np.ndarray, values: np.ndarray, n: int) -> np.ndarray:
+    """Area-weighted nodal means of per-triangle values (M, ...): v_i = sum_e A_e v_e / sum_e A_e over the triangles
+    of node i (0 for a node without one)."""
+    w = np.repeat(np.abs(area), 3)
+    idx = mesh.tri.ravel()
+    den = np.bincount(idx, w, minlength=n)
+    flat = np.repeat(values.reshape(len(area), -1), 3, axis=0)
+    num = np.stack([np.bincount(idx, w * flat[:, k], minlength=n) for k in range(flat.shape[1])], axis=1)
+    out = np.where(den[:, None] > 0, num / np.where(den > 0, den, 1.0)[:, None], 0.0)
+    return out.reshape((n,) + values.shape[1:])
+
+
+def history_from_nodes(nodes: Nodes, mesh: Mesh) -> History:
+    """Each triangle's history as the mean of its three nodes' (after a remeshing)."""
+    t = mesh.tri
+    return History(S=nodes.S[t].mean(axis=1), S_zz=nodes.S_zz[t].mean(axis=1), eps_p=nodes.eps_p[t].mean(axis=1),
+                   W_p=nodes.W_p[t].mean(axis=1), J=nodes.J[t].mean(axis=1))

@@ -1,0 +1,219 @@
+"""The PFEM's mechanics against answers known in closed form (issue 24): patch tests to round-off, no volumetric
+locking and no pressure checkerboard on a bent cantilever, Newton-Raphson's quadratic convergence, plane-strain
+J2 compression against the rigid-plastic curve, the cantilever's period, and a remeshing that conserves mass and
+momentum exactly."""
+import numpy as np
+import pytest
+
+from refsph.pfem import solid
+from refsph.pfem.element import ppp_stabilisation, pressure_mass, shape_gradients
+from refsph.pfem.mesh import alpha_shape_mesh, boundary_edges
+from refsph.plasticity import JohnsonCook
+from refsph.strength import Elastic
+
+E, NU, RHO = 200e9, 0.3, 7800.0
+
+
+def lattice(nx, ny, x0, x1, y0, y1):
+    X, Y = np.meshgrid(np.linspace(x0, x1, nx + 1), np.linspace(y0, y1, ny + 1))
+    return np.c_[X.ravel(), Y.ravel()]
+
+
+def law(nu=NU, strength=None):
+    return solid.SolidLaw(rho0=RHO, G=E / (2 * (1 + nu)), K=E / (3 * (1 - 2 * nu)), alpha_T=0.0, T_ref=293.0,
+                          strength=strength or Elastic())
+
+
+def fresh_history(mesh):
+    m = len(mesh.tri)
+    return solid.History(np.zeros((m, 2, 2)), np.zeros(m), np.zeros(m), np.zeros(m), np.ones(m))
+
+
+def lumped_masses(x, mesh):
+    A = shape_gradients(x[mesh.tri])[1]
+    return np.bincount(mesh.tri.ravel(), np.repeat(RHO * A / 3.0, 3), minlength=len(x))
+
+
+def test_element_matrices_are_the_integrals():
+    """int N_a N_b and the projection term of Dohrmann & Bochev, by a 3-point rule exact for quadratics."""
+    xe = np.array([[[0.1, 0.0], [1.3, 0.2], [0.4, 0.9]]])
+    g, A = shape_gradients(xe)
+    assert np.allclose(g.sum(axis=1), 0.0) and A[0] > 0
+    lam = np.array([[2 / 3, 1 / 6, 1 / 6], [1 / 6, 2 / 3, 1 / 6], [1 / 6, 1 / 6, 2 / 3]])   # N_a at the points
+    M = A[0] / 3.0 * lam.T @ lam
+    assert np.allclose(pressure_mass(A)[0], M, rtol=1e-14)
+    P = lam - lam.mean(axis=1, keepdims=True) * 0 - 1.0 / 3.0
+    assert np.allclose(ppp_stabilisation(A)[0], A[0] / 3.0 * P.T @ P, rtol=1e-13, atol=1e-16)
+    assert np.allclose(ppp_stabilisation(A)[0] @ np.ones(3), 0.0, atol=1e-16)   # a constant p is not touched
+
+
+@pytest.mark.parametrize("grad, label", [([[1e-3, 2e-3], [-0.5e-3, 3e-3]], "small"),
+                                         ([[0.2, 0.1], [-0.05, -0.15]], "20 % strain")])
+def test_patch_test_linear_displacement_is_exact(grad, label):
+    """Boundary nodes moved by u = A x + b, interior nodes free (a distorted mesh): the interior nodes land on the
+    same linear field and the pressure is uniform, to round-off (small and large deformation)."""
+    rng = np.random.default_rng(1)
+    x = lattice(6, 6, 0, 1, 0, 1)
+    inner = (x[:, 0] > 0) & (x[:, 0] < 1) & (x[:, 1] > 0) & (x[:, 1] < 1)
+    x[inner] += rng.uniform(-0.05, 0.05, (inner.sum(), 2))
+    mesh = alpha_shape_mesh(x, None)
+    du = x @ np.array(grad).T + np.array([1e-4, -2e-4])
+    fixed = np.zeros((len(x), 2), bool)
+    fixed[~inner] = True
+    nodes = solid.make_nodes(x, lumped_masses(x, mesh), 293.0)
+    r = solid.newton_step(nodes, mesh, fresh_history(mesh), law(), 1e-3, solid.Loads(fixed=fixed, du_fixed=du),
+                          dynamic=False)
+    assert np.abs(r.du - du).max() < 1e-14 * np.abs(du).max() * 100
+    assert np.ptp(r.p) < 1e-11 * np.abs(r.p).max()
+    assert np.ptp(r.history.S, axis=0).max() < 1e-11 * np.abs(r.history.S).max()
+
+
+def cantilever(ny, nu, L=10.0, H=1.0, P=5e5):
+    """Plane-strain cantilever clamped at x = 0 with a parabolic shear load P [N/m] at the tip: tip deflection over
+    Timoshenko's, and the nodal mean stress against p = (1 + nu) / 3 sigma_xx = (1 + nu) / 3 P (L - x) y / I."""
+    x = lattice(int(ny * L / H), ny, 0, L, -H / 2, H / 2)
+    mesh = alpha_shape_mesh(x, None)
+    fixed = np.zeros((len(x), 2), bool)
+    fixed[x[:, 0] == 0] = True
+    tip = np.isclose(x[:, 0], L)
+    y = x[tip, 1]
+    w = (1 - 4 * y**2 / H**2) * np.where(np.isclose(np.abs(y), H / 2), 0.5, 1.0)   # trapezoid weights
+    f = np.zeros((len(x), 2))
+    f[tip, 1] = -P * w / w.sum()
+    nodes = solid.make_nodes(x, lumped_masses(x, mesh), 293.0)
+    r = solid.newton_step(nodes, mesh, fresh_history(mesh), law(nu), 1.0,
+                          solid.Loads(fixed=fixed, du_fixed=np.zeros_like(x), f_ext=f), dynamic=False)
+    Ep, I, G = E / (1 - nu**2), H**3 / 12, E / (2 * (1 + nu))
+    d_tim = P * L**3 / (3 * Ep * I) + P * L / (5 / 6 * G * H)
+    d = -r.du[tip & (np.abs(x[:, 1]) < 1e-12), 1][0]
+    pa = (1 + nu) / 3 * P * (L - x[:, 0]) * x[:, 1] / I
+    inner = (x[:, 0] > 1) & (x[:, 0] < L - 1)
+    return d / d_tim, np.abs(r.p - pa)[inner].max() / np.abs(pa).max()
+
+
+def test_cantilever_converges_without_locking_or_checkerboard():
+    """Compressible (nu = 0.3) and nearly incompressible (nu = 0.4999, K / G = 5000) bending: the tip deflection
+    converges to Timoshenko's at the same rate for both (a displacement-only linear triangle locks: its deflection
+    goes to 0 as nu -> 1/2), and the pressure converges to the linear bending field (a checkerboard would not)."""
+    for nu in (0.3, 0.4999):
+        res = [cantilever(ny, nu) for ny in (2, 4, 8)]
+        err = [1 - d for d, _ in res]
+        order = np.log2(err[1] / err[2])
+        print(f"nu = {nu}: deflection / Timoshenko {[round(d, 4) for d, _ in res]}, observed order {order:.2f}, "
+              f"pressure error {[round(e, 3) for _, e in res]}")
+        assert 0 < err[2] < 0.05 and order > 1.2
+        assert res[2][1] < 0.5 * res[1][1] and res[1][1] < 0.7 * res[0][1] and res[2][1] < 0.12
+
+
+def compression(nsteps, strain=0.4, print_newton=False):
+    """Plane-strain compression of a square (rollers on two sides, the top pressed by exp(-strain)) with linear
+    hardening sigma_y = A + B eps_p: the stress at the end against the rigid-plastic -2 / sqrt(3) sigma_y(eps_p)."""
+    x = lattice(4, 4, 0, 1e-3, 0, 1e-3)
+    mesh = alpha_shape_mesh(x, None)
+    jc = JohnsonCook(A=400e6, B=400e6, n=1.0, C=0.0, m=1.0, eps_dot_0=1.0, T_room=293.0, T_melt=1800.0, cp=450.0,
+                     chi=0.9, heating=False)
+    lw = law(strength=jc)
+    nodes, hist = solid.make_nodes(x, lumped_masses(x, mesh), 293.0), fresh_history(mesh)
+    top = np.isclose(x[:, 1], 1e-3)
+    fixed = np.zeros((len(x), 2), bool)
+    fixed[np.isclose(x[:, 1], 0), 1] = fixed[np.isclose(x[:, 0], 0), 0] = fixed[top, 1] = True
+    norms = None
+    for k in range(nsteps):
+        du = np.zeros_like(x)
+        du[top, 1] = 1e-3 * np.exp(-strain * (k + 1) / nsteps) - nodes.x[top, 1]
+        r = solid.newton_step(nodes, mesh, hist, lw, 1e-3, solid.Loads(fixed=fixed, du_fixed=du), dynamic=False)
+        nodes, hist = solid.commit(nodes, r, 1e-3, dynamic=False), r.history
+        if k == nsteps // 2:
+            norms = [a for a, _ in r.residuals[1:]]
+    R = solid.assemble(nodes, mesh, hist, lw, np.zeros_like(x), nodes.p, 1e-3, False, tangent=False)[0]
+    sigma = R[:2 * len(x)][1::2][top].sum() / nodes.x[top, 0].max()
+    analytic = -2 / np.sqrt(3) * (400e6 + 400e6 * hist.eps_p.mean())
+    return sigma / analytic - 1, norms
+
+
+def test_newton_converges_quadratically_in_a_plastic_step():
+    _, norms = compression(10)
+    print("Newton-Raphson residual norms (plastic compression step):", " ".join(f"{r:.1e}" for r in norms))
+    assert norms[-1] < 1e-10
+    big = [r for r in norms if r > 1e-12]
+    for r0, r1 in zip(big[1:-1], big[2:]):                         # e_{k+1} <= C e_k^2 once in the basin
+        assert r1 < 10.0 * r0 * r0
+
+
+def test_plane_strain_compression_against_the_rigid_plastic_curve():
+    """At 33 % height reduction (log strain 0.4) the flow stress is within 2 % of -2/sqrt(3) sigma_y(eps_p) at 20
+    steps and halves at 40: the radial return's yield stress lags by one step's hardening (first order)."""
+    e20, _ = compression(20)
+    e40, _ = compression(40)
+    print(f"compression stress error: {100 * e20:+.2f} % (20 steps), {100 * e40:+.2f} % (40 steps)")
+    assert abs(e20) < 0.02 and 1.6 < e20 / e40 < 2.4
+
+
+def test_cantilever_period_converges_to_euler_bernoulli():
+    """Free vibration in the first mode (trapezoidal rule, dt = T/40): the period over Euler-Bernoulli's converges
+    (errors 16 % and 4 % at 2 and 4 elements through the depth)."""
+    L, H = 10.0, 1.0
+    ratios = []
+    for ny in (2, 4):
+        x = lattice(int(ny * L / H), ny, 0, L, -H / 2, H / 2)
+        mesh = alpha_shape_mesh(x, None)
+        nodes, hist = solid.make_nodes(x, lumped_masses(x, mesh), 293.0), fresh_history(mesh)
+        b1 = 1.8751 / L
+        T_eb = 2 * np.pi / (b1**2 * np.sqrt(E / (1 - NU**2) * H**3 / 12 / (RHO * H)))
+        s = b1 * x[:, 0]
+        sig = (np.cosh(1.8751) + np.cos(1.8751)) / (np.sinh(1.8751) + np.sin(1.8751))
+        nodes.v[:, 1] = 1e-2 * (np.cosh(s) - np.cos(s) - sig * (np.sinh(s) - np.sin(s)))
+        fixed = np.zeros((len(x), 2), bool)
+        fixed[x[:, 0] == 0] = True
+        tip = np.flatnonzero((x[:, 0] == L) & (np.abs(x[:, 1]) < 1e-12))[0]
+        t, y = [], []
+        for _ in range(50):
+            r = solid.newton_step(nodes, mesh, hist, law(), T_eb / 40, solid.Loads(fixed, np.zeros_like(x)))
+            nodes, hist = solid.commit(nodes, r, T_eb / 40), r.history
+            t.append(nodes.t)
+            y.append(nodes.x[tip, 1])
+        t, y = np.array(t), np.array(y)
+        k = np.flatnonzero(np.diff(np.sign(y)) != 0)
+        crossings = t[k] - y[k] * (t[k + 1] - t[k]) / (y[k + 1] - y[k])
+        ratios.append(2 * np.mean(np.diff(crossings)) / T_eb)
+    print("period / Euler-Bernoulli:", [round(r, 4) for r in ratios])
+    assert abs(1 - ratios[1]) < 0.06 and abs(1 - ratios[1]) < 0.4 * abs(1 - ratios[0])
+
+
+def test_remeshing_keeps_mass_and_momentum_and_a_uniform_history():
+    """Algorithm 1: nodes moved, meshed again; masses, momentum and nodal fields are the nodes' own, so they are
+    conserved exactly; a uniform history projected to the nodes and back stays uniform."""
+    rng = np.random.default_rng(3)
+    x = lattice(8, 8, 0, 1e-3, 0, 1e-3) + rng.uniform(-2e-5, 2e-5, (81, 2))
+    mesh = alpha_shape_mesh(x, 1.5)
+    nodes = solid.make_nodes(x, lumped_masses(x, mesh), 293.0)
+    nodes.v[:] = rng.normal(size=nodes.v.shape)
+    m0, P0 = nodes.m.sum(), (nodes.m[:, None] * nodes.v).sum(axis=0)
+    S = np.broadcast_to(np.array([[1e8, 2e7], [2e7, -5e7]]), (len(mesh.tri), 2, 2))
+    area = shape_gradients(x[mesh.tri])[1]
+    nodes.S = solid.project_to_nodes(mesh, area, S, nodes.n)
+    nodes.x = nodes.x + rng.uniform(-3e-5, 3e-5, nodes.x.shape)           # the nodes move; a new mesh
+    new = alpha_shape_mesh(nodes.x, 1.5)
+    assert not np.array_equal(new.tri, mesh.tri)
+    hist = solid.history_from_nodes(nodes, new)
+    assert abs(nodes.m.sum() - m0) <= 1e-12 * m0
+    assert np.allclose((nodes.m[:, None] * nodes.v).sum(axis=0), P0, rtol=0, atol=1e-12 * np.abs(P0).max())
+    assert np.abs(hist.S - S[0]).max() < 1e-12 * 1e8
+
+
+def test_alpha_shape_keeps_a_gap_open_and_finds_the_boundary():
+    """Two blocks 3 spacings apart: alpha = 1.4 keeps them apart (every boundary edge short), alpha = None bridges
+    them; every node of a lattice block's outline is a boundary node, no interior node is."""
+    a = lattice(5, 5, 0, 1, 0, 1)
+    b = lattice(5, 5, 1.6, 2.6, 0, 1)
+    x = np.concatenate([a, b])
+    m = alpha_shape_mesh(x, 1.4)
+    assert not np.any((x[m.tri][..., 0].min(axis=1) < 1.01) & (x[m.tri][..., 0].max(axis=1) > 1.59))
+    assert np.any((x[alpha_shape_mesh(x, None).tri][..., 0].max(axis=1) > 1.59)
+                  & (x[alpha_shape_mesh(x, None).tri][..., 0].min(axis=1) < 1.01))
+    outline = (np.isclose(a[:, 0], 0) | np.isclose(a[:, 0], 1) | np.isclose(a[:, 1], 0) | np.isclose(a[:, 1], 1))
+    assert np.array_equal(m.boundary[:len(a)], outline)
+    e = boundary_edges(m.tri)
+    assert np.allclose(np.linalg.norm(x[e[:, 1]] - x[e[:, 0]], axis=1), 0.2)
+    with pytest.raises(ValueError, match="alpha"):
+        alpha_shape_mesh(x, -1.0)

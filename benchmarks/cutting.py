@@ -2,13 +2,12 @@
 
     python benchmarks/cutting.py                   # all runs, one at a time on both cores (about 2 hours)
     python benchmarks/cutting.py --only paper-     # only the jobs whose name contains 'paper-'
-    python benchmarks/cutting.py --plot-only       # JSON, table and figures again from runs/benchmarks/cutting/
+    python benchmarks/cutting.py --plot-only       # the records again from the folders in runs/benchmarks/cutting/
     python benchmarks/cutting.py --plot-only --rerun-of DIR --rerun-label "commit abc1234"
                                                    # ... and vs_rerun: the paper runs against the same runs in DIR
     python benchmarks/cutting.py --report          # benchmarks/cutting_report.md from cutting.json (runs nothing)
-    taskset -c 0 python benchmarks/cutting.py --only penalty- --add
-                                                   # run only those, one core, and add their records to cutting.json
-                                                   # (the other records stay as they are; no run folders needed)
+    taskset -c 0 python benchmarks/cutting.py --only penalty-
+                                                   # run only those, one core; their records go into cutting.json
     python benchmarks/cutting.py --strain-figure 0.3   # only figures/08_cutting_strain_f0.3.png, from the run folders
 
 Runs (2D plane strain, the scene `refsph.scenes.cutting`, 1 mm of cut = 20 us unless stated):
@@ -23,6 +22,17 @@ Each run is one process; its folder runs/benchmarks/cutting/NAME keeps summary.j
 snapshots (every 1/8 of the cut). BLAS/OpenMP pools are pinned to one thread; refsph's pair sums run on the run's
 share of the cores (Numerics.threads: all of them with --jobs 1, one each with --jobs 2). Wall times are what the
 issue's 30-minute target is about; CPU times add up all threads.
+
+What a rerun writes: the records of the jobs it ran (with --plot-only: of the jobs of --only, default all, whose
+folders are there), measured anew from their folders, are merged into the committed cutting.json
+(study.merge_derived): every other record stays as it was, byte for byte, so a partial rerun, or one in a fresh
+clone where the git-ignored run folders are missing, drops nothing; a run that failed never replaces a good record
+(a run that could not run, or was killed, gives no record at all); the vs_paper differences are taken anew only for
+the records that ran and those compared with them. A figure drawn from run folders (strain, temperature, reference
+updates) is redrawn only when every run it shows was recorded from its folder in this call; one drawn from the
+records alone (forces, bands, work-precision, contact) whenever the records allow. A file whose content (a figure:
+its pixels) did not change is not written, so a rerun that reproduced the committed results, or had nothing to do,
+leaves git status clean. --add (the old way to merge) is the default now and accepted for old commands.
 """
 from __future__ import annotations
 
@@ -222,11 +232,13 @@ def add_reruns(records, runs, label):
     return records
 
 
-def write_json(records):
+def write_json(records) -> bool:
     """One record per line (compact arrays), so that a change shows in git as the runs that changed; strict
-    JSON (a measurement that could not be made, e.g. the spacing of a single band, is null)."""
+    JSON (a measurement that could not be made, e.g. the spacing of a single band, is null). Written only if it
+    changed; True if it was."""
     from refsph.io import json_ready
-    OUT_JSON.write_text("[\n" + ",\n".join(json.dumps(json_ready(r), allow_nan=False) for r in records) + "\n]\n")
+    return study.write_if_changed(OUT_JSON, "[\n" + ",\n".join(json.dumps(json_ready(r), allow_nan=False)
+                                                                for r in records) + "\n]\n")
 
 
 def table(records) -> str:
@@ -301,23 +313,37 @@ def strain_figure(by: dict, feed: float) -> None:
     fig.suptitle(f"Orthogonal cutting, feed {feed * 1e3:g} mm, dp = 0.01 mm: chip and plastic strain at four "
                  f"instants (cf. the paper's Figs. {'12-13' if feed < 0.4e-3 else '17-18'}); grey: the tool's "
                  "surface layers", fontsize=12)
-    fig.savefig(FIG / f"08_cutting_strain_f{feed * 1e3:g}.png", dpi=110)
-    plt.close(fig)
+    study.save_figure(fig, FIG / f"08_cutting_strain_f{feed * 1e3:g}.png", dpi=110)
 
 
-def plots(records):
+def plots(records, folders=()):
+    """The figures: those drawn from run folders only where every run they show (of those with a record) is in
+    ``folders``, the runs recorded from their folders in this call; those drawn from the records always (a figure
+    whose pixels did not change is not written)."""
     import matplotlib
     matplotlib.use("Agg")
     FIG.mkdir(exist_ok=True)
     by = {r["name"]: r for r in records}
+
+    def from_folders(names, figure) -> bool:
+        shown = {n for n in names if n in by}
+        if shown and shown <= set(folders):
+            return True
+        if shown & set(folders):
+            print(f"{figure} figure not redrawn: it needs the run folders of {', '.join(sorted(shown - set(folders)))}")
+        return False
+    paper = [f"paper-{m}-f{f * 1e3:g}" for m in METHODS for f in FEEDS]
     # Figs. 12-13 and 17-18: plastic strain at four instants, ESPH above TLSPH, one figure per feed
     for feed in FEEDS:
-        strain_figure(by, feed)
-    temperature_figure(by)
+        if from_folders([n for n in paper if n.endswith(f"-f{feed * 1e3:g}")], f"strain f{feed * 1e3:g}"):
+            strain_figure(by, feed)
+    if from_folders(paper, "temperature"):
+        temperature_figure(by)
     forces_figure([r for r in records if r["name"].startswith("paper-")])
     bands_figure(by)
     work_precision_figure(records)
-    reference_updates_figure(by)
+    if from_folders(["coarse-tlsph-f0.3-25um", "noupdate-tlsph-f0.3-25um"], "reference-updates"):
+        reference_updates_figure(by)
     contact_figure(records)
 
 
@@ -347,8 +373,7 @@ def temperature_figure(by):
         fig.colorbar(sc, cax=fig.add_axes([0.9, 0.2, 0.015, 0.6]), label="temperature [K] (298 K to T_melt)")
     fig.suptitle("Temperature at the end of the cut, dp = 0.01 mm (cf. Figs. 14-15; adiabatic: 90 % of the "
                  "plastic work heats the particle, no conduction)", fontsize=10)
-    fig.savefig(FIG / "08_cutting_temperature.png", dpi=110)
-    plt.close(fig)
+    study.save_figure(fig, FIG / "08_cutting_temperature.png", dpi=110)
 
 
 def forces_figure(paper):
@@ -372,8 +397,7 @@ def forces_figure(paper):
         ax.legend(fontsize=8)
     axs[0].set_ylabel("force per unit thickness [MN/m = kN/mm]")
     fig.suptitle("Orthogonal cutting, dp = 0.01 mm: forces (the means are taken over the 2nd half)", fontsize=10)
-    fig.savefig(FIG / "08_cutting_forces.png", dpi=120)
-    plt.close(fig)
+    study.save_figure(fig, FIG / "08_cutting_forces.png", dpi=120)
 
 
 def bands_figure(by):
@@ -404,8 +428,7 @@ def bands_figure(by):
                 ax.set_ylabel("eps_p, middle row of the cut layer")
     fig.suptitle("Shear bands: peaks of the plastic strain along the chip (dotted: the bands counted; the strain at "
                  "the entry corner, x near 3 mm, runs off the scale)", fontsize=10)
-    fig.savefig(FIG / "08_cutting_bands.png", dpi=120)
-    plt.close(fig)
+    study.save_figure(fig, FIG / "08_cutting_bands.png", dpi=120)
 
 
 def work_precision_figure(records):
@@ -439,8 +462,7 @@ def work_precision_figure(records):
         ax.set_title(f"{label}, feed 0.3 mm, 1 mm of cut", fontsize=10)
         ax.grid(alpha=0.3, which="both")
         ax.legend(fontsize=8)
-    fig.savefig(FIG / "08_cutting_work_precision.png", dpi=120)
-    plt.close(fig)
+    study.save_figure(fig, FIG / "08_cutting_work_precision.png", dpi=120)
 
 
 def reference_updates_figure(by):
@@ -474,8 +496,7 @@ def reference_updates_figure(by):
         fig.suptitle(f"Reduced size (dp = {with_upd['dp_nominal_mm']:.3g} mm, feed {with_upd['feed_mm']:g} mm): "
                      "the chip "
                      "with and without updates of the reference configuration", fontsize=10)
-        fig.savefig(FIG / "08_cutting_reference_updates.png", dpi=120)
-        plt.close(fig)
+        study.save_figure(fig, FIG / "08_cutting_reference_updates.png", dpi=120)
 
 
 def _contact_pairs(records):
@@ -510,8 +531,7 @@ def contact_figure(records):
     axs[0].set_ylabel("force per unit thickness [MN/m = kN/mm]")
     fig.suptitle("Orthogonal cutting, TLSPH, dp = 0.01 mm: the paper's pinball contact against the penalty contact",
                  fontsize=10)
-    fig.savefig(FIG / "08_cutting_contact_forces.png", dpi=120)
-    plt.close(fig)
+    study.save_figure(fig, FIG / "08_cutting_contact_forces.png", dpi=120)
 
 
 TARGET_S = 30 * 60      # the issue's target: 1 mm of cut at the paper's resolution in 30 minutes (two cores)
@@ -737,66 +757,83 @@ def main(argv=None):
     global RUNS
     args = _parser().parse_args(argv)
     if args.report:
-        OUT_REPORT.write_text(report(json.loads(OUT_JSON.read_text())))
-        print(f"wrote {OUT_REPORT.relative_to(ROOT)}")
-        return
+        wrote = study.write_if_changed(OUT_REPORT, report(json.loads(OUT_JSON.read_text())))
+        print(f"{'wrote' if wrote else 'unchanged:'} {OUT_REPORT.relative_to(ROOT)}")
+        return 0
     if args.json_figures:
         import matplotlib
         matplotlib.use("Agg")
         work_precision_figure(json.loads(OUT_JSON.read_text()))
-        return
+        return 0
     if args.runs is not None:
         RUNS = Path(args.runs).resolve()
     if args.strain_figure is not None:
-        feed = args.strain_figure * 1e-3
-        by = {j["name"]: record(j) for j in job_list() if j["name"].startswith("paper-")
-              and abs(j["feed"] - feed) < 1e-9 and (RUNS / j["name"] / "summary.json").exists()}
-        strain_figure(by, feed)
-        print(f"drew figures/08_cutting_strain_f{args.strain_figure:g}.png from {', '.join(by) or 'no runs'}")
-        return
+        return _strain_figure_only(args.strain_figure * 1e-3)
     jobs = [j for j in job_list() if args.only is None or args.only in j["name"]]
+    ran = None
     if not args.plot_only:
         threads = study.threads_per_job(args.jobs)       # all cores for --jobs 1, one each for --jobs 2
+        ran = set()
         for name, done in study.execute(run_job, {j["name"]: (dict(j, threads=threads),) for j in jobs}, args.jobs):
-            if done != name:
+            if done != name:                              # it could not run: its folder is no result of this call
                 print(f"{name}: {done['status']}", flush=True)
-    if args.add:
-        add_records(jobs)
-        return
-    done = [j for j in job_list() if (RUNS / j["name"] / "summary.json").exists()]
-    records = add_differences([record(j) for j in done])
-    if args.rerun_of is not None:
-        records = add_reruns(records, Path(args.rerun_of).resolve(), args.rerun_label)
-    elif OUT_JSON.exists():                               # keep the comparison already made (its runs may be gone)
-        old = {r["name"]: r.get("vs_rerun") for r in json.loads(OUT_JSON.read_text())}
-        for r in records:
-            if old.get(r["name"]) is not None and r["name"].startswith("paper-"):
-                r["vs_rerun"] = old[r["name"]]
-    write_json(records)
+            else:
+                ran.add(name)
+    record_runs([j for j in jobs if ran is None or j["name"] in ran], args.rerun_of, args.rerun_label)
+    return 0
+
+
+def _recordable(job) -> bool:
+    """A finished or failed run in its folder (a run still going, killed or interrupted is no result)."""
+    status = study.run_status(RUNS / job["name"])
+    if status in ("running", "interrupted", "unreadable"):
+        print(f"{job['name']}: status {status!r} in its folder, not recorded")
+    return status not in (None, "running", "interrupted", "unreadable")
+
+
+def record_runs(jobs, rerun_of=None, rerun_label=""):
+    """The records of ``jobs`` (those with a run folder) merged into cutting.json (module text: a failed run never
+    replaces a good record, every other record stays as it was), the table, and the figures they change."""
+    committed = json.loads(OUT_JSON.read_text()) if OUT_JSON.exists() else []
+    fresh = [record(j) for j in jobs if _recordable(j)]
+    old = {r["name"]: r.get("vs_rerun") for r in committed}
+    for r in fresh:                                       # keep the comparison already made (its runs may be gone)
+        if old.get(r["name"]) is not None and r["name"].startswith("paper-"):
+            r["vs_rerun"] = old[r["name"]]
+    records, went_in = study.merge_derived(committed, fresh, add_differences)
+    for r in fresh:
+        if r["name"] not in went_in:
+            print(f"{r['name']}: {r['status']}; the committed good record is kept")
+    if rerun_of is not None:
+        records = add_reruns(records, Path(rerun_of).resolve(), rerun_label)
+    elif not fresh:
+        print(f"no run folder to record in {RUNS}: nothing written")
+        return records
+    print(f"{'wrote' if write_json(records) else 'unchanged:'} {OUT_JSON.relative_to(ROOT)} "
+          f"(recorded: {', '.join(sorted(went_in)) or 'none'})")
     print(table(records))
-    plots(records)
+    plots(records, went_in)
+    return records
 
 
-def add_records(jobs):
-    """--add: the records of ``jobs`` (those with a run folder) go into cutting.json, replacing a record of the same
-    name, after the others (job order); every other record is kept as it was, byte for byte, so no other run's
-    folder is needed. Draws only the contact figure."""
-    old = json.loads(OUT_JSON.read_text()) if OUT_JSON.exists() else []
-    new = {j["name"]: record(j) for j in jobs if (RUNS / j["name"] / "summary.json").exists()}
-    order = [j["name"] for j in job_list()]
-    kept = [r for r in old if r["name"] not in new]
-    added = sorted(new.values(), key=lambda r: order.index(r["name"]))
-    write_json(kept + added)
-    print(table(added))
-    contact_figure(kept + added)
-    print(f"added {', '.join(new) or 'nothing'} to {OUT_JSON.relative_to(ROOT)}")
+def _strain_figure_only(feed):
+    """--strain-figure: figures/08_cutting_strain_fFEED.png from the two paper runs of that feed (both needed)."""
+    names = [f"paper-{m}-f{feed * 1e3:g}" for m in METHODS]
+    missing = [n for n in names if not (RUNS / n / "summary.json").exists()]
+    if missing:
+        print(f"--strain-figure needs the run folders of {', '.join(missing)} in {RUNS}: nothing drawn")
+        return 1
+    jobs = {j["name"]: j for j in job_list()}
+    strain_figure({n: record(jobs[n]) for n in names}, feed)
+    print(f"figures/08_cutting_strain_f{feed * 1e3:g}.png from {', '.join(names)} (written if its pixels changed)")
+    return 0
 
 
 def _parser():
     ap = study.parser(__doc__, "jobs", "plot_only", "only")
     ap.add_argument("--add", action="store_true",
-                    help="record only the jobs of --only (after running them, or from their folders with "
-                         "--plot-only) and add them to the JSON: the other records stay as they are")
+                    help="(the default now, kept for old commands) the records of the jobs that ran, or with "
+                         "--plot-only of the jobs of --only whose folders are there, merged into the JSON")
     ap.add_argument("--runs", default=None, help=f"folder of the run folders (default {RUNS.relative_to(ROOT)})")
     ap.add_argument("--rerun-of", default=None, metavar="DIR",
                     help="folder of the same paper runs made by other code (e.g. an earlier commit): store how far "
@@ -814,4 +851,4 @@ def _parser():
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(main())

@@ -12,7 +12,9 @@ on the machine can only slow a repetition down). For each method, every combinat
 is timed. The rate evaluations are the same arithmetic whatever the blocks and threads, so the table isolates
 what the data layout buys: arrays that fit in the L2 cache (blocks) and two cores at once (threads). The last
 column is the time that 1 mm of cut (about 22,400 CFL steps) would take at that speed, the target of issue 5
-being under 30 minutes. Output: a table and ``benchmarks/pair_blocks.json``.
+being under 30 minutes. Output: a table and ``benchmarks/pair_blocks.json`` (``--json``), merged as throughput.py's:
+the results timed replace those of the same method, block size and thread count, every other result stays, so a
+run restricted with ``--methods``, ``--sizes`` or ``--threads`` drops nothing (``throughput.write_results``).
 
     python benchmarks/pair_blocks.py           # both methods, sizes all/2^15/2^16/2^17/2^18, 1 and 2 threads
     python benchmarks/pair_blocks.py --methods esph --sizes all 131072 --threads 2 --steps 20
@@ -116,7 +118,8 @@ def main(argv=None) -> list[dict]:
                 results.append(r)
                 print(f"{method:6s} {'all' if size is None else size:>7} {threads or 0:7d} {r['n_pairs']:8d} "
                       f"{r['s_per_step']:7.4f} {r['cpu_s_per_step']:10.4f} {r['minutes_per_mm']:7.1f}", flush=True)
-    write_results(args.json, results, refsph_path=str(Path(refsph.neighbours.__file__).parent),
+    write_results(args.json, results, lambda r: (r["method"], r["block_size"], r["threads"]),
+                  refsph_path=str(Path(refsph.neighbours.__file__).parent),
                   refsph_commit=_commit(Path(refsph.neighbours.__file__).parent),
                   scene="cutting, dp = 0.01 mm, h = 0.018 mm, feed 0.3 mm, from t = 0",
                   timing="best of `repeats` repetitions of `steps` predictor-corrector steps after 3 warm-up "

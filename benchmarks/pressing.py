@@ -3,11 +3,9 @@
     python benchmarks/pressing.py                 # all runs, one at a time (about 9 CPU-minutes)
     python benchmarks/pressing.py --jobs 2        # two runs at a time (two cores)
     python benchmarks/pressing.py --only conv-    # only the jobs whose name contains 'conv-'
-    python benchmarks/pressing.py --plot-only     # JSON, table and figures again from runs/benchmarks/pressing/
+    python benchmarks/pressing.py --plot-only     # the records again from the folders in runs/benchmarks/pressing/
     python benchmarks/pressing.py --report        # benchmarks/pressing_report.md from the committed JSON only
-    python benchmarks/pressing.py --only penalty- --add
-                                                  # run only those and add their records to the JSON (the other
-                                                  # records stay as they are; no other run folders needed)
+    python benchmarks/pressing.py --only penalty- # run only those; their records go into the JSON
 
 Runs (2D plane strain, the scene `refsph.scenes.pressing`, tool travel 0.2 mm = 1 us, both methods unless stated):
   conv       dp = 0.0167, 0.0133, 0.01, 0.00667 mm (the paper's Fig. 10; h/dp = 1.5), CFL step (Courant 0.3)
@@ -31,6 +29,17 @@ step and to K_p, the cost, and the figures above (chapter 07 teaches the lesson 
 Wall times are single-core (the BLAS/OpenMP pools are pinned to one thread) and each run starts in a fresh
 process, as `refsph run` would (a reused worker process runs ESPH up to ~1.8x faster after a large run, because
 its heap has grown already); with --jobs 2 two runs share the machine's two cores.
+
+What a rerun writes: the records of the jobs it ran (with --plot-only: of the jobs of --only, default all, whose
+folders are there and hold a finished run) are merged into the committed pressing.json (study.merge_derived):
+every other record stays as it was, byte for byte, so a partial rerun, or one in a fresh clone where the
+git-ignored run folders are missing, drops nothing, and a run that failed or could not run gives no record (the
+committed one stays). The differences (vs_finest, vs_base) are taken anew only for the records that ran and those
+compared with them. The resolution figure (from the run folders) is redrawn only when every conv run was recorded
+from its folder in this call; the others (from the records) whenever there are records. A file whose content (a
+figure: its pixels) did not change is not written, so a rerun that reproduced the committed results, or had
+nothing to do, leaves git status clean. --add (the old way to merge) is the default now and accepted for old
+commands.
 """
 from __future__ import annotations
 
@@ -204,9 +213,10 @@ def add_differences(records):
     return records
 
 
-def write_json(records):
-    """One record per line (compact arrays), so that a change shows in git as the runs that changed."""
-    OUT_JSON.write_text("[\n" + ",\n".join(json.dumps(r) for r in records) + "\n]\n")
+def write_json(records) -> bool:
+    """One record per line (compact arrays), so that a change shows in git as the runs that changed. Written only if
+    it changed; True if it was."""
+    return study.write_if_changed(OUT_JSON, "[\n" + ",\n".join(json.dumps(r) for r in records) + "\n]\n")
 
 
 def table(records) -> str:
@@ -238,19 +248,29 @@ def _moving_average(y, k):
     return np.convolve(y, np.ones(k) / k, mode="same")
 
 
-def plots(records, json_only: bool = False):
-    """The benchmark's figures; ``json_only``: only those drawn from the records alone (the work-precision plot)."""
+def plots(records, json_only: bool = False, folders=()):
+    """The benchmark's figures; ``json_only``: only the work-precision and contact plots; the resolution figure (from
+    the run folders) only if every conv run is in ``folders``, the runs recorded from their folders in this call. A
+    figure whose pixels did not change is not written."""
     import matplotlib
     matplotlib.use("Agg")
     FIG.mkdir(exist_ok=True)
     conv = {m: sorted([r for r in records if r["name"].startswith("conv-") and r["method"] == m],
                       key=lambda r: -r["dp_mm"]) for m in METHODS}
+    if not all(conv.values()):
+        print("no figures: they need conv runs of both methods")
+        return
     _plot_work_precision(records, conv)
     _plot_contact(records)
-    if json_only:                                       # the rest needs the run folders
+    if json_only:
         return
-    _plot_resolution(conv)
     _plot_force(conv)
+    shown = {r["name"] for m in METHODS for r in conv[m]}
+    if shown <= set(folders):
+        _plot_resolution(conv)
+    elif shown & set(folders):
+        print("the resolution figure is not redrawn: it needs the run folders of "
+              f"{', '.join(sorted(shown - set(folders)))}")
 
 
 COLORS = dict(esph="C0", tlsph="C3")
@@ -295,8 +315,7 @@ def _plot_work_precision(records, conv):
     fig.legend(handles, labels, loc="outside lower center", ncol=3, fontsize=8)
     fig.suptitle("Metal pressing, 2D plane strain: work-precision (each method against its own finest run, "
                  "dp = 0.00667 mm)", fontsize=11)
-    fig.savefig(FIG / "07_pressing_work_precision.png", dpi=120)
-    plt.close(fig)
+    study.save_figure(fig, FIG / "07_pressing_work_precision.png", dpi=120)
 
 
 def _plot_resolution(conv):
@@ -335,8 +354,7 @@ def _plot_resolution(conv):
     fig.colorbar(sc, cax=cax, label=f"effective plastic strain (colour scale cut at {vmax:g})", extend="max")
     fig.suptitle("Metal pressing, tool travel 0.2 mm: final plastic strain at four spacings (cf. Fig. 10); "
                  "grey: the tool", fontsize=10)
-    fig.savefig(FIG / "07_pressing_resolution.png", dpi=130)
-    plt.close(fig)
+    study.save_figure(fig, FIG / "07_pressing_resolution.png", dpi=130)
 
 
 def _plot_force(conv):
@@ -358,8 +376,7 @@ def _plot_force(conv):
     axs[0].set_ylabel("tool force [MN/m]")
     axs[0].set_ylim(bottom=0)
     fig.suptitle("Metal pressing: tool force against time at the four spacings, CFL step", fontsize=10)
-    fig.savefig(FIG / "07_pressing_force.png", dpi=120)
-    plt.close(fig)
+    study.save_figure(fig, FIG / "07_pressing_force.png", dpi=120)
 
 
 def _contact_pairs(records):
@@ -392,8 +409,7 @@ def _plot_contact(records):
     ax.legend(fontsize=8)
     ax.set_title(f"Metal pressing, TLSPH, dp = {_um(pairs[-1][1])} um: force of the block on the tool, two tool "
                  "contacts\n(thin: 2.5 ns bins, thick: 22.5 ns running mean)", fontsize=9)
-    fig.savefig(FIG / "07_pressing_contact_force.png", dpi=120)
-    plt.close(fig)
+    study.save_figure(fig, FIG / "07_pressing_contact_force.png", dpi=120)
 
 
 def observed_order(h, f):
@@ -545,24 +561,6 @@ def _report_sensitivity(P, records, conv) -> list[str]:
     return L
 
 
-def add_records(jobs):
-    """--add: the records of ``jobs`` (those with a run folder) go into pressing.json, replacing a record of the
-    same name, after the others (job order); every other record is written as it was (byte for byte), so no other
-    run's folder is needed; the new records' differences are taken against the records in the JSON. Draws only
-    the contact figure."""
-    import copy
-    old = json.loads(OUT_JSON.read_text()) if OUT_JSON.exists() else []
-    new = {j["name"]: record(j) for j in jobs if (RUNS / j["name"] / "summary.json").exists()}
-    order = [j["name"] for j in job_list()]
-    kept = [r for r in old if r["name"] not in new]
-    added = sorted(new.values(), key=lambda r: order.index(r["name"]))
-    add_differences(copy.deepcopy(kept) + added)        # fills the new records' vs_finest / vs_base only
-    write_json(kept + added)
-    print(table(added))
-    _plot_contact(kept + added)
-    print(f"added {', '.join(new) or 'nothing'} to {OUT_JSON.relative_to(ROOT)}")
-
-
 def _pair_cell(a, b, key, spec, scale=1.0) -> str:
     """'pinball / penalty' of one measure."""
     return f"{study.fmt(a.get(key), spec, scale)} / {study.fmt(b.get(key), spec, scale)}"
@@ -622,42 +620,60 @@ def _report_contact(P, records) -> list[str]:
 def main(argv=None):
     ap = study.parser(__doc__, "jobs", "plot_only", "only", "json_figures", "report",
                       json_figures=dict(help="only redraw the figures made from the committed JSON alone "
-                                             "(figures/07_pressing_work_precision.png)"),
+                                             "(figures/07_pressing_work_precision.png, 07_pressing_contact_force.png)"),
                       report=dict(help=f"no runs: write {OUT_REPORT.name} from the committed {OUT_JSON.name} "
                                        "(nothing else)"))
     ap.add_argument("--add", action="store_true",
-                    help="record only the jobs of --only (after running them, or from their folders with "
-                         "--plot-only) and add them to the JSON: the other records stay as they are")
+                    help="(the default now, kept for old commands) the records of the jobs that ran, or with "
+                         "--plot-only of the jobs of --only whose folders are there, merged into the JSON")
     args = ap.parse_args(argv)
     if args.json_figures:
         plots(json.loads(OUT_JSON.read_text()), json_only=True)
         return 0
     if args.report:
-        OUT_REPORT.write_text(report(json.loads(OUT_JSON.read_text())))
-        print(f"wrote {OUT_REPORT.relative_to(ROOT)} from {OUT_JSON.relative_to(ROOT)}")
+        wrote = study.write_if_changed(OUT_REPORT, report(json.loads(OUT_JSON.read_text())))
+        print(f"{'wrote' if wrote else 'unchanged:'} {OUT_REPORT.relative_to(ROOT)} from {OUT_JSON.relative_to(ROOT)}")
         return 0
-    jobs = job_list()
-    todo = [j for j in jobs if args.only is None or args.only in j["name"]]
+    todo = [j for j in job_list() if args.only is None or args.only in j["name"]]
+    ran = None
     if not args.plot_only:
         todo.sort(key=lambda j: (j["dp"], j["dt"] is None))      # longest first
         # a fresh process for every run (study.execute): a worker that ran a large run before starts the next one
         # with a grown heap and runs it faster (glibc returns freed memory to the OS only at the top of the heap),
         # so reused workers would make the wall times depend on the order of the runs
         threads = study.threads_per_job(args.jobs)       # all cores for --jobs 1, one each for --jobs 2
+        ran = set()
         for name, done in study.execute(run_job, {j["name"]: (dict(j, threads=threads),) for j in todo}, args.jobs):
-            if done != name:
+            if done != name:                              # failed or could not run: no result of this call
                 print(f"{name}: {done['status']}", flush=True)
-    if args.add:
-        add_records(todo)
-        return 0
-    have = [j for j in jobs if (RUNS / j["name"] / "summary.json").exists()]
-    records = add_differences([record(j) for j in have])
-    write_json(records)
-    print(table(records))
-    if all(any(r["name"].startswith("conv-") and r["method"] == m for r in records) for m in METHODS):
-        plots(records)
-        print(f"figures written to {FIG}")
+            else:
+                ran.add(name)
+    record_runs([j for j in job_list() if j in todo and (ran is None or j["name"] in ran)])
     return 0
+
+
+def _finished(job) -> bool:
+    """A run folder holding a finished run (a failed, killed or running one gives no record)."""
+    status = study.run_status(RUNS / job["name"])
+    if status not in (None, "ok"):
+        print(f"{job['name']}: status {status!r} in its folder, not recorded")
+    return status == "ok"
+
+
+def record_runs(jobs) -> list:
+    """The records of ``jobs`` (those with a finished run in their folder) merged into pressing.json (module text),
+    the table, and the figures they change."""
+    committed = json.loads(OUT_JSON.read_text()) if OUT_JSON.exists() else []
+    fresh = [record(j) for j in jobs if _finished(j)]
+    if not fresh:
+        print(f"no finished run to record in {RUNS}: nothing written")
+        return committed
+    records, went_in = study.merge_derived(committed, fresh, add_differences)
+    print(f"{'wrote' if write_json(records) else 'unchanged:'} {OUT_JSON.relative_to(ROOT)} "
+          f"(recorded: {', '.join(sorted(went_in))})")
+    print(table(records))
+    plots(records, folders=went_in)
+    return records
 
 
 if __name__ == "__main__":

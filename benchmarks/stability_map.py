@@ -18,8 +18,9 @@ variant changes one thing (or, marked +, two). Accuracy: the case's own number (
 final length, mean tool force), reported beside survived / failed, with the final state's fragment count and
 smallest pair distance (every case: particles clumping show there first).
 
-Writes benchmarks/stability_map.json (one record per run, resumable: a rerun skips what is done),
-benchmarks/stability_map_report.md and figures/10_stability_map.png. refsph.stability holds the rules the run-time
+Writes benchmarks/stability_map.json (one record per run, resumable: a rerun skips what is done, and one with nothing
+to do writes nothing), benchmarks/stability_map_report.md and figures/10_stability_map.png (each only when its
+content, a figure's pixels, changed). refsph.stability holds the rules the run-time
 warning applies; tests/test_hard_cases.py checks them against this map.
 """
 from __future__ import annotations
@@ -151,7 +152,7 @@ def figure(res: dict) -> None:
         ax.set_xticks(range(len(CASES)), CASES, rotation=20)
         ax.set_yticks(range(len(vs)), vs)
         ax.set_title(f"{method.upper()}: survived?")
-    fig.savefig(FIGURE, dpi=110)
+    study.save_figure(fig, FIGURE, dpi=110)
 
 
 def main(argv=None) -> int:
@@ -171,9 +172,9 @@ def main(argv=None) -> int:
             print(f"[{k + 1}/{len(todo)}] {key:40s} {'survived' if rec.get('survived') else 'FAILED':9s} "
                   f"{rec.get('accuracy', float('nan')):.4g} {rec.get('wall_time_s', float('nan')):6.1f} s", flush=True)
     res = STORE.load()
-    REPORT.write_text(report(res))
+    study.write_if_changed(REPORT, report(res))
     figure(res)
-    print(f"wrote {OUT_JSON}, {REPORT}, {FIGURE}")
+    print(f"{OUT_JSON}, {REPORT}, {FIGURE}: each written where its content changed")
     return 0
 
 

@@ -18,6 +18,10 @@ tables and pages, and parse the common flags.
   heap or caches from an earlier run, so a wall time is a cold start's), ``jobs`` at a time, or on a
   dask.distributed cluster (``--scheduler ADDRESS``; dask is imported only then), and yields ``(key, result)`` as
   runs finish. A run that raises yields a failed record instead of stopping the sweep.
+* ``merge_records()``, ``merge_derived()``, ``write_if_changed()``, ``write_json()``, ``save_figure()``: what a rerun
+  writes. A partial rerun (``--only``, a fresh clone without the git-ignored run folders) merges its records into
+  the committed ones, a failed run never replaces a good record, and a file (JSON, page, figure) whose content did
+  not change is not written: a rerun that reproduced the committed results leaves ``git status`` clean.
 * ``md_table()``, ``fmt()``: markdown tables and cells.
 * ``Page``: the prose of a report page, in ``benchmarks/templates/<name>.md``, sections marked ``@@ name``,
   filled with ``string.Template`` (``$name``; a literal dollar is ``$$``).
@@ -122,16 +126,48 @@ class RunStore:
 
 
 # ----------------------------------------------------------------------------- running
-def merge_records(committed: list, fresh: list, key: str = "name") -> list:
+def merge_records(committed: list, fresh: list, key="name") -> list:
     """A list-of-records JSON after a partial rerun: the committed records in their order, each replaced by the
-    fresh one of the same ``key`` (a fresh failed one never replaces a good one), fresh ones not committed before
-    appended. A run folder missing here (a fresh clone) therefore never drops its committed record."""
-    new = {r[key]: r for r in fresh}
+    fresh one of the same ``key`` (a field name, or a function of the record; a fresh failed one never replaces a
+    good one), fresh ones not committed before appended. A run folder missing here (a fresh clone) therefore never
+    drops its committed record."""
+    of = key if callable(key) else (lambda r: r[key])
+    new = {of(r): r for r in fresh}
     out = []
     for r in committed:
-        f = new.pop(r[key], None)
+        f = new.pop(of(r), None)
         out.append(r if f is None or (_is_good(r) and not _is_good(f)) else f)
     return out + list(new.values())
+
+
+def merge_derived(committed: list, fresh: list, derive, key: str = "name") -> tuple[list, set]:
+    """``merge_records``, then the fields ``derive(records)`` computes across the records (in place, one record for
+    one; e.g. differences to a reference run: dict fields with a ``"ref"`` key naming the record compared with). A
+    record takes its derived fields anew only if it is one of the fresh records that went in or refers (before or
+    after) to one; every other committed record stays as it was, byte for byte. Returns (records, the keys of the
+    fresh records that went in)."""
+    import copy
+    merged = merge_records(committed, fresh, key)
+    fresh_ids = {id(r) for r in fresh}
+    went_in = {r[key] for r in merged if id(r) in fresh_ids}
+    derived = derive(copy.deepcopy(merged))
+
+    def refs(r):
+        return {v["ref"] for v in r.values() if isinstance(v, dict) and "ref" in v}
+    return [d if r[key] in went_in or (refs(r) | refs(d)) & went_in else r
+            for r, d in zip(merged, derived, strict=True)], went_in
+
+
+def run_status(folder: Path) -> str | None:
+    """The ``status`` in a run folder's summary.json ("ok", "nan", "error", "running" for a run still going or
+    killed, ...); None if the folder holds no summary (a fresh clone: ``runs/`` is not in git)."""
+    summary = Path(folder) / "summary.json"
+    if not summary.exists():
+        return None
+    try:
+        return json.loads(summary.read_text()).get("status")
+    except ValueError:
+        return "unreadable"
 
 
 def write_if_changed(path: Path, text: str) -> bool:
@@ -141,6 +177,58 @@ def write_if_changed(path: Path, text: str) -> bool:
     if path.exists() and path.read_text() == text:
         return False
     path.write_text(text)
+    return True
+
+
+def _without(o, ignore):
+    if isinstance(o, dict):
+        return {k: _without(v, ignore) for k, v in o.items() if k not in ignore}
+    if isinstance(o, list):
+        return [_without(v, ignore) for v in o]
+    return o
+
+
+def write_json(path: Path, doc, ignore=(), indent: int = 1) -> bool:
+    """Write ``doc`` as JSON to ``path`` unless the file holds the same document, the fields named in ``ignore`` (at
+    any depth) aside: e.g. wall times, which vary from run to run while the numbers do not, so a rerun that reproduced
+    the committed numbers leaves the file, and git status, as they were. True if it wrote."""
+    path, text = Path(path), json.dumps(doc, indent=indent) + "\n"
+    if path.exists():
+        try:
+            old = json.loads(path.read_text())
+        except ValueError:
+            old = None
+        if _without(old, set(ignore)) == _without(json.loads(text), set(ignore)):
+            return False
+    path.write_text(text)
+    return True
+
+
+def save_figure(fig, path: Path, **savefig_kw) -> bool:
+    """Save ``fig`` (then closed) as the PNG ``path`` unless that file already shows the same picture, pixel for pixel
+    (whatever its metadata or compression): a figure redrawn from unchanged data leaves the file, and git status, as
+    they were. True if it wrote."""
+    import io
+
+    import matplotlib.image
+    import matplotlib.pyplot as plt
+    import numpy as np
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", **savefig_kw)
+    plt.close(fig)
+    path, data = Path(path), buf.getvalue()
+    if path.exists():
+        old = path.read_bytes()
+        if old == data:
+            return False
+        try:
+            a, b = (matplotlib.image.imread(io.BytesIO(x), format="png") for x in (old, data))
+            if a.shape == b.shape and np.array_equal(a, b):
+                return False
+        except (OSError, ValueError, SyntaxError):            # not a PNG we can read: write the new one
+            pass
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_bytes(data)
     return True
 
 

@@ -17,7 +17,9 @@ rest time, peaks, wall time, particle count, steps) and the figures
   figures/06_taylor_sections.png         plastic strain and temperature on the section at 15 and 30 us (Figs. 4-5)
   benchmarks/taylor_report.md            (--report) the study as a report, every table number from taylor.json
 Wall times are single-core (each run is a fresh process, study.execute); with --jobs 2 two runs share the machine's
-two cores.
+two cores. A rerun merges the records of the finished runs in the run folders there into the committed taylor.json
+(study.merge_records): a run folder missing in a fresh clone drops no record, a failed or unfinished run gives none
+(the committed record stays); a file whose content (a figure: its pixels) did not change is not written.
 """
 from __future__ import annotations
 
@@ -96,8 +98,16 @@ def plots(records, json_only: bool = False):
     _plot_work_precision(records)
     if json_only:                                       # the rest needs the run folders
         return
-    _plot_length_history(records)
-    _plot_sections()
+    # from the run folders: only where every run a figure shows has its folder (a partial rerun in a fresh clone
+    # keeps the committed figure)
+    history = [r["name"] for r in records if r["dp_mm"] == 0.5 and r["name"].startswith(("conv-", "dt1e-8-"))]
+    for figure, names, draw in (("06_taylor_length_history.png", history, lambda: _plot_length_history(records)),
+                                ("06_taylor_sections.png", [f"conv-{m}-0.5mm" for m in METHODS], _plot_sections)):
+        missing = [n for n in names if not (RUNS / n / "summary.json").exists()]
+        if missing:
+            print(f"{figure} not redrawn: it needs the run folders of {', '.join(missing)}")
+        else:
+            draw()
 
 
 COLORS = dict(esph="C0", tlsph="C3")
@@ -131,8 +141,7 @@ def _plot_work_precision(records):
         ax.set_title(f"Taylor bar, 3D quarter model: final {label}")
         ax.legend(fontsize=7)
     fig.tight_layout()
-    fig.savefig(FIG / "06_taylor_work_precision.png", dpi=120)
-    plt.close(fig)
+    study.save_figure(fig, FIG / "06_taylor_work_precision.png", dpi=120)
 
 
 def _plot_length_history(records):
@@ -157,8 +166,7 @@ def _plot_length_history(records):
     ax.set_title("Taylor bar length, dp = 0.5 mm (cf. Fig. 3)")
     ax.legend(fontsize=8)
     fig.tight_layout()
-    fig.savefig(FIG / "06_taylor_length_history.png", dpi=120)
-    plt.close(fig)
+    study.save_figure(fig, FIG / "06_taylor_length_history.png", dpi=120)
 
 
 def _plot_sections():
@@ -188,8 +196,7 @@ def _plot_sections():
     axs[1, 0].set_ylabel("z [mm]")
     fig.suptitle("Taylor bar, section through the axis (lower 16 mm), dp = 0.5 mm (cf. Figs. 4-5)")
     fig.tight_layout()
-    fig.savefig(FIG / "06_taylor_sections.png", dpi=120)
-    plt.close(fig)
+    study.save_figure(fig, FIG / "06_taylor_sections.png", dpi=120)
 
 
 def table(records) -> str:
@@ -372,14 +379,13 @@ def main(argv=None):
                 print(f"{name}: {done['status']}", flush=True)
     # every run that exists (the 0.375 mm ones too, if an earlier call made them with --finest), merged into the
     # committed records: a run whose folder is not here (a fresh clone, a partial rerun) keeps its record
-    names = [j["name"] for j in job_list(args.finest or 0.375e-3) if (RUNS / j["name"] / "summary.json").exists()]
+    # (a folder whose run failed, or still runs, gives no record: its committed one stays)
+    names = [j["name"] for j in job_list(args.finest or 0.375e-3) if study.run_status(RUNS / j["name"]) == "ok"]
     committed = json.loads(OUT_JSON.read_text()) if OUT_JSON.exists() else []
     records = study.merge_records(committed, [record(n) for n in names])
     study.write_if_changed(OUT_JSON, json.dumps(records, indent=1) + "\n")
     print(table(records))
-    if all((RUNS / f"conv-{m}-0.5mm" / "summary.json").exists() for m in METHODS):
-        plots(records)
-        print(f"figures written to {FIG}")
+    plots(records)                  # those from the run folders only where they are; each written if it changed
     return 0
 
 

@@ -25,6 +25,12 @@ difference of the modal amplitude history from a reference run (leapfrog, Couran
 amplitude; the work is the wall time of the run. Written to the same JSON (``integrator_study``).
 
 Usage:  python benchmarks/throughput.py [--sizes 100 200] [--steps N] [--repeats R] [--json PATH] [--study]
+
+What a rerun writes (``write_results``, pair_blocks.py's too): the results it timed replace those of the same method,
+stepper and size in the JSON (``--json``), every other result stays as it was, so a run restricted with
+``--sizes``, ``--methods`` or ``--integrators`` drops nothing; the integrator study is replaced only by ``--study``.
+Where results of an earlier run are kept, the file's ``meta`` stays theirs and each new result carries, as
+``run_meta``, the fields of its own run's meta that differ (versions, commit). A run that fails writes nothing.
 """
 from __future__ import annotations
 
@@ -146,7 +152,7 @@ def main(argv=None) -> list[dict]:
                   f"{r['particle_steps_per_s']:16.3e} {r['ns_per_pair_step']:12.1f} {r['wall_s']:7.3f} "
                   f"{r['cpu_s']:7.3f} {r['setup_s']:7.3f}", flush=True)
     study = integrator_study() if args.study else None
-    write_results(args.json, results, threads=1,
+    write_results(args.json, results, lambda r: (r["method"], r["integrator"], r["n_particles"]), threads=1,
                   pair_definition="half pair (i < j) with |x_i - x_j| < 2h in the initial lattice",
                   timing="best of `repeats` repetitions of `steps` steps of each integrator, after one warm-up "
                          "step; particle_steps_per_s and ns_per_pair_step from the wall time",
@@ -189,10 +195,27 @@ def software() -> dict:
                 python=platform.python_version(), machine=platform.machine(), cores=os.cpu_count())
 
 
-def write_results(path: Path, results: list, **meta) -> None:
-    """{meta: software() + meta, results} as JSON at path."""
-    path.write_text(json.dumps(dict(meta=dict(software(), **meta), results=results), indent=2) + "\n")
-    print(f"\nwritten {path}")
+SECTIONS = ("integrator_study",)      # meta fields that are results of their own: replaced only when given
+
+
+def write_results(path: Path, results: list, key, **meta) -> None:
+    """{meta: software() + meta, results} as JSON at path, merged into what the file holds (module text): a result
+    replaces the one of the same ``key(result)`` (study.merge_records), the others stay as they were."""
+    meta = dict(software(), **meta)
+    old = json.loads(path.read_text()) if path.exists() else {}
+    old_meta, new_keys = old.get("meta", {}), {key(r) for r in results}
+    kept = [r for r in old.get("results", []) if key(r) not in new_keys]
+    sections = {k: v for k, v in meta.items() if k in SECTIONS}
+    if kept:                            # the file's meta stays the earlier run's; the new results say where they differ
+        differ = {k: v for k, v in meta.items() if k not in SECTIONS and old_meta.get(k) != v}
+        results = [dict(r, run_meta=differ) if differ else r for r in results]
+        meta = dict(old_meta, **sections)
+    else:
+        meta = {**{k: v for k, v in meta.items() if k not in SECTIONS},
+                **{k: old_meta[k] for k in SECTIONS if k in old_meta}, **sections}
+    doc = dict(meta=meta, results=study.merge_records(old.get("results", []), results, key))
+    wrote = study.write_if_changed(path, json.dumps(doc, indent=2) + "\n")
+    print(f"\n{'written' if wrote else 'unchanged:'} {path}")
 
 
 if __name__ == "__main__":

@@ -3,7 +3,8 @@
 A run directory holds
 
     summary.json              scene, method, dim, dp, h, n_particles, n_steps, wall_time_s, status, metrics, ...
-    snapshots/snap_00000.npz  one file per output time (NumPy .npz, arrays below, SI units)
+    snapshots/snap_00000.npz  one file per output time (NumPy .npz, arrays below, SI units): numbers only
+    snapshots/units.json      the unit of every snapshot array, {"t": "s", "x": "m", ...}: once per run folder
     snapshots/last_good.npz   only after a failure: the last state that was finite
     snapshots/restart.npz     the checkpoint of the last snapshot (solver state, history) for refsph run --restart
     reaction_forces.csv       scenes with rigid bodies or clamps: the force on each, every step (below)
@@ -28,7 +29,11 @@ Snapshot arrays (N particles, d dimensions):
 | W_p       | (N,)      | J/m^3         | plastic work density (plasticity)                    |
 | T         | (N,)      | K             | temperature (plasticity)                             |
 | body      | (N,)      | -             | body id (scenes with tools: 0 workpiece, see summary["boundaries"]) |
-| units     | ()        | -             | JSON string: unit of every key                       |
+
+Every entry is a plain number array (float64; ``id`` int64, ``body`` int32), so that any npz reader, a C or C++
+one too, reads every snapshot; the units are in ``snapshots/units.json`` beside them (the same arrays in every
+snapshot of a run, ``last_good.npz`` included), not in the npz. Snapshots of earlier refsph versions
+carry them as a 0-d unicode array ``units`` holding that JSON; :func:`load_snapshot` reads both.
 
 ``reaction_forces.csv``: a comment line, a header ``t,dt,<name>_x,<name>_y[,<name>_z],...`` and one row per
 time step: the midpoint time of the step [s], its size [s] and the force the rest of the system exerted on each
@@ -47,16 +52,18 @@ import numpy as np
 from .material import eos_pressure, von_mises
 from .state import FIELD_UNITS, PLASTIC_FIELDS, State
 
-__all__ = ["run_files", "claim_run_folder", "save_snapshot", "load_snapshot", "state_from_snapshot",
+__all__ = ["run_files", "claim_run_folder", "save_snapshot", "save_units", "load_snapshot", "state_from_snapshot",
            "state_from_particles", "load_run", "write_json", "json_ready", "save_reactions", "load_reactions",
-           "analyse_cutting_run", "SNAPSHOT_UNITS"]
+           "analyse_cutting_run", "SNAPSHOT_UNITS", "UNITS_FILE"]
 
 SNAPSHOT_UNITS = dict(FIELD_UNITS, p="Pa", sigma_vm="Pa", F="1", id="1 (particle id)")
+UNITS_FILE = "units.json"       # snapshots/units.json: the unit of every snapshot array (module text)
 
 
 def save_snapshot(path, state: State, material, F: np.ndarray | None = None, ids: np.ndarray | None = None) -> None:
-    """Write one snapshot (atomically: a crash never leaves a half-written file). ``ids``: the particles' ids, if
-    not their rows (particles read with ``--from`` keep the ids of their file)."""
+    """Write one snapshot, numbers only, and the units of its arrays in ``units.json`` beside it (:func:`save_units`;
+    both atomically: a crash never leaves a half-written file). ``ids``: the particles' ids, if not their rows
+    (particles read with ``--from`` keep the ids of their file)."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     arrays = dict(
@@ -71,10 +78,22 @@ def save_snapshot(path, state: State, material, F: np.ndarray | None = None, ids
         arrays.update(eps_p=state.eps_p, eps_dot_p=state.eps_dot_p, W_p=state.W_p, T=state.T)
     if state.body is not None:
         arrays["body"] = state.body
-    units = {k: SNAPSHOT_UNITS[k] for k in arrays}
+    save_units(path.parent, {k: SNAPSHOT_UNITS[k] for k in arrays})
     tmp = path.with_name(path.name + ".tmp.npz")
-    np.savez(tmp, units=json.dumps(units), **arrays)
+    np.savez(tmp, **arrays)
     os.replace(tmp, path)
+
+
+def save_units(folder, units: dict) -> None:
+    """``folder/units.json``: {array: unit} of the snapshots in ``folder``, written atomically (:func:`write_json`),
+    once: a file that already says exactly this is left as it is."""
+    path = Path(folder) / UNITS_FILE
+    try:
+        if json.loads(path.read_text()) == units:
+            return
+    except (OSError, ValueError):
+        pass
+    write_json(path, units)
 
 
 def read_npz(path, what: str = "file") -> dict:
@@ -99,21 +118,38 @@ def read_json(path, what: str = "file"):
         raise ValueError(f"{path}: not a readable {what} (invalid JSON: {e})") from None
 
 
-def load_snapshot(path) -> dict:
-    """Snapshot as a dict of arrays (``t`` a float, ``units`` a dict); ValueError naming the file if it cannot be
-    read or lacks ``t``, ``x``."""
+def _snapshot_arrays(path) -> tuple[dict, str | None]:
+    """A snapshot's arrays (``t`` a float) and the JSON text of an old snapshot's ``units`` entry (None in a
+    snapshot of numbers only); ValueError naming the file if it cannot be read or lacks ``t``, ``x``."""
     out = read_npz(path, "snapshot")
     missing = [k for k in ("t", "x") if k not in out]
     if missing:
         raise ValueError(f"{path}: not a refsph snapshot (no {', '.join(missing)})")
-    out["units"] = json.loads(str(out["units"])) if "units" in out else {}
+    text = out.pop("units", None)
     out["t"] = float(out["t"])
+    return out, None if text is None else str(text)
+
+
+def load_snapshot(path) -> dict:
+    """Snapshot as a dict of arrays (``t`` a float) and ``units``: {array: unit} from ``units.json`` beside it (an
+    old snapshot's own ``units`` entry where it has one; {} where neither is there); ValueError naming the file if
+    the snapshot or the units file cannot be read, or the snapshot lacks ``t``, ``x``."""
+    out, text = _snapshot_arrays(path)
+    beside = Path(path).parent / UNITS_FILE
+    if text is not None:
+        units = json.loads(text)
+    else:
+        units = read_json(beside, "units file") if beside.is_file() else {}
+    if not isinstance(units, dict):
+        raise ValueError(f"{beside if text is None else path}: the units are not a JSON object of array: unit")
+    out["units"] = {k: u for k, u in units.items() if k in out}
     return out
 
 
 def state_from_snapshot(snap) -> State:
-    """A :class:`~refsph.state.State` from a snapshot (a path, or the dict :func:`load_snapshot` gives)."""
-    z = load_snapshot(snap) if isinstance(snap, (str, Path)) else snap
+    """A :class:`~refsph.state.State` from a snapshot (a path, or the dict :func:`load_snapshot` gives); the units
+    are not read (a restart does not need them)."""
+    z = _snapshot_arrays(snap)[0] if isinstance(snap, (str, Path)) else snap
     extra = {k: np.array(z[k]) for k in PLASTIC_FIELDS + ("body",) if k in z}
     return State(x=np.array(z["x"]), v=np.array(z["v"]), m=np.array(z["m"]), rho=np.array(z["rho"]),
                  S=np.array(z["S"]), S_zz=np.array(z["S_zz"]), X=np.array(z["X"]), V0=np.array(z["V0"]),
@@ -200,13 +236,15 @@ def json_ready(o):
 
 RUN_FILE_PATTERNS = ("summary.json", "summary.json.tmp", "reaction_forces.csv", "reaction_forces.csv.tmp",
                      "snapshots/snap_[0-9][0-9][0-9][0-9][0-9].npz", "snapshots/*.tmp.npz", "snapshots/restart.npz",
-                     "snapshots/restart_prev.npz", "snapshots/last_good.npz",
+                     "snapshots/restart_prev.npz", "snapshots/last_good.npz", f"snapshots/{UNITS_FILE}",
+                     f"snapshots/{UNITS_FILE}.tmp",
                      "vtk/snap_[0-9][0-9][0-9][0-9][0-9].vtu", "vtk/run.pvd", "vtk/units.json")
 
 
 def run_files(folder) -> list[Path]:
     """The files of ``folder`` that refsph writes in a run folder (``RUN_FILE_PATTERNS``: the summary, the
-    reaction CSV, the snapshots and the restart checkpoint, ``refsph export``'s VTK files); nothing else."""
+    reaction CSV, the snapshots, their units and the restart checkpoint, ``refsph export``'s VTK files); nothing
+    else."""
     folder = Path(folder)
     return sorted({p for pattern in RUN_FILE_PATTERNS for p in folder.glob(pattern) if p.is_file()})
 

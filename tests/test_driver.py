@@ -37,6 +37,46 @@ def test_run_writes_summary_and_snapshots(tmp_path, method):
     assert prov["numpy"] == np.__version__ and prov["threads"] == summary["threads"]
 
 
+def test_snapshots_hold_numbers_only_and_old_ones_still_read(tmp_path, monkeypatch):
+    """Issue 23: every array of a snapshot is a plain number array (C and C++ npz readers read no unicode arrays);
+    the units are in snapshots/units.json, written once per run and listed among refsph's run files; a snapshot of
+    an earlier refsph, with its units as a 0-d JSON text inside and no units.json, still reads (load_snapshot,
+    state_from_snapshot, compare); a restart does not need the units."""
+    import refsph.io
+    from refsph.crosscheck.compare import compare
+    from refsph.io import UNITS_FILE, run_files, state_from_snapshot
+    written = []
+    real = refsph.io.write_json
+    monkeypatch.setattr(refsph.io, "write_json", lambda path, data: (written.append(path.name), real(path, data)))
+    out = tmp_path / "run"
+    run("pressing", "tlsph", quick=True, t_end=0.2e-6, out=out, progress=False)     # F, plasticity, a tool (body)
+    _, snaps = load_run(out)
+    units_file = out / "snapshots" / UNITS_FILE
+    assert written.count(UNITS_FILE) == 1 and units_file in run_files(out)
+    units = json.loads(units_file.read_text())
+    for p in snaps:
+        with np.load(p, allow_pickle=False) as z:
+            assert "units" not in z.files and all(z[k].dtype.kind in "fi" for k in z.files), p.name
+            assert set(z.files) == set(units)
+    last = load_snapshot(snaps[-1])
+    assert last["units"] == units and units["p"] == "Pa" and units["T"] == "K" and units["id"].startswith("1")
+    with np.load(snaps[-1]) as z:                                     # the same snapshot as an earlier refsph wrote it
+        old = {k: z[k] for k in z.files}
+    old_dir = tmp_path / "old"
+    old_dir.mkdir()
+    np.savez(old_dir / "snap_00000.npz", units=json.dumps(units), **old)
+    back = load_snapshot(old_dir / "snap_00000.npz")
+    assert back["units"] == units and back["t"] == last["t"] and np.array_equal(back["S"], last["S"])
+    assert np.array_equal(state_from_snapshot(old_dir / "snap_00000.npz").x, last["x"])
+    np.savez(snaps[-1], units=json.dumps(units), **old)                 # compare reads an old snapshot beside new ones
+    assert all(r.passed for r in compare(out, out))
+    units_file.write_text("{broken")
+    with pytest.raises(ValueError, match="units.json"):
+        load_snapshot(snaps[0])
+    with np.load(snaps[0]) as z:                                        # a restart reads no units
+        assert np.array_equal(state_from_snapshot(snaps[0]).x, z["x"])
+
+
 def test_summary_is_written_at_every_snapshot(tmp_path, monkeypatch):
     """A run that is killed keeps a summary.json (status 'running') up to its last snapshot."""
     import refsph.simulate as sim

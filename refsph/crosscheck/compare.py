@@ -5,7 +5,9 @@ Two kinds of folders are compared:
 * **golden cases** (``refsph oracle DIR``, a folder with ``index.json``): for every case of REF, every array of its
   ``output.npz`` against the same array in TEST/<case>/output.npz, with the case's own tolerance (``case.json``)
   and error measure (``case.json``'s ``measure``, where a case names one for an array: the relative L2 difference,
-  or a pointwise relative error with a floor; see :func:`compare_case`);
+  or a pointwise relative error with a floor; see :func:`compare_case`), or, for a metric that scatters by nature
+  (the cutting forces), the tolerance stored with the case from the measured scatter of perturbed runs
+  (``<case>/scatter.json``, :func:`scatter_tolerances`; the table says so beside the row);
 * **run folders** (``refsph run ... --out DIR``, a folder with ``summary.json``): the scalar metrics of
   ``summary.json`` and the snapshot fields, particles matched by ``id`` (the row where a snapshot has no ids),
   snapshots matched by time (TEST interpolated linearly in time where its snapshot times differ from REF's).
@@ -33,7 +35,9 @@ file ``--tolerances FILE``: {"fields": {"S": 1e-3}, "metrics": {"cutting_force_m
 fields the file names: another code rarely writes every field refsph does). What was measured for such files
 (README): a fixed dt against the CFL step moves the Taylor bar by 0.01 mm (3e-4) and the pressing force by
 0.01 % (ESPH) and 1 % (TLSPH); a rerun with the sums in another order moves the cutting forces by a few per cent
-and the chip thickness by up to 7 %; refsph against LAMMPS-SMD: benchmarks/lammps/tolerances.json.
+and the chip thickness by up to 7 %; moving the particles at random by 0.01 dx (benchmarks/metric_scatter.py) moves
+the coarse cutting runs' forces by up to 0.6 % after 0.2 mm of cut and up to 13 % after 0.6 mm (TLSPH's thrust;
+the chip thickness 1.4 %, the band count by one); refsph against LAMMPS-SMD: benchmarks/lammps/tolerances.json.
 """
 from __future__ import annotations
 
@@ -45,20 +49,22 @@ import numpy as np
 
 from ..io import read_json, read_npz
 
-__all__ = ["Row", "Rows", "compare", "compare_case", "compare_cases", "compare_runs", "format_table", "DEFAULTS",
-           "FIELDS", "LABELS"]
+__all__ = ["Row", "Rows", "compare", "compare_case", "compare_cases", "compare_runs", "format_table",
+           "scatter_tolerances", "DEFAULTS", "FIELDS", "LABELS", "SCATTER_FILE"]
 
 DEFAULTS = dict(field=1e-6, metric=1e-6)
 FIELDS = ("x", "v", "rho", "S", "S_zz", "F", "eps_p", "T")
 LABELS = ("missing", "shape mismatch", "dtype", "interpolated", "not finite")
-SNAPSHOT_META = ("units",)                  # entries of a snapshot that are not numbers (refsph's own: a JSON text)
+SCATTER_FILE = "scatter.json"   # <case>/scatter.json: tolerances from the scatter of perturbed runs (golden/FORMAT.md)
+SNAPSHOT_META = ("units",)      # entries of a snapshot that are not numbers (an earlier refsph's units, a JSON text)
 
 
 @dataclass
 class Row:
     """One compared quantity: its ``error`` against its ``tolerance``; ``labels`` (:data:`LABELS`) and ``note``
     where the number alone would mislead; where the error is largest: ``where`` (particle or pair, component),
-    ``time`` [s] (runs), ``ref_value`` and ``test_value``."""
+    ``time`` [s] (runs), ``ref_value`` and ``test_value``; ``tolerance_from``: where the tolerance comes from
+    where a stored scatter was consulted (the stored scatter, or case.json's where that is the larger)."""
 
     quantity: str
     error: float
@@ -69,6 +75,7 @@ class Row:
     time: float | None = None
     ref_value: float | None = None
     test_value: float | None = None
+    tolerance_from: str = ""
 
     @property
     def passed(self) -> bool:
@@ -214,19 +221,51 @@ def compare_case(case_dir: Path, out_test: dict | None, fields: dict | None = No
     case = read_json(case_dir / "case.json", "golden case")
     measure = case.get("measure", {})
     out_ref = read_npz(case_dir / "output.npz", "golden-case output")
+    scatter, stale = scatter_tolerances(case_dir, out_ref, case["tolerance"])     # {array: (tolerance, from)}
     pairs = None
     rows = []
     for k, a in out_ref.items():
-        tol = (fields or {}).get(k, case["tolerance"].get(k, DEFAULTS["field"]))
+        tol = (fields or {}).get(k, scatter[k][0] if k in scatter else case["tolerance"].get(k, DEFAULTS["field"]))
         kind = case.get("arrays", {}).get(f"output/{k}", {}).get("rows", "row")
         if kind == "pair" and pairs is None:
             pairs = _pairs_of(case_dir)
         missing = (f"TEST has no {case_dir.name}/output.npz" if out_test is None
                    else f"TEST's {case_dir.name}/output.npz has no array {k}")
-        rows.append(_array_row(f"{case_dir.name}/{k}", None if out_test is None else out_test.get(k), a, tol,
-                               measure.get(k), rows=kind, pairs=pairs if kind == "pair" else None,
-                               missing=missing))
+        row = _array_row(f"{case_dir.name}/{k}", None if out_test is None else out_test.get(k), a, tol,
+                         measure.get(k), rows=kind, pairs=pairs if kind == "pair" else None, missing=missing)
+        if k in scatter and k not in (fields or {}):
+            row.tolerance_from = scatter[k][1]
+        if k in stale:
+            row.note = "; ".join(filter(None, [row.note, stale[k]]))
+        rows.append(row)
     return rows
+
+
+def scatter_tolerances(case_dir, out_ref: dict, own: dict) -> tuple[dict, dict]:
+    """The tolerances a golden case stores from the measured scatter of its metrics (``<case>/scatter.json``,
+    written by benchmarks/metric_scatter.py; golden/FORMAT.md): {array: (tolerance, where it comes from)}, the
+    tolerance the larger of the stored one and the case's own (``own``: case.json's), and {array: note} for the
+    stored ones that were measured around another value than the case's output holds now (stale: the case's own
+    tolerance then). No file: ({}, {})."""
+    case_dir = Path(case_dir)
+    path = case_dir / SCATTER_FILE
+    if not path.is_file():
+        return {}, {}
+    doc = read_json(path, "stored scatter")
+    tolerances, stale = {}, {}
+    for k, tol in doc.get("tolerance", {}).items():
+        if k not in out_ref or tol is None:
+            continue
+        around = doc["metrics"][k]["reference"]
+        if around != float(out_ref[k]):
+            stale[k] = (f"{path} is stale: measured around {around!r}, the case holds {float(out_ref[k])!r}; the "
+                        "case's own tolerance is used (run benchmarks/metric_scatter.py again)")
+            continue
+        where = f"{case_dir.name}/{SCATTER_FILE}"
+        mine = float(own.get(k, 0.0))
+        tolerances[k] = ((float(tol), f"the stored scatter ({where})") if tol > mine else
+                         (mine, f"case.json, larger than the stored scatter's {tol:.1e} ({where})"))
+    return tolerances, stale
 
 
 def _pairs_of(case_dir: Path):
@@ -313,8 +352,8 @@ def _absent_ids(z: dict, ids: np.ndarray) -> np.ndarray:
 
 
 def _load_snapshot(path: Path) -> dict:
-    """A snapshot's numeric arrays (``t`` a float); refsph's ``units`` text is skipped, and another code's snapshot
-    need not have one."""
+    """A snapshot's numeric arrays (``t`` a float); the ``units`` text of an earlier refsph's snapshot is skipped
+    (refsph's units are in ``snapshots/units.json`` now, which no comparison needs)."""
     out = {k: v for k, v in read_npz(path, "snapshot").items() if k not in SNAPSHOT_META}
     if "t" not in out:
         raise ValueError(f"{path}: not a snapshot (no t)")
@@ -438,7 +477,8 @@ def format_table(rows: list[Row]) -> str:
     said = ""
     for r in rows:
         lines.append(f"{r.quantity:{width}s}  {r.error:10.3e}  {r.tolerance:9.1e}  {'yes' if r.passed else 'NO'}"
-                     + (f"   {r.label}" if r.labels else ""))
+                     + (f"   {r.label}" if r.labels else "")
+                     + (f"   tolerance from {r.tolerance_from}" if r.tolerance_from else ""))
         if not r.passed:
             lines += _detail(r, said)
             said = r.note

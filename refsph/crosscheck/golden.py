@@ -9,7 +9,10 @@ Each case is a folder ``DIR/<case>/`` with
   its rows are, meaning), every convention as data (``conventions``), the parameters, material, or the whole
   scene set-up (tools and their motion, clamps, walls, symmetry planes, numerics), and ``tolerance``: {array:
   relative tolerance} with ``why`` (errors are measured as max |test - ref| / max |ref| per array unless
-  ``measure`` names another error for an array, see :mod:`refsph.crosscheck.compare`).
+  ``measure`` names another error for an array, see :mod:`refsph.crosscheck.compare`);
+* ``scatter.json`` -- only beside ``metrics_cutting_coarse_*``, and not written here: the measured run-to-run
+  scatter of the metrics that depend chaotically on details and their tolerances (benchmarks/metric_scatter.py,
+  :func:`scatter_document`, ``SCATTER_RULE``); writing a case again keeps it (:func:`_clear_case`).
 
 The format (version 2) is written down for readers in any language in ``golden/FORMAT.md``: the npz files are
 uncompressed zip archives of NPY 1.0 arrays of float64 or int64, little-endian, C order (:func:`plain_array`;
@@ -91,7 +94,7 @@ from ..contact import (CoulombFriction, PinballContact, hertz_force, penetration
                        pinball_force, rate_force, reduced)
 from ..esph import ESPHParams, artificial_pressure, artificial_viscosity, esph_rates
 from ..integrate import cfl_time_step
-from ..io import json_ready
+from ..io import json_ready, read_npz
 from ..kernels import get_kernel
 from ..material import eos_pressure
 from ..neighbours import find_pairs
@@ -105,7 +108,7 @@ from ..strength import plastic_update
 from ..surface import moment_min_eigenvalue, surface_alpha_shape, surface_sph
 from ..thermal import conduction_rate, laplacian
 from ..tlsph import ReferenceOperator, TLSPHParams, tlsph_rates
-from .compare import Row, compare_case
+from .compare import SCATTER_FILE, Row, compare_case
 
 __all__ = ["write_golden_cases", "case_names", "pinned_environment", "generated_with", "metric_rows", "METRIC_RUNS",
            "FORMAT_VERSION", "FORMAT_CHANGES", "COMMON_CONVENTIONS", "ESPH_CONVENTIONS", "plain_array", "savez_fixed"]
@@ -1081,6 +1084,59 @@ def metric_rows(case_dir, metrics: dict) -> list[Row]:
     return compare_case(case_dir, _metric_arrays(METRIC_RUNS[key], metrics))
 
 
+# The metrics of the cutting scene that depend chaotically on details (the pinball's on/off switch, which particle
+# reaches the edge first): their run-to-run scatter, measured by benchmarks/metric_scatter.py on runs whose
+# workpiece particles are moved at random by SCATTER_JITTER dx, is kept beside the golden case in scatter.json
+# (golden/FORMAT.md) and refsph compare takes the tolerance of such a metric from there
+# (refsph.crosscheck.compare.scatter_tolerances). The rule:
+SCATTER_K = 2.0
+SCATTER_JITTER = 0.01
+SCATTER_METRICS = ("cutting_force_mean_N_per_m", "thrust_force_mean_N_per_m", "chip_thickness_mm", "n_shear_bands")
+SCATTER_RULE = (f"tolerance = k x the largest relative deviation of a perturbed run from the reference value "
+                f"(|v_i - v_ref| / |v_ref|), k = {SCATTER_K:g}; refsph compare uses the larger of it and case.json's "
+                "own tolerance")
+
+
+def spread(values, reference=None) -> dict:
+    """The spread of one metric over perturbed runs: ``n`` (runs that measured it: None and nan are runs that
+    could not), ``mean``, sample ``std``, ``max_deviation`` (max |v - mean|); with a finite ``reference`` also
+    ``max_deviation_from_reference`` (max |v - reference|), it relative to |reference|, and the ``tolerance`` of
+    :data:`SCATTER_RULE` (None where the reference is 0 or not finite, or fewer than two runs measured it)."""
+    v = np.array([np.nan if x is None else x for x in values], dtype=float)
+    v = v[np.isfinite(v)]
+    out = dict(values=[float(x) for x in v], n=int(len(v)), runs=len(values), mean=None, std=None,
+               max_deviation=None, reference=None if reference is None else float(reference),
+               max_deviation_from_reference=None, relative_max_deviation=None, tolerance=None)
+    if len(v) >= 2:
+        out.update(mean=float(v.mean()), std=float(v.std(ddof=1)), max_deviation=float(np.max(np.abs(v - v.mean()))))
+    ref = np.nan if reference is None else float(reference)
+    if len(v) >= 2 and np.isfinite(ref):
+        dev = float(np.max(np.abs(v - ref)))
+        out.update(max_deviation_from_reference=dev)
+        if ref != 0:
+            out.update(relative_max_deviation=dev / abs(ref), tolerance=SCATTER_K * dev / abs(ref))
+    return out
+
+
+def scatter_document(case_dir, unperturbed: dict, perturbed: dict, **about) -> dict:
+    """The content of ``<case>/scatter.json`` for a ``metrics_*`` golden case: the spread (:func:`spread`) of the
+    sensitive metrics (:data:`SCATTER_METRICS`) and the case's own over the perturbed runs (``perturbed``: {seed:
+    the run's summary metrics}) around the reference (the case's output where it holds the metric, else the
+    unperturbed run's value, ``unperturbed``), and ``tolerance`` for the sensitive ones where the rule gives one;
+    ``about``: what else to say (jitter, dp, length of cut, ...)."""
+    case_dir = Path(case_dir)
+    out_ref = read_npz(case_dir / "output.npz", "golden-case output")
+    names = [k for k in dict.fromkeys(SCATTER_METRICS + tuple(out_ref)) if k in unperturbed]
+    metrics = {k: spread([m.get(k) for m in perturbed.values()],
+                         out_ref[k] if k in out_ref and np.ndim(out_ref[k]) == 0 else unperturbed[k]) for k in names}
+    tolerance = {k: metrics[k]["tolerance"] for k in SCATTER_METRICS if k in metrics}
+    return dict(case=case_dir.name, what="the run-to-run scatter of the case's metrics: the same run with the "
+                "workpiece's particles moved at random by up to jitter x dx (one run per seed), against the "
+                "reference (the case's output, or the unperturbed run for a metric the case does not hold)",
+                written_by="benchmarks/metric_scatter.py", rule=SCATTER_RULE, k=SCATTER_K, **about,
+                seeds=[int(s) for s in perturbed], metrics=metrics, tolerance=tolerance)
+
+
 def _registry() -> list[tuple[tuple[str, ...], object]]:
     """(the case names, the function that writes them), in the order of index.json."""
     kernels = tuple(f"kernel_{k}_{d}d" for k in ("cubic", "wendland") for d in (2, 3))
@@ -1161,16 +1217,26 @@ def _check_target(root: Path, only=None) -> set:
     return chosen
 
 
+def _clear_case(folder: Path) -> None:
+    """Remove what the generator writes in a case's folder; a stored scatter (``scatter.json``: measured by
+    benchmarks/metric_scatter.py, minutes of runs, not by the generator) stays, and says itself when it is stale."""
+    if not folder.is_dir():
+        return
+    for p in folder.iterdir():
+        if p.name != SCATTER_FILE:
+            shutil.rmtree(p) if p.is_dir() else p.unlink()
+
+
 def _write_cases(root: Path, only=None) -> list[str]:
     _check_pinned()
     chosen = _check_target(root, only)
     if only is None and root.exists():                     # what refsph wrote: the cases and index.json; the
         for case in root.iterdir():                         # rest (golden/FORMAT.md, the spec) stays
             if case.is_dir() and (case / "case.json").is_file():
-                shutil.rmtree(case)
+                _clear_case(case)
         (root / "index.json").unlink(missing_ok=True)
     for name in chosen:
-        shutil.rmtree(root / name, ignore_errors=True)
+        _clear_case(root / name)
     root.mkdir(parents=True, exist_ok=True)
     for group, write in _registry():
         if chosen & set(group):

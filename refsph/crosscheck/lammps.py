@@ -32,7 +32,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..io import write_json
+from ..io import save_units, write_json
 
 __all__ = ["LAMMPS_TO_SI", "LammpsNotFound", "find_lmp", "run_lammps", "read_dump", "read_dumps", "read_history",
            "snapshot_from_frame", "particles_from_frame", "write_run", "finished_run", "INSTALL_HINT"]
@@ -204,20 +204,20 @@ def particles_from_frame(frame: dict, path, dim: int = 3) -> Path:
 
 def write_run(out, frames: list, history: dict, summary: dict, dim: int = 3) -> Path:
     """A refsph run folder from LAMMPS output: ``snapshots/snap_NNNNN.npz`` (one per dump frame, in SI, X from
-    the first frame) and ``summary.json`` (``summary``: scene, method, metrics, ... as refsph writes them).
-    ``refsph compare REFSPH_RUN OUT`` then compares the two codes, particles matched by id, LAMMPS's frames
-    interpolated to refsph's snapshot times."""
+    the first frame; their units in ``snapshots/units.json``) and ``summary.json`` (``summary``: scene, method,
+    metrics, ... as refsph writes them). ``refsph compare REFSPH_RUN OUT`` then compares the two codes, particles
+    matched by id, LAMMPS's frames interpolated to refsph's snapshot times."""
     out = Path(out)
     (out / "snapshots").mkdir(parents=True, exist_ok=True)
     first = frames[0]
     X = _positions(first, dim)                  # every frame has the first frame's rows (checked below)
     ids0 = first["id"]
+    save_units(out / "snapshots", dict(t="s", id="1", x="m", v="m/s", m="kg", rho="kg/m^3", V0="m^3", p="Pa", S="Pa",
+                                       X="m", eps_p="1"))
     for k, fr in enumerate(frames):
         if not np.array_equal(fr["id"], ids0):
             raise ValueError(f"frame {k} (step {fr['step']}) has other ids than the first: dump_modify sort id")
         snap = snapshot_from_frame(fr, frame_time(fr, history), X, dim)
-        snap["units"] = json.dumps(dict(t="s", id="1", x="m", v="m/s", m="kg", rho="kg/m^3", V0="m^3", p="Pa",
-                                        S="Pa", X="m", eps_p="1"))
         np.savez(out / "snapshots" / f"snap_{k:05d}.npz", **snap)
     write_json(out / "summary.json", dict(summary, n_particles=len(ids0), dim=dim, status="ok",
                                           n_snapshots=len(frames)))

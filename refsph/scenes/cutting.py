@@ -12,6 +12,9 @@ Model, and the choices the paper leaves open (its Fig. 11 is not in the text we 
   the clearance face (an L of particles), so that every workpiece particle near the tool sees a full kernel
   support of tool. Frictionless (Section 3.3).
 * **Cut length** (not printed): option ``travel``, 1 mm by default (t_end = 20 us), a third of the workpiece.
+* **Perturbed runs**: ``jitter`` moves the workpiece's particles at random by up to that many spacings (``seed``;
+  0 by default: the lattice), for the run-to-run scatter of the metrics (``benchmarks/metric_scatter.py``). The
+  measurements keep the lattice as the material coordinates (a jitter of 0.01 dx moves no particle across a row).
 
 Numerics: Table 5 (dp = 0.01 mm, h = 0.018 mm: h/dp = 1.8, beta1 = beta2 = 0.5), ESPH gamma = 0.3, CFL step with
 Courant 0.3 (the paper's fixed 1e-10 s is 9x smaller), ESPH Verlet skin 0.15 h; TLSPH reference updates at
@@ -44,8 +47,7 @@ from ..paper_data import CUTTING_GEOMETRY, CUTTING_OBSERVED, CUTTING_TABLE5
 from ..state import concatenate_states, make_state
 from .base import Numerics, Scene, Setup
 from .measure import (N_FORCE_BINS, TOOL_BODY, aisi4340_johnson_cook, aisi4340_material, binned_mean, box_outline,
-                      check_particle_count,
-                      block_lattice, time_mean)
+                      check_particle_count, block_lattice, jittered, time_mean)
 
 __all__ = ["SCENE", "cutting_particles", "chip_thickness", "lattice_shape", "shear_bands", "cutting_metrics",
            "cutting_table", "STEADY_FROM", "BAND_REL_PROMINENCE"]
@@ -56,6 +58,8 @@ CUTTING_OPTIONS = {
     "feed": (0.3e-3, "depth of cut (the paper's 'feeding length') [m]: 0.3e-3 or 0.5e-3 in the paper"),
     "travel": (1.0e-3, "length of cut at the end of the run [m] (not printed in the paper)"),
     "eps_dot_0": (1.0, "Johnson-Cook reference strain rate [1/s] (not printed in Table 3)"),
+    "jitter": (0.0, "random displacement of the workpiece's particles, in units of dx (a perturbed run)"),
+    "seed": (0, "the random seed of the jitter"),
 }
 
 
@@ -82,7 +86,7 @@ def _default_dp(dim, quick):
     return 0.025e-3 if quick else CUTTING_TABLE5["particle_spacing_m"]
 
 
-def _build(dim, dp, quick, *, feed, travel, eps_dot_0):
+def _build(dim, dp, quick, *, feed, travel, eps_dot_0, jitter, seed):
     if dim != 2:
         raise ValueError("the cutting scene is 2D plane strain")
     if not (np.isfinite(travel) and 0 < travel <= 2.0e-3):
@@ -92,16 +96,18 @@ def _build(dim, dp, quick, *, feed, travel, eps_dot_0):
                         beta2=t5["beta2"], gamma=t5["artificial_pressure_gamma_esph"], skin_factor=0.15)
     layers = math.ceil(2.0 * numerics.h_over_dp - 1e-9)
     xw, xt, dx, dy, clamp, y0 = cutting_particles(dp, float(feed), layers)
+    xw = jittered(xw, jitter, (dx, dy), seed)
     mat = aisi4340_material()                           # Table 3 (the same AISI 4340 as the pressing)
     jc = aisi4340_johnson_cook(eps_dot_0)
     speed = g["tool_speed_m_s"]
     work = make_state(xw, [0.0, 0.0], mat.rho0, dx * dy, T0=jc.T_room)
     tool = make_state(xt, [-speed, 0.0], mat.rho0, dx * dy, T0=jc.T_room, body=np.full(len(xt), TOOL_BODY))
     t_end = float(travel) / speed
+    perturbed = dict(jitter=float(jitter), seed=int(seed)) if jitter > 0 else {}   # (no jitter: the info as before)
     return Setup(state=concatenate_states(work, tool), material=mat, dp=dx, numerics=numerics, t_end=t_end,
                  n_snapshots=8, info=dict(n_work=work.n, n_tool=tool.n, dx=dx, dy=dy, feed_m=float(feed), y0=y0,
                                           tool_layers=layers, travel_m=float(travel), tool_speed_m_s=speed,
-                                          eps_dot_0=float(eps_dot_0)),
+                                          eps_dot_0=float(eps_dot_0), **perturbed),
                  strength=jc, rigid=(RigidBody("tool", TOOL_BODY, (-speed, 0.0), shape=box_outline(xt, dx, dy)),),
                  clamps=(Clamp("held", clamp),))
 

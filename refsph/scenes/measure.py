@@ -14,8 +14,8 @@ from ..plasticity import JohnsonCook
 from ..state import State
 
 __all__ = ["TOOL_BODY", "N_FORCE_BINS", "lattice", "block_lattice", "aisi4340_material", "aisi4340_johnson_cook",
-           "binned_mean", "time_mean", "kinetic_energy", "elastic_energy", "linear_momentum", "min_pair_distance",
-           "zero_crossings", "disc", "annulus", "angular_momentum", "n_fragments", "von_mises_max"]
+           "binned_mean", "time_mean", "jittered", "kinetic_energy", "elastic_energy", "linear_momentum",
+           "min_pair_distance", "zero_crossings", "disc", "annulus", "angular_momentum", "n_fragments", "von_mises_max"]
 
 TOOL_BODY = 1           # body id of the tool in the scenes with one (0 is the workpiece)
 N_FORCE_BINS = 400      # force histories in summary.json: time averages over this many equal bins
@@ -58,6 +58,20 @@ def block_lattice(nx: int, ny: int, dx: float, dy: float):
     i, j = np.meshgrid(np.arange(nx), np.arange(ny), indexing="ij")
     i, j = i.ravel(), j.ravel()
     return np.stack([(i + 0.5) * dx, (j + 0.5) * dy], axis=1), i, j
+
+
+MAX_JITTER = 0.1        # a perturbed run moves particles by at most this many spacings
+
+
+def jittered(x: np.ndarray, jitter: float, spacing, seed: int) -> np.ndarray:
+    """``x`` with every coordinate moved at random (uniform, random seed ``seed``) by up to ``jitter`` spacings
+    (``spacing``: one number or one per axis): a perturbed run, for the run-to-run scatter of a scene's metrics;
+    ``x`` itself where jitter is 0. ValueError unless 0 <= jitter <= MAX_JITTER."""
+    if not (np.isfinite(jitter) and 0.0 <= jitter <= MAX_JITTER):
+        raise ValueError(f"option jitter must lie in [0, {MAX_JITTER}] (units of dx), got {jitter!r}")
+    if jitter == 0:
+        return x
+    return x + float(jitter) * np.asarray(spacing) * np.random.default_rng(int(seed)).uniform(-1.0, 1.0, x.shape)
 
 
 def aisi4340_material() -> ElasticMaterial:

@@ -74,7 +74,8 @@ from ..penalty import RoundedPolygon
 from ..state import concatenate_states, make_state
 from ..thermal import Conduction, FrictionHeat, SurfaceLoss
 from .base import Numerics, Scene, Setup, parse_bool
-from .measure import N_FORCE_BINS, TOOL_BODY, binned_mean, block_lattice, check_particle_count, time_mean
+from .measure import (N_FORCE_BINS, TOOL_BODY, binned_mean, block_lattice, check_particle_count, jittered,
+                      time_mean)
 
 __all__ = ["SCENE", "MATERIALS", "tool_particles", "tool_shape", "mass_scale_for", "rake_frame", "chip_measures",
            "drift", "thermal_cutting_metrics", "thermal_cutting_table", "STEADY_FROM"]
@@ -188,8 +189,6 @@ def _build(dim, dp, quick, *, case, material, vc, tu, n_tu, travel, length, mass
             raise ValueError(f"option {name} must be positive, got {v!r}")
     if not (np.isfinite(mass_scale) and mass_scale >= 0):
         raise ValueError(f"option mass_scale must be >= 0 (0: chosen from inertia_ratio), got {mass_scale!r}")
-    if not (np.isfinite(jitter) and 0.0 <= jitter <= 0.1):
-        raise ValueError(f"option jitter must lie in [0, 0.1] (units of dx), got {jitter!r}")
     mat = MATERIALS[material]
     dx = float(dp) if dp is not None else tu / (n_tu * (0.8 if quick else 1.0))
     if tu < 2 * dx or travel * tu > 0.8 * length:
@@ -200,8 +199,7 @@ def _build(dim, dp, quick, *, case, material, vc, tu, n_tu, travel, length, mass
     nx, ny = round(length / dx), round(H / dx)
     xw, i, j = block_lattice(nx, ny, dx, dx)
     held = np.flatnonzero((i == 0) | (j == 0))
-    if jitter > 0:                                    # a perturbed run (the run-to-run scatter)
-        xw = xw + float(jitter) * dx * np.random.default_rng(int(seed)).uniform(-1.0, 1.0, xw.shape)
+    xw = jittered(xw, jitter, dx, seed)               # a perturbed run (the run-to-run scatter)
     y0 = ny * dx - tu
     xt, tool_held = tool_particles(dx, tu, (nx * dx, y0), tool_length, tool_depth)
     T0 = CONTACT_RLA["T_ref_K"]

@@ -23,7 +23,7 @@ from .esph import velocity_gradient
 from .kernels import Kernel
 from .neighbours import PairSum, find_pairs
 
-__all__ = ["moment_min_eigenvalue", "surface_sph", "surface_alpha_shape"]
+__all__ = ["moment_min_eigenvalue", "surface_sph", "surface_alpha_shape", "circumradius"]
 
 
 def moment_min_eigenvalue(x: np.ndarray, V: np.ndarray, h: float, kernel: Kernel,
@@ -53,7 +53,7 @@ def surface_alpha_shape(x: np.ndarray, dp: float, alpha: float = 1.3) -> np.ndar
     n, d = x.shape
     tri = Delaunay(x)
     simp = tri.simplices
-    keep = _circumradius(x[simp]) <= alpha * dp
+    keep = circumradius(x[simp]) <= alpha * dp
     faces = []
     for k in range(d + 1):                                  # the face opposite vertex k of every kept simplex
         faces.append(np.sort(np.delete(simp[keep], k, axis=1), axis=1))
@@ -64,7 +64,7 @@ def surface_alpha_shape(x: np.ndarray, dp: float, alpha: float = 1.3) -> np.ndar
     return out
 
 
-def _circumradius(P: np.ndarray) -> np.ndarray:
+def circumradius(P: np.ndarray) -> np.ndarray:
     """Circumradius of simplices P (m, d + 1, d): the centre c solves 2 (p_k - p_0) . c = |p_k|^2 - |p_0|^2; a flat
     simplex (its points on a line or plane: a lattice gives such slivers) has an infinite one."""
     p0 = P[:, :1, :]

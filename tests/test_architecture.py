@@ -87,10 +87,12 @@ EQUATION_MODULES = {f"refsph.{m}" for m in (
 RUN_LOOP_MODULES = {"refsph", "refsph.simulate", "refsph.solvers", "refsph.reference", "refsph.coupling",
                     "refsph.cli", "refsph.io"}  # refsph: the root; reference, coupling: parts of the TLSPH solver
 FLAT_LAYERS = {"equations": EQUATION_MODULES, "run loop": RUN_LOOP_MODULES}
-FOLDER_LAYERS = {"scenes": "refsph.scenes", "crosscheck": "refsph.crosscheck", "teaching": "refsph.teaching"}
+FOLDER_LAYERS = {"scenes": "refsph.scenes", "pfem": "refsph.pfem", "crosscheck": "refsph.crosscheck",
+                 "teaching": "refsph.teaching"}
 NOT_IMPORTED_BY = {                  # layer: the layers its modules must not import (unclassified modules neither)
-    "equations": {"run loop", "scenes", "crosscheck", "teaching"},
-    "scenes": {"run loop", "crosscheck", "teaching"},
+    "equations": {"run loop", "scenes", "pfem", "crosscheck", "teaching"},
+    "scenes": {"run loop", "pfem", "crosscheck", "teaching"},
+    "pfem": {"run loop", "crosscheck", "teaching"},
 }
 
 

@@ -217,3 +217,38 @@ def test_alpha_shape_keeps_a_gap_open_and_finds_the_boundary():
     assert np.allclose(np.linalg.norm(x[e[:, 1]] - x[e[:, 0]], axis=1), 0.2)
     with pytest.raises(ValueError, match="alpha"):
         alpha_shape_mesh(x, -1.0)
+
+
+def test_tool_contact_sticks_then_slides_at_mu():
+    """An elastic block pressed onto a rigid flat (the penalty inside Newton) and then dragged sideways by its top:
+    the tangential force grows while it sticks (F_T / F_N < mu), then the block slides with F_T / F_N = mu to
+    round-off (the return map), every bottom node in contact."""
+    from refsph.contact import CoulombFriction
+    from refsph.penalty import RoundedPolygon
+    from refsph.pfem.contact import StepContact, ToolContact, boundary_lengths
+    L, H = 1e-3, 0.5e-3
+    x = lattice(8, 4, 0, L, 0, H)
+    mesh = alpha_shape_mesh(x, None)
+    lw = law()
+    nodes, hist = solid.make_nodes(x, lumped_masses(x, mesh), 293.0), fresh_history(mesh)
+    flat = RoundedPolygon.from_polygon([[-1e-3, -1e-3], [3e-3, -1e-3], [3e-3, 0.0], [-1e-3, 0.0]], 0.0, [0.0, 0.0])
+    params = ToolContact(k_normal=200 * lw.G / (L / 8), k_tangent=200 * lw.G / (L / 8),
+                         friction=CoulombFriction(mu0=0.3, q=1.0, T_room=293.0, T_melt=1800.0))
+    top = np.isclose(x[:, 1], H)
+    fixed = np.zeros((len(x), 2), bool)
+    fixed[top] = True
+    f_T, ratios = np.zeros(len(x)), []
+    for k in range(6):
+        du = np.zeros_like(x)
+        du[top, 1 if k == 0 else 0] = -1e-6 if k == 0 else 0.5e-6
+        c = StepContact(params, flat, [0.0, 0.0], [0.0, 0.0], nodes.x, f_T, nodes.T,
+                        boundary_lengths(nodes.x, mesh.edges, nodes.n), np.flatnonzero(mesh.boundary))
+        r = solid.newton_step(nodes, mesh, hist, lw, 1e-3, solid.Loads(fixed, du, contact=c), dynamic=False)
+        nodes, hist, f_T = solid.commit(nodes, r, 1e-3, dynamic=False), r.history, c.last["f_T"]
+        F = r.contact_force.sum(axis=0)
+        ratios.append(-F[0] / F[1])
+        assert np.count_nonzero(c.last["f_N"] > 0) == 9 and F[1] > 0
+    print("F_T / F_N per step:", [round(v, 4) for v in ratios])
+    assert abs(ratios[0]) < 1e-9 and 0 < ratios[1] < ratios[2] < 0.3
+    assert np.allclose(ratios[3:], 0.3, rtol=1e-12)
+    assert np.all(nodes.x[np.isclose(x[:, 1], 0), 0] - x[np.isclose(x[:, 1], 0), 0] > 1e-6)   # it slid

@@ -26,7 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial import Delaunay, cKDTree
 
-from ..surface import _circumradius
+from ..surface import circumradius
 
 __all__ = ["Mesh", "nodal_spacing", "alpha_shape_mesh", "boundary_edges", "signed_areas"]
 
@@ -87,7 +87,7 @@ def alpha_shape_mesh(x: np.ndarray, alpha: float | None, h: np.ndarray | None = 
     h = nodal_spacing(x) if h is None else np.asarray(h, dtype=float)
     keep = np.abs(A) > 1e-10 * np.mean(h[tri], axis=1) ** 2
     if alpha is not None:
-        keep &= _circumradius(x[tri]) <= alpha * np.mean(h[tri], axis=1)
+        keep &= circumradius(x[tri]) <= alpha * np.mean(h[tri], axis=1)
     if body is not None:
         b = np.asarray(body)[tri]
         keep &= (b[:, 0] == b[:, 1]) & (b[:, 1] == b[:, 2])

@@ -98,7 +98,8 @@ class SolidLaw:
 class Nodes:
     """The particles, which are the nodes: x, v, a (N, 2) [m, m/s, m/s^2], m (N,) [kg/m], p (N,) [Pa] (mean
     stress), T (N,) [K], and the history projected to them at the last remeshing: S (N, 2, 2), S_zz (N,) [Pa],
-    eps_p (N,), W_p (N,) [J/m^3], J (N,) (the volume ratio); t [s]."""
+    eps_p (N,), W_p (N,) [J/m^3], J (N,) (the volume ratio), eps_dot (N,) [1/s] (the last step's equivalent strain
+    rate); t [s]."""
 
     x: np.ndarray
     v: np.ndarray
@@ -111,6 +112,7 @@ class Nodes:
     eps_p: np.ndarray
     W_p: np.ndarray
     J: np.ndarray
+    eps_dot: np.ndarray
     t: float = 0.0
 
     @property
@@ -120,13 +122,18 @@ class Nodes:
 
 @dataclass
 class History:
-    """Per triangle, at the start of the step: S (M, 2, 2), S_zz, eps_p, W_p, J (M,)."""
+    """Per triangle, at the start of the step: S (M, 2, 2), S_zz, eps_p, W_p, J (M,); ``eps_dot`` (M,) [1/s] the
+    equivalent strain rate of the previous step, or None. Given, the return map takes the yield stress at that
+    rate (lagged one step) instead of at the step's own: sigma_y(eps_dot) with eps_dot = |dev d| / dt has a cone
+    point at d = 0 (its derivative ~ C sigma_y / |d|), on which Newton-Raphson stalls wherever a flowing element
+    unloads; lagged, the step is smooth (the staggered treatment of the rate, stated in chapter 12)."""
 
     S: np.ndarray
     S_zz: np.ndarray
     eps_p: np.ndarray
     W_p: np.ndarray
     J: np.ndarray
+    eps_dot: np.ndarray | None = None
 
 
 @dataclass
@@ -167,7 +174,7 @@ def make_nodes(x: np.ndarray, m: np.ndarray, T: np.ndarray | float) -> Nodes:
     z = np.zeros(n)
     return Nodes(x=x.copy(), v=np.zeros((n, 2)), a=np.zeros((n, 2)), m=np.asarray(m, dtype=float).copy(),
                  p=z.copy(), T=np.broadcast_to(np.asarray(T, dtype=float), (n,)).copy(), S=np.zeros((n, 2, 2)),
-                 S_zz=z.copy(), eps_p=z.copy(), W_p=z.copy(), J=np.ones(n))
+                 S_zz=z.copy(), eps_p=z.copy(), W_p=z.copy(), J=np.ones(n), eps_dot=z.copy())
 
 
 def volumetric_pressure(J: np.ndarray, T: np.ndarray, law: SolidLaw, lnJ: np.ndarray | None = None) -> np.ndarray:
@@ -198,10 +205,11 @@ def element_response(xe: np.ndarray, due: np.ndarray, hist: History, Te: np.ndar
     S_trial = np.einsum("mik,mkl,mjl->mij", Q, hist.S, Q) + 2.0 * law.G * dev
     S_zz_trial = hist.S_zz + 2.0 * law.G * dev_zz
     eps_dot = np.sqrt(np.maximum(2.0 / 3.0 * (np.einsum("mij,mij->m", dev, dev) + dev_zz * dev_zz), 0.0)) / dt
-    S_new, S_zz_new, d_eps_p, d_w_p = law.strength.return_map(S_trial, S_zz_trial, hist.eps_p, eps_dot, Te, law.G)
+    rate = eps_dot if hist.eps_dot is None else hist.eps_dot
+    S_new, S_zz_new, d_eps_p, d_w_p = law.strength.return_map(S_trial, S_zz_trial, hist.eps_p, rate, Te, law.G)
     J = hist.J * (1.0 + dJ)
     lnJ = np.log(hist.J) + np.log1p(dJ)                          # no cancellation at small strains
-    return dict(S=S_new, S_zz=S_zz_new, d_eps_p=d_eps_p, d_w_p=d_w_p, J=J,
+    return dict(S=S_new, S_zz=S_zz_new, d_eps_p=d_eps_p, d_w_p=d_w_p, J=J, eps_dot=eps_dot,
                 p_hat=volumetric_pressure(J, Te, law, lnJ), grad=g_end, area=A_end)
 
 
@@ -287,26 +295,27 @@ def newton_step(nodes: Nodes, mesh: Mesh, hist: History, law: SolidLaw, dt: floa
     p[~meshed] = 0.0
     fix = np.concatenate([fixed.ravel(), ~meshed])
     f_ext = np.zeros(2 * n) if loads.f_ext is None else np.asarray(loads.f_ext, dtype=float).ravel()
-    history, step = [], None
+    history = []
+
+    def evaluate(du, p, tangent):
+        return _residual(nodes, mesh, hist, law, du, p, dt, dynamic, f_ext, loads.contact, tangent)
+
+    def norms(R, scale):
+        R_free = np.where(fix, 0.0, R)
+        return R_free, (float(np.linalg.norm(R_free[:2 * n])) / scale[0], float(np.linalg.norm(R_free[2 * n:]))
+                        / scale[1])
+
+    R, Kg, resp, scale, fc = evaluate(du, p, True)
     for _ in range(max_iter + 1):
-        R, Kg, resp, scale, fc = _residual(nodes, mesh, hist, law, du, p, dt, dynamic, f_ext, loads.contact)
-        if step is not None and not np.all(np.isfinite(R)):       # an inverted triangle: halve the last correction
-            for _ in range(8):
-                step = 0.5 * step
-                du, p = du - step[:2 * n].reshape(n, 2), p - step[2 * n:]
-                R, Kg, resp, scale, fc = _residual(nodes, mesh, hist, law, du, p, dt, dynamic, f_ext, loads.contact)
-                if np.all(np.isfinite(R)):
-                    break
         lift = np.zeros(3 * n)
         lift[:2 * n] = target - du.ravel()                        # the prescribed part of the correction
         lift[~fix] = 0.0
-        R_free = np.where(fix, 0.0, R)
-        res_u = float(np.linalg.norm(R_free[:2 * n])) / max(scale[0], np.finfo(float).tiny)
-        res_p = float(np.linalg.norm(R_free[2 * n:])) / scale[1]
+        R_free, (res_u, res_p) = norms(R, scale)
         history.append((res_u, res_p))
         if res_u < tol and res_p < tol and not np.any(lift):
             return StepResult(du=du, p=p, history=History(resp["S"], resp["S_zz"], hist.eps_p + resp["d_eps_p"],
-                                                           hist.W_p + resp["d_w_p"], resp["J"]),
+                                                           hist.W_p + resp["d_w_p"], resp["J"],
+                                                           None if hist.eps_dot is None else resp["eps_dot"]),
                               d_eps_p=resp["d_eps_p"], d_w_p=resp["d_w_p"], area=resp["area"], residuals=history,
                               contact_force=fc)
         if not np.all(np.isfinite(R)):
@@ -316,23 +325,35 @@ def newton_step(nodes: Nodes, mesh: Mesh, hist: History, law: SolidLaw, dt: floa
         step = spsolve(Kf, -(R_free + keep @ (Kg @ lift))) + lift
         if not np.all(np.isfinite(step)):
             break
-        du = du + step[:2 * n].reshape(n, 2)
-        p = p + step[2 * n:]
-    raise NewtonFailed(f"Newton-Raphson did not converge in {max_iter} iterations (residuals {history[-3:]})")
+        merit, s = res_u**2 + res_p**2, 1.0                       # backtracking on the scaled residual (a contact
+        for _ls in range(12):                                     # that switches on and off, an inverted triangle)
+            trial = evaluate(du + s * step[:2 * n].reshape(n, 2), p + s * step[2 * n:], False)
+            t_norm = norms(trial[0], scale)[1]
+            if np.all(np.isfinite(trial[0])) and (np.any(lift) or t_norm[0]**2 + t_norm[1]**2
+                                                  <= (1.0 - 1e-4 * s) * merit):
+                break
+            s *= 0.5
+        du, p = du + s * step[:2 * n].reshape(n, 2), p + s * step[2 * n:]
+        R, Kg, resp, scale, fc = evaluate(du, p, True)
+    raise NewtonFailed(f"Newton-Raphson did not converge in {max_iter} iterations (residuals {history[-3:]})",
+                       history)
 
 
-def _residual(nodes, mesh, hist, law, du, p, dt, dynamic, f_ext, contact):
+def _residual(nodes, mesh, hist, law, du, p, dt, dynamic, f_ext, contact, tangent=True):
     """assemble() with the nodal forces and the contact (its force and stiffness) added."""
     n = nodes.n
-    with np.errstate(invalid="ignore", divide="ignore"):
-        R, Kg, resp, scale = assemble(nodes, mesh, hist, law, du, p, dt, dynamic)
+    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+        R, Kg, resp, scale = assemble(nodes, mesh, hist, law, du, p, dt, dynamic, tangent)
     R[:2 * n] -= f_ext
-    scale = (float(np.hypot(scale[0], np.linalg.norm(f_ext))), scale[1])
+    floor = 1e-8 * law.G * float(np.sqrt(np.sum(np.abs(resp["area"]))))   # a stress of 1e-8 G over the body
+    scale = (float(np.sqrt(scale[0] ** 2 + np.sum(f_ext**2) + floor**2)), scale[1])
     fc = None
     if contact is not None:
         fc, kc = contact(nodes.x + du)
         R[:2 * n] -= fc.ravel()
-        Kg = Kg - sp.block_diag([sp.block_diag(list(kc)), sp.csr_matrix((n, n))], format="csr")
+        scale = (float(np.hypot(scale[0], np.linalg.norm(fc))), scale[1])
+        if Kg is not None:
+            Kg = Kg - sp.block_diag([sp.block_diag(list(kc)), sp.csr_matrix((n, n))], format="csr")
     return R, Kg, resp, scale, fc
 
 
@@ -362,4 +383,4 @@ def history_from_nodes(nodes: Nodes, mesh: Mesh) -> History:
     """Each triangle's history as the mean of its three nodes' (after a remeshing)."""
     t = mesh.tri
     return History(S=nodes.S[t].mean(axis=1), S_zz=nodes.S_zz[t].mean(axis=1), eps_p=nodes.eps_p[t].mean(axis=1),
-                   W_p=nodes.W_p[t].mean(axis=1), J=nodes.J[t].mean(axis=1))
+                   W_p=nodes.W_p[t].mean(axis=1), J=nodes.J[t].mean(axis=1), eps_dot=nodes.eps_dot[t].mean(axis=1))

@@ -1,0 +1,101 @@
+"""Tool contact in the PFEM, as an implicit method does it (issue 24): the gap to the tool's exact boundary enforced
+inside the Newton-Raphson iterations by a penalty, Coulomb friction mu(T) by a return map.
+
+The paper (Section 2.3) does not say how its PFEM enforces contact; refsph takes the penalty form standard in
+implicit codes (Wriggers, "Computational Contact Mechanics", 2nd ed. 2006, Sections 5.2 and 6.2; the rigid tool
+is refsph's exact :class:`refsph.penalty.RoundedPolygon`, the same boundary the SPH penalty contact uses). For a
+boundary node i with penetration g_i > 0 (inside the tool), outward tool normal n_i and tangent t_i (n rotated by
++90 deg), tributary boundary length l_i (half its two boundary edges):
+
+    f_N,i   = k_N l_i g_i                                               normal force on the node  [N/m]
+    f_T,i*  = f_T,i^n - k_T l_i s_i                                     trial (stick) tangential force
+              s_i = ((x_i - x_i^n) - du_tool) . t_i                     the step's slip relative to the tool
+    f_T,i   = f_T,i*                            if |f_T,i*| <= mu(T_i) f_N,i      (stick)
+            = mu(T_i) f_N,i sign(f_T,i*)        otherwise                         (slip: the return map)
+    f_i     = f_N,i n_i + f_T,i t_i,            the force on the tool: -sum_i f_i
+
+k_N, k_T [Pa/m] are penalties per unit penetration and per unit length of boundary; a few hundred times G / h
+keeps the penetration below 1 % of the spacing. mu(T) is :class:`refsph.contact.CoulombFriction` (the second
+paper's Eqs. (10)-(11)) at the node's temperature of the last heat step (the staggered scheme of Section 2.3.3).
+The Newton matrix gets each node's 2 x 2 derivative df_i/dx_i (central differences, the force of a node depends on
+its own position only). The frictional heat of the step is |f_T,i| |s_i| on the sliding nodes (Eq. (7) with
+eta = 1 is applied by the caller).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..contact import CoulombFriction
+from ..penalty import RoundedPolygon
+
+__all__ = ["ToolContact", "boundary_lengths", "StepContact"]
+
+
+@dataclass(frozen=True)
+class ToolContact:
+    """The penalty contact's parameters (module text): ``k_normal``, ``k_tangent`` [Pa/m], ``friction`` (None:
+    frictionless). No defaults."""
+
+    k_normal: float
+    k_tangent: float
+    friction: CoulombFriction | None
+
+    def __post_init__(self):
+        for name in ("k_normal", "k_tangent"):
+            v = getattr(self, name)
+            if not (np.isfinite(v) and v > 0):
+                raise ValueError(f"ToolContact.{name} must be a positive penalty [Pa/m], got {v!r}")
+
+
+def boundary_lengths(x: np.ndarray, edges: np.ndarray, n: int) -> np.ndarray:
+    """l_i: half the length of each boundary edge given to both its nodes (0 off the boundary)."""
+    L = np.linalg.norm(x[edges[:, 1]] - x[edges[:, 0]], axis=1)
+    return np.bincount(edges.ravel(), np.repeat(0.5 * L, 2), minlength=n)
+
+
+class StepContact:
+    """The contact of one step (the ``contact`` of :class:`refsph.pfem.solid.Loads`): the tool ``shape`` with its
+    core at ``shift`` (its position at t_{n+1}) having moved by ``du_tool`` in the step, the nodes' positions
+    ``x_n`` and tangential forces ``f_T_n`` (N,) at t_n, their temperatures T and tributary lengths ``length``;
+    ``nodes`` the indices that may touch (the workpiece's boundary). Calling it with x_{n+1} gives (f, df/dx)."""
+
+    def __init__(self, params: ToolContact, shape: RoundedPolygon, shift, du_tool, x_n, f_T_n, T, length, nodes):
+        self.p, self.shape = params, shape
+        self.shift, self.du_tool = np.asarray(shift, dtype=float), np.asarray(du_tool, dtype=float)
+        self.x_n, self.f_T_n, self.T, self.length = x_n, f_T_n, T, length
+        self.nodes = np.asarray(nodes)
+        self.mu = np.zeros(len(x_n)) if params.friction is None else params.friction.mu(T)
+        self.last = None
+
+    def forces(self, x: np.ndarray, idx: np.ndarray) -> dict:
+        """The forces on nodes ``idx`` at positions x (len(idx), 2): f (.., 2), f_N, f_T, slip s, g."""
+        g, n = self.shape.gap(x, self.shift)
+        t = np.stack([-n[:, 1], n[:, 0]], axis=1)
+        on = g > 0
+        li = self.length[idx]
+        fN = np.where(on, self.p.k_normal * li * g, 0.0)
+        s = np.einsum("nd,nd->n", x - self.x_n[idx] - self.du_tool, t)
+        trial = self.f_T_n[idx] - self.p.k_tangent * li * s
+        cap = self.mu[idx] * fN
+        fT = np.where(on, np.clip(trial, -cap, cap), 0.0)
+        return dict(f=fN[:, None] * n + fT[:, None] * t, f_N=fN, f_T=fT, slip=np.where(on, s, 0.0), gap=g)
+
+    def __call__(self, x_new: np.ndarray):
+        N = len(x_new)
+        f, k = np.zeros((N, 2)), np.zeros((N, 2, 2))
+        idx = self.nodes
+        xi = x_new[idx]
+        res = self.forces(xi, idx)
+        f[idx] = res["f"]
+        eps = 1e-7 * np.maximum(self.length[idx], 1e-12)
+        for d in range(2):
+            e = np.zeros_like(xi)
+            e[:, d] = eps
+            k[idx, :, d] = (self.forces(xi + e, idx)["f"] - self.forces(xi - e, idx)["f"]) / (2 * eps[:, None])
+        full = {key: np.zeros(N) for key in ("f_N", "f_T", "slip", "gap")}
+        for key in full:
+            full[key][idx] = res[key]
+        self.last = full
+        return f, k

@@ -252,3 +252,22 @@ def test_tool_contact_sticks_then_slides_at_mu():
     assert abs(ratios[0]) < 1e-9 and 0 < ratios[1] < ratios[2] < 0.3
     assert np.allclose(ratios[3:], 0.3, rtol=1e-12)
     assert np.all(nodes.x[np.isclose(x[:, 1], 0), 0] - x[np.isclose(x[:, 1], 0), 0] > 1e-6)   # it slid
+
+
+def test_transfer_history_keeps_the_kept_triangles_own():
+    """A remeshing that keeps a triangle (the same three nodes, in any order) keeps its history exactly; only new
+    triangles get the nodal average."""
+    rng = np.random.default_rng(5)
+    x = lattice(6, 6, 0, 1e-3, 0, 1e-3) + rng.uniform(-1e-5, 1e-5, (49, 2))
+    old = alpha_shape_mesh(x, 1.5)
+    m = len(old.tri)
+    hist = solid.History(rng.normal(size=(m, 2, 2)), rng.normal(size=m), rng.random(m), rng.random(m),
+                         1 + 0.01 * rng.random(m), rng.random(m))
+    nodes = solid.make_nodes(x, np.ones(len(x)), 293.0)
+    from refsph.pfem.mesh import Mesh
+    new = Mesh(tri=np.concatenate([old.tri[::-1][:, [1, 2, 0]][:-3], old.tri[:3][:, [0, 2, 1]]]), edges=old.edges,
+               boundary=old.boundary)
+    out = solid.transfer_history(old, hist, new, nodes)
+    src = np.concatenate([np.arange(m)[::-1][:-3], np.arange(3)])
+    assert np.array_equal(out.eps_p, hist.eps_p[src]) and np.array_equal(out.S, hist.S[src])
+    assert np.array_equal(out.eps_dot, hist.eps_dot[src])

@@ -6,7 +6,6 @@ solved by Newton-Raphson (:mod:`.solid`); the heat step is a backward-Euler fini
 (:mod:`.thermal`). The strength laws are the SPH solvers' (:mod:`refsph.strength`).
 
 Status: the mechanics, the heat step and the tool contact with their checks (``tests/test_pfem.py``,
-``tests/test_pfem_thermal.py``); the cutting scene (:mod:`.cutting`) is built but its Newton-Raphson stalls at the
-first tool contact (its module text says why); ``--method pfem``, the heat step in the cut and the 18 PFEM cuts are
-still to come (issue 24).
+``tests/test_pfem_thermal.py``); the cutting scene (:mod:`.cutting`) runs past the first tool contact (its module
+text says how), slowly; ``--method pfem``, the heat step in the cut and the 18 PFEM cuts are still to come.
 """

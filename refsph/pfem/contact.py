@@ -68,19 +68,41 @@ class StepContact:
         self.nodes = np.asarray(nodes)
         self.mu = np.zeros(len(x_n)) if params.friction is None else params.friction.mu(T)
         self.last = None
+        self.active = self.slip = None                         # frozen sets (None: decided by the gap / the cap)
+
+    def freeze(self, x_new: np.ndarray) -> bool:
+        """Fix the contact and slip sets at positions x_new (the active-set strategy: within one Newton-Raphson
+        solve the forces are then smooth); True if the sets changed."""
+        idx = self.nodes
+        saved, self.active, self.slip = (self.active, self.slip), None, None
+        res = self.forces(x_new[idx], idx)
+        active = np.zeros(len(x_new), bool)
+        active[idx] = res["gap"] > 0
+        slip = np.zeros(len(x_new))
+        trial = self.f_T_n[idx] - self.p.k_tangent * self.length[idx] * res["slip_raw"]
+        cap = self.mu[idx] * res["f_N"]
+        slip[idx] = np.where(active[idx] & (np.abs(trial) > cap), np.sign(trial), 0.0)
+        changed = saved[0] is None or not (np.array_equal(saved[0], active) and np.array_equal(saved[1], slip))
+        self.active, self.slip = active, slip
+        return changed
 
     def forces(self, x: np.ndarray, idx: np.ndarray) -> dict:
         """The forces on nodes ``idx`` at positions x (len(idx), 2): f (.., 2), f_N, f_T, slip s, g."""
         g, n = self.shape.gap(x, self.shift)
         t = np.stack([-n[:, 1], n[:, 0]], axis=1)
-        on = g > 0
+        on = g > 0 if self.active is None else self.active[idx]
         li = self.length[idx]
         fN = np.where(on, self.p.k_normal * li * g, 0.0)
         s = np.einsum("nd,nd->n", x - self.x_n[idx] - self.du_tool, t)
         trial = self.f_T_n[idx] - self.p.k_tangent * li * s
         cap = self.mu[idx] * fN
-        fT = np.where(on, np.clip(trial, -cap, cap), 0.0)
-        return dict(f=fN[:, None] * n + fT[:, None] * t, f_N=fN, f_T=fT, slip=np.where(on, s, 0.0), gap=g)
+        if self.slip is None:
+            fT = np.where(on, np.clip(trial, -cap, cap), 0.0)
+        else:
+            sl = self.slip[idx]
+            fT = np.where(on, np.where(sl != 0, sl * cap, trial), 0.0)
+        return dict(f=fN[:, None] * n + fT[:, None] * t, f_N=fN, f_T=fT, slip=np.where(on, s, 0.0), gap=g,
+                    slip_raw=s)
 
     def __call__(self, x_new: np.ndarray):
         N = len(x_new)
@@ -95,6 +117,7 @@ class StepContact:
             e[:, d] = eps
             k[idx, :, d] = (self.forces(xi + e, idx)["f"] - self.forces(xi - e, idx)["f"]) / (2 * eps[:, None])
         full = {key: np.zeros(N) for key in ("f_N", "f_T", "slip", "gap")}
+        full["gap"][:] = -np.inf
         for key in full:
             full[key][idx] = res[key]
         self.last = full

@@ -14,14 +14,12 @@ on); the history goes to the nodes and the nodes are meshed again (remeshing eve
 is retried at half the step (up to four times). dt = ``courant`` dx / v_c: the tool moves a fraction of the finest
 spacing per step (the mesh, not stability, limits it).
 
-**Status (open, issue 24): Newton-Raphson stalls at the first tool contact.** At t_u/5 (case 1) the first steps
-converge (9-25 iterations with the line search), then a step stalls at a scaled residual ~0.3 however small dt is:
-the remeshed state is out of balance by O(1) (the history averaged to the nodes and back, the contact force on a
-single node: the tool's 10 um edge is smaller than the spacing, so one node carries the tool's whole load), and
-the residual is strongly non-smooth there (the contact switching, the yield surface). The tangent is exact
-(checked by directional differences), so the remedy lies in the formulation (a contact on segments rather than
-nodes, history kept per node without the averaging, or smaller penalty with augmentation), not the solver.
-A flat contact with friction works (``tests/test_pfem.py``: stick, then slide at F_T / F_N = mu to round-off).
+**Status (issue 24): the first tool contact is passed, the 18 cuts are not yet run.** Newton-Raphson had stalled
+at the first contact (at a scaled residual ~0.3, however small the step): the trapezoidal rule's velocities ring
+at an impact, and the predictor du = dt v drove the contact nodes deep into the tool. Each step now starts from
+du = 0 and freezes the contact and slip sets within a Newton solve (:func:`solve_with_active_set`); the quick cut
+(case 1, t_u/5) then goes on past the first contact, at steps halved a few times. A flat contact with friction
+works (``tests/test_pfem.py``: stick, then slide at F_T / F_N = mu to round-off).
 
 The measures are the SPH scene's own functions (:func:`refsph.scenes.thermal_cutting.chip_measures`,
 :func:`~refsph.scenes.thermal_cutting.thermal_cutting_metrics`), so the two methods are measured alike.
@@ -41,7 +39,7 @@ from ..scenes.thermal_cutting import (CLEARANCE_DEG, EDGE_RADIUS, RAKE_DEG, chip
 from .contact import StepContact, ToolContact, boundary_lengths
 from .mesh import alpha_shape_mesh
 from .solid import (Loads, NewtonFailed, SolidLaw, commit, history_from_nodes, make_nodes, newton_step,
-                    project_to_nodes)
+                    project_to_nodes, transfer_history)
 
 __all__ = ["PFEMCut", "graded_workpiece", "pfem_cut", "run_pfem_cut"]
 
@@ -145,7 +143,7 @@ def run_pfem_cut(cut: PFEMCut, progress=None, max_steps: int | None = None) -> d
                                   f_T, nodes.T, boundary_lengths(nodes.x, mesh.edges, nodes.n),
                                   np.flatnonzero(mesh.boundary))
             try:
-                r = newton_step(nodes, mesh, hist_e, law, dt, Loads(cut.fixed, zero, contact=contact), dynamic=True)
+                r = solve_with_active_set(nodes, mesh, hist_e, law, dt, Loads(cut.fixed, zero, contact=contact))
                 break
             except NewtonFailed as e:
                 dt, retries = 0.5 * dt, retries + 1
@@ -165,8 +163,8 @@ def run_pfem_cut(cut: PFEMCut, progress=None, max_steps: int | None = None) -> d
         for name in ("S", "S_zz", "eps_p", "W_p", "J", "eps_dot"):
             setattr(nodes, name, project_to_nodes(mesh, r.area, getattr(r.history, name), nodes.n))
         if remesh_needed(nodes.x, mesh, cut.remesh_quality) or step % cut.remesh_every == cut.remesh_every - 1:
-            mesh = alpha_shape_mesh(nodes.x, cut.alpha, cut.h)           # Algorithm 1: "if remeshing is needed"
-            hist_e = history_from_nodes(nodes, mesh)
+            new = alpha_shape_mesh(nodes.x, cut.alpha, cut.h)            # Algorithm 1: "if remeshing is needed"
+            hist_e, mesh = transfer_history(mesh, r.history, new, nodes), new
             remeshes += 1
         else:
             hist_e = r.history
@@ -183,6 +181,20 @@ def run_pfem_cut(cut: PFEMCut, progress=None, max_steps: int | None = None) -> d
     metrics = thermal_cutting_metrics(hist, info, cut.t_end)
     return dict(nodes=nodes, mesh=mesh, history=hist, metrics=metrics, newton_iterations=iters, retries=retries,
                 wall_time_s=time.perf_counter() - t0, steps=step, remeshes=remeshes)
+
+
+def solve_with_active_set(nodes, mesh, hist, law, dt, loads, max_outer: int = 8):
+    """Newton-Raphson with the contact and slip sets frozen (:meth:`refsph.pfem.contact.StepContact.freeze`): set
+    from the predictor, solved, set again from the solution, until the sets stop changing (the active-set strategy,
+    Wriggers 2006, Section 6.3); then the solution satisfies the unfrozen contact law too."""
+    c = loads.contact
+    c.freeze(nodes.x)
+    for _ in range(max_outer):
+        r = newton_step(nodes, mesh, hist, law, dt, loads, dynamic=True, predictor=False)
+        if not c.freeze(nodes.x + r.du):
+            c.active = c.slip = None
+            return newton_step(nodes, mesh, hist, law, dt, loads, dynamic=True, predictor=False)   # unfrozen law
+    raise NewtonFailed(f"the contact's active set kept changing over {max_outer} solves", [])
 
 
 def triangle_quality(x: np.ndarray, tri: np.ndarray) -> np.ndarray:

@@ -29,8 +29,9 @@ import numpy as np
 
 from ..contact import CoulombFriction
 from ..penalty import RoundedPolygon
+from .solid import NewtonFailed, newton_step
 
-__all__ = ["ToolContact", "boundary_lengths", "StepContact"]
+__all__ = ["ToolContact", "boundary_lengths", "StepContact", "solve_with_active_set"]
 
 
 @dataclass(frozen=True)
@@ -122,3 +123,19 @@ class StepContact:
             full[key][idx] = res[key]
         self.last = full
         return f, k
+
+
+def solve_with_active_set(nodes, mesh, hist, law, dt, loads, max_outer: int = 8):
+    """Newton-Raphson with the contact and slip sets frozen (:meth:`StepContact.freeze`): set at the step's start
+    (each solve starts from du = 0: the trapezoidal rule's velocities ring at an impact, and the predictor dt v
+    would drive the contact nodes deep into the tool), solved, set again from the solution, until the sets stop
+    changing (the active-set strategy, Wriggers 2006, Section 6.3); then a last solve with the sets free checks
+    that the solution satisfies the contact law itself."""
+    c = loads.contact
+    c.freeze(nodes.x)
+    for _ in range(max_outer):
+        r = newton_step(nodes, mesh, hist, law, dt, loads, dynamic=True, predictor=False)
+        if not c.freeze(nodes.x + r.du):
+            c.active = c.slip = None
+            return newton_step(nodes, mesh, hist, law, dt, loads, dynamic=True, predictor=False)   # unfrozen law
+    raise NewtonFailed(f"the contact's active set kept changing over {max_outer} solves", [])

@@ -28,7 +28,7 @@ from scipy.spatial import Delaunay, cKDTree
 
 from ..surface import circumradius
 
-__all__ = ["Mesh", "nodal_spacing", "alpha_shape_mesh", "boundary_edges", "signed_areas"]
+__all__ = ["Mesh", "nodal_spacing", "alpha_shape_mesh", "boundary_edges", "signed_areas", "triangle_quality"]
 
 
 @dataclass
@@ -96,3 +96,11 @@ def alpha_shape_mesh(x: np.ndarray, alpha: float | None, h: np.ndarray | None = 
     boundary = np.zeros(len(x), dtype=bool)
     boundary[edges.ravel()] = True
     return Mesh(tri=tri, edges=edges, boundary=boundary, alpha=alpha)
+
+
+def triangle_quality(x: np.ndarray, tri: np.ndarray) -> np.ndarray:
+    """q = 4 sqrt(3) A / (sum of the squared edges): 1 for an equilateral triangle, 0 for a flat one, < 0 inverted."""
+    a, b, c = x[tri[:, 0]], x[tri[:, 1]], x[tri[:, 2]]
+    A = 0.5 * ((b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (b[:, 1] - a[:, 1]) * (c[:, 0] - a[:, 0]))
+    e2 = np.sum((b - a) ** 2, axis=1) + np.sum((c - b) ** 2, axis=1) + np.sum((a - c) ** 2, axis=1)
+    return 4.0 * np.sqrt(3.0) * A / e2

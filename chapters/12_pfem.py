@@ -37,7 +37,7 @@ import numpy as np
 from scipy.spatial import Delaunay
 from refsph.paper_data import AISI1045_RLA, rla_cutting_case
 from refsph.pfem import solid
-from refsph.pfem.mesh import alpha_shape_mesh
+from refsph.pfem.mesh import alpha_shape_mesh, topology as mesh_topology
 from refsph.teaching.notebook import chapter
 ch = chapter("12_pfem")
 
@@ -102,19 +102,13 @@ print(f"plain loop = refsph.pfem.mesh.alpha_shape_mesh for alpha = None, 1.4, 0.
 # mesh has vertices − edges + triangles = bodies − holes) and of triangles inside the notch.
 
 # %%
-from scipy.sparse import coo_matrix
-from scipy.sparse.csgraph import connected_components
 
 
 def topology(x, mesh):
-    used = np.unique(mesh.tri)
-    e = np.unique(np.sort(np.concatenate([mesh.tri[:, [0, 1]], mesh.tri[:, [1, 2]], mesh.tri[:, [2, 0]]]), axis=1),
-                  axis=0)
-    label = connected_components(coo_matrix((np.ones(len(e)), tuple(e.T)), shape=(len(x),) * 2), directed=False)[1]
-    bodies = len(np.unique(label[used]))
+    bodies, holes = mesh_topology(len(x), mesh.tri)
     c = x[mesh.tri].mean(axis=1)
     notch = int(np.sum((c[:, 0] > 3.2) & (c[:, 0] < 6.8) & (c[:, 1] > 2.5)))
-    return dict(bodies=bodies, holes=bodies - (len(used) - len(e) + len(mesh.tri)), notch=notch, n_tri=len(mesh.tri))
+    return dict(bodies=bodies, holes=holes, notch=notch, n_tri=len(mesh.tri))
 
 
 ALPHAS = (None, 2.0, 1.4, 0.8)
@@ -296,14 +290,21 @@ assert patch_u < 1e-12 and patch_p < 1e-11
 from unittest import mock
 
 
-def cantilever(ny, nu, stabilised=True, L=10.0, H=1.0, P=5e5):
-    """(deflection / Timoshenko, max |p - p_exact| / max |p_exact| away from the ends, x, mesh, p)."""
+def tip_loaded_beam(ny, L, H, P):
+    """The beam's nodes (ny elements deep), its mesh, the tip nodes and the parabolic tip shear load P [N/m] on
+    them (trapezoid weights)."""
     x = grid(int(ny * L / H), ny, 0, L, -H / 2, H / 2)
     mesh = alpha_shape_mesh(x, None)
     tip = np.isclose(x[:, 0], L)
     w = (1 - 4 * x[tip, 1] ** 2 / H**2) * np.where(np.isclose(np.abs(x[tip, 1]), H / 2), 0.5, 1.0)
     f = np.zeros((len(x), 2))
     f[tip, 1] = -P * w / w.sum()
+    return x, mesh, tip, f
+
+
+def cantilever(ny, nu, stabilised=True, L=10.0, H=1.0, P=5e5):
+    """(deflection / Timoshenko, max |p - p_exact| / max |p_exact| away from the ends, x, mesh, p)."""
+    x, mesh, tip, f = tip_loaded_beam(ny, L, H, P)
     law = solid.SolidLaw(rho0=7800.0, G=E / (2 * (1 + nu)), K=E / (3 * (1 - 2 * nu)), alpha_T=0.0, T_ref=293.0,
                          strength=Elastic())
     loads = solid.Loads(fixed=np.repeat((x[:, 0] == 0)[:, None], 2, axis=1), du_fixed=np.zeros_like(x), f_ext=f)
@@ -536,12 +537,7 @@ def held_cantilever(ny, steps, transfer, L=10.0, H=1.0, P=5e5, nu=0.3):
     """Tip deflection / Timoshenko after each of `steps` quasi-static steps under a constant tip load, remeshed
     after every step with the history moved by `transfer` (None: never remeshed), and the peak bending stress
     |s_xx| that each remeshing keeps (a fraction)."""
-    x = grid(int(ny * L / H), ny, 0, L, -H / 2, H / 2)
-    mesh = alpha_shape_mesh(x, None)
-    tip = np.isclose(x[:, 0], L)
-    w = (1 - 4 * x[tip, 1] ** 2 / H**2) * np.where(np.isclose(np.abs(x[tip, 1]), H / 2), 0.5, 1.0)
-    f = np.zeros((len(x), 2))
-    f[tip, 1] = -P * w / w.sum()
+    x, mesh, tip, f = tip_loaded_beam(ny, L, H, P)
     loads = solid.Loads(fixed=np.repeat((x[:, 0] == 0)[:, None], 2, axis=1), du_fixed=np.zeros_like(x), f_ext=f)
     law = solid.SolidLaw(rho0=7800.0, G=E / (2 * (1 + nu)), K=E / (3 * (1 - 2 * nu)), alpha_T=0.0, T_ref=293.0,
                          strength=Elastic())

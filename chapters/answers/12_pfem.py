@@ -18,12 +18,10 @@
 from unittest import mock
 
 import numpy as np
-from scipy.sparse import coo_matrix
-from scipy.sparse.csgraph import connected_components
 
 from refsph.pfem import solid, thermal
 from refsph.pfem.element import ppp_stabilisation
-from refsph.pfem.mesh import alpha_shape_mesh
+from refsph.pfem.mesh import alpha_shape_mesh, topology as mesh_topology
 from refsph.paper_data import AISI1045_RLA
 from refsph.strength import Elastic
 
@@ -45,14 +43,10 @@ def chapter_points():
 
 
 def topology(x, mesh):
-    used = np.unique(mesh.tri)
-    e = np.unique(np.sort(np.concatenate([mesh.tri[:, [0, 1]], mesh.tri[:, [1, 2]], mesh.tri[:, [2, 0]]]), axis=1),
-                  axis=0)
-    label = connected_components(coo_matrix((np.ones(len(e)), tuple(e.T)), shape=(len(x),) * 2), directed=False)[1]
-    bodies = len(np.unique(label[used]))
+    bodies, holes = mesh_topology(len(x), mesh.tri)
     c = x[mesh.tri].mean(axis=1)
     notch = int(np.sum((c[:, 0] > 3.2) & (c[:, 0] < 6.8) & (c[:, 1] > 2.5)))
-    return dict(bodies=bodies, holes=bodies - (len(used) - len(e) + len(mesh.tri)), notch=notch)
+    return dict(bodies=bodies, holes=holes, notch=notch)
 
 
 def answer_1():

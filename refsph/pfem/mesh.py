@@ -24,11 +24,14 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.sparse import coo_matrix
+from scipy.sparse.csgraph import connected_components
 from scipy.spatial import Delaunay, cKDTree
 
 from ..surface import circumradius
 
-__all__ = ["Mesh", "nodal_spacing", "alpha_shape_mesh", "boundary_edges", "signed_areas", "triangle_quality"]
+__all__ = ["Mesh", "nodal_spacing", "alpha_shape_mesh", "boundary_edges", "signed_areas", "triangle_quality",
+           "topology"]
 
 
 @dataclass
@@ -104,3 +107,14 @@ def triangle_quality(x: np.ndarray, tri: np.ndarray) -> np.ndarray:
     A = 0.5 * ((b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (b[:, 1] - a[:, 1]) * (c[:, 0] - a[:, 0]))
     e2 = np.sum((b - a) ** 2, axis=1) + np.sum((c - b) ** 2, axis=1) + np.sum((a - c) ** 2, axis=1)
     return 4.0 * np.sqrt(3.0) * A / e2
+
+
+def topology(n: int, tri: np.ndarray) -> tuple[int, int]:
+    """(bodies, holes) of a triangle mesh of n nodes: the connected pieces, and the holes from Euler's formula
+    V - E + F = bodies - holes (F the triangles, V the nodes they use, E their edges)."""
+    used = np.unique(tri)
+    e = np.unique(np.sort(np.concatenate([tri[:, [0, 1]], tri[:, [1, 2]], tri[:, [2, 0]]]), axis=1), axis=0)
+    label = connected_components(coo_matrix((np.ones(len(e)), tuple(e.T)), shape=(n, n)), directed=False)[1]
+    bodies = len(np.unique(label[used]))
+    return bodies, bodies - (len(used) - len(e) + len(tri))
+

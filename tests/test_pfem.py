@@ -271,3 +271,25 @@ def test_transfer_history_keeps_the_kept_triangles_own():
     src = np.concatenate([np.arange(m)[::-1][:-3], np.arange(3)])
     assert np.array_equal(out.eps_p, hist.eps_p[src]) and np.array_equal(out.S, hist.S[src])
     assert np.array_equal(out.eps_dot, hist.eps_dot[src])
+
+
+def test_newmark_trapezoidal_keeps_and_damped_rule_takes_the_energy_of_an_oscillator():
+    """x'' = -w^2 x by Newmark's rule (the same formulas as the solid's): the trapezoidal rule (Eq. (21)) keeps the
+    amplitude, gamma = 0.7 damps a mode at w dt = 1 strongly; unstable parameters are refused."""
+    w, dt = 1.0, 1.0
+    amp = {}
+    for nm in (solid.TRAPEZOIDAL, solid.Newmark((0.7 + 0.5) ** 2 / 4, 0.7)):
+        x, v, a = 1.0, 0.0, -1.0
+        for _ in range(200):
+            # a_{n+1} = -w^2 (x + du) with a_{n+1} = (du - dt v - dt^2 (1/2 - beta) a) / (beta dt^2): linear in du
+            du = (dt * v + dt * dt * (0.5 - nm.beta) * a - nm.beta * dt * dt * w * w * x) / (1 + nm.beta * (w * dt)**2)
+            a_new = nm.acceleration(du, v, a, dt)
+            assert abs(a_new + w * w * (x + du)) < 1e-12
+            v = v + dt * ((1 - nm.gamma) * a + nm.gamma * a_new)
+            x, a = x + du, a_new
+        amp[nm.gamma] = np.hypot(x, v / w)
+    assert abs(amp[0.5] - 1.0) < 1e-10 and amp[0.7] < 1e-3
+    assert np.array_equal(solid.newmark_of(True).acceleration(np.ones(2), np.ones(2), np.ones(2), 0.5),
+                          4.0 / 0.25 * (np.ones(2) - 0.5) - 1.0)
+    with pytest.raises(ValueError, match="unconditionally stable"):
+        solid.Newmark(0.25, 0.7)

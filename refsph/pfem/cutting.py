@@ -40,8 +40,8 @@ from ..scenes.thermal_cutting import (CLEARANCE_DEG, EDGE_RADIUS, RAKE_DEG, chip
                                       tool_shape)
 from .contact import StepContact, ToolContact, boundary_lengths, solve_with_active_set
 from .mesh import alpha_shape_mesh, triangle_quality
-from .solid import (Loads, NewtonFailed, SolidLaw, commit, history_from_nodes, make_nodes, project_to_nodes,
-                    transfer_history)
+from .solid import (TRAPEZOIDAL, Loads, Newmark, NewtonFailed, SolidLaw, commit, history_from_nodes, make_nodes,
+                    project_to_nodes, transfer_history)
 
 __all__ = ["PFEMCut", "graded_workpiece", "pfem_cut", "run_pfem_cut"]
 
@@ -54,7 +54,8 @@ class PFEMCut:
     alpha-shape's local size), the held components ``fixed`` (N, 2), the ``law``, the tool (``shape``, its core's
     position ``shift0`` at t = 0 and velocity ``v_tool`` [m/s]), the ``contact``, ``alpha``, the step ``dt`` and
     ``t_end`` [s], the initial positions ``X0`` and ``info`` (the SPH scene's keys, for the measures); a remeshing
-    every ``remesh_every`` steps and whenever a triangle's quality drops below ``remesh_quality``."""
+    every ``remesh_every`` steps and whenever a triangle's quality drops below ``remesh_quality``; ``newmark`` the
+    time rule (the paper's trapezoidal rule by default)."""
 
     nodes: object
     h: np.ndarray
@@ -71,6 +72,7 @@ class PFEMCut:
     info: dict = field(default_factory=dict)
     remesh_every: int = 1
     remesh_quality: float = 0.3
+    newmark: Newmark = TRAPEZOIDAL
 
 
 def graded_workpiece(length: float, tu: float, dx: float) -> tuple[np.ndarray, np.ndarray]:
@@ -145,7 +147,8 @@ def run_pfem_cut(cut: PFEMCut, progress=None, max_steps: int | None = None) -> d
                                   f_T, nodes.T, boundary_lengths(nodes.x, mesh.edges, nodes.n),
                                   np.flatnonzero(mesh.boundary))
             try:
-                r = solve_with_active_set(nodes, mesh, hist_e, law, dt, Loads(cut.fixed, zero, contact=contact))
+                r = solve_with_active_set(nodes, mesh, hist_e, law, dt, Loads(cut.fixed, zero, contact=contact),
+                                          dynamic=cut.newmark)
                 break
             except NewtonFailed as e:
                 dt, retries = 0.5 * dt, retries + 1
@@ -154,7 +157,7 @@ def run_pfem_cut(cut: PFEMCut, progress=None, max_steps: int | None = None) -> d
             raise NewtonFailed(f"PFEM cut: Newton failed at t = {nodes.t:.3e} s even at dt = {dt:.2e} s",
                                *last_failure.args[1:])
         iters.append(r.iterations)
-        nodes = commit(nodes, r, dt)
+        nodes = commit(nodes, r, dt, cut.newmark)
         c = contact.last
         f_T = c["f_T"]
         F_tool = -r.contact_force.sum(axis=0) if r.contact_force is not None else np.zeros(2)

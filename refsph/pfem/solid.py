@@ -57,7 +57,8 @@ from .mesh import Mesh
 
 __all__ = ["SolidLaw", "Nodes", "History", "Loads", "StepResult", "element_response", "element_residual",
            "volumetric_pressure", "assemble", "newton_step", "commit", "project_to_nodes", "history_from_nodes",
-           "make_nodes", "NewtonFailed", "transfer_history"]
+           "make_nodes", "NewtonFailed", "transfer_history", "Newmark", "TRAPEZOIDAL",
+           "newmark_of"]
 
 
 class NewtonFailed(RuntimeError):
@@ -169,6 +170,34 @@ class StepResult:
         return len(self.residuals) - 1
 
 
+@dataclass(frozen=True)
+class Newmark:
+    """Newmark's rule (beta, gamma): a_{n+1} = (du - dt v_n - dt^2 (1/2 - beta) a_n) / (beta dt^2),
+    v_{n+1} = v_n + dt ((1 - gamma) a_n + gamma a_{n+1}). beta = 1/4, gamma = 1/2 is the paper's trapezoidal rule
+    (Eq. (21): it damps nothing); gamma > 1/2 with beta = (gamma + 1/2)^2 / 4 damps the high frequencies (an
+    impact's ringing) at first-order accuracy. ``dynamic=True`` in the functions below is the trapezoidal rule."""
+
+    beta: float
+    gamma: float
+
+    def __post_init__(self):
+        if not (0.0 < self.beta <= 0.5 and 0.5 <= self.gamma <= 1.0 and self.beta >= 0.25 * (self.gamma + 0.5) ** 2
+                - 1e-12):
+            raise ValueError(f"Newmark(beta, gamma) must be unconditionally stable: 1/2 <= gamma <= 1, "
+                             f"(gamma + 1/2)^2 / 4 <= beta <= 1/2; got {self.beta!r}, {self.gamma!r}")
+
+    def acceleration(self, du, v, a, dt):
+        return (du - dt * v - dt * dt * (0.5 - self.beta) * a) / (self.beta * dt * dt)
+
+
+TRAPEZOIDAL = Newmark(0.25, 0.5)
+
+
+def newmark_of(dynamic) -> Newmark:
+    """The rule a ``dynamic`` argument names: True -> the trapezoidal rule, a :class:`Newmark` -> itself."""
+    return dynamic if isinstance(dynamic, Newmark) else TRAPEZOIDAL
+
+
 def make_nodes(x: np.ndarray, m: np.ndarray, T: np.ndarray | float) -> Nodes:
     """Nodes at rest and stress free at positions x (N, 2) with masses m (N,) and temperature T."""
     x = np.asarray(x, dtype=float)
@@ -267,7 +296,8 @@ def assemble(nodes: Nodes, mesh: Mesh, hist: History, law: SolidLaw, du: np.ndar
     scale_p = np.linalg.norm(np.bincount(tri.ravel(), (area * (np.abs(resp["p_hat"])[:, None] + np.abs(pe)
                                                                  + 1e-12 * law.G)).ravel() / law.K, minlength=n))
     if dynamic:
-        a_new = 4.0 / dt**2 * (du - dt * nodes.v) - nodes.a                 # Eq. (21)
+        nm = newmark_of(dynamic)
+        a_new = nm.acceleration(du, nodes.v, nodes.a, dt)                  # Eq. (21)
         R[:2 * n] += (nodes.m[:, None] * a_new).ravel()
         scale = scale + np.abs(nodes.m[:, None] * a_new).ravel()
     Kg = None
@@ -277,7 +307,7 @@ def assemble(nodes: Nodes, mesh: Mesh, hist: History, law: SolidLaw, du: np.ndar
         cols = np.tile(dofs, (1, 9)).ravel()
         Kg = sp.coo_matrix((Ke.ravel(), (rows, cols)), shape=(3 * n, 3 * n)).tocsr()
         if dynamic:
-            Kg = Kg + sp.diags(np.concatenate([np.repeat(4.0 * nodes.m / dt**2, 2), np.zeros(n)]))
+            Kg = Kg + sp.diags(np.concatenate([np.repeat(nodes.m / (nm.beta * dt**2), 2), np.zeros(n)]))
     return R, Kg, resp, (float(np.linalg.norm(scale)), float(scale_p))
 
 
@@ -292,7 +322,7 @@ def newton_step(nodes: Nodes, mesh: Mesh, hist: History, law: SolidLaw, dt: floa
     if not dynamic:
         fixed[~meshed] = True
     du = dt * nodes.v + 0.5 * dt * dt * nodes.a if dynamic and predictor else np.zeros((n, 2))
-    target = np.where(fixed, np.where(meshed[:, None] | dynamic, loads.du_fixed, 0.0), du).ravel()
+    target = np.where(fixed, np.where(meshed[:, None] | bool(dynamic), loads.du_fixed, 0.0), du).ravel()
     p = nodes.p.copy()
     p[~meshed] = 0.0
     fix = np.concatenate([fixed.ravel(), ~meshed])
@@ -363,8 +393,9 @@ def _residual(nodes, mesh, hist, law, du, p, dt, dynamic, f_ext, contact, tangen
 def commit(nodes: Nodes, step: StepResult, dt: float, dynamic: bool = True) -> Nodes:
     """The nodes at t_{n+1}: x += du, v and a by Eq. (21) (quasi-static: v = du / dt, a = 0), p."""
     if dynamic:
-        v = 2.0 / dt * step.du - nodes.v
-        a = 4.0 / dt**2 * (step.du - dt * nodes.v) - nodes.a
+        nm = newmark_of(dynamic)
+        a = nm.acceleration(step.du, nodes.v, nodes.a, dt)
+        v = nodes.v + dt * ((1.0 - nm.gamma) * nodes.a + nm.gamma * a)
     else:
         v, a = step.du / dt, np.zeros_like(step.du)
     return replace(nodes, x=nodes.x + step.du, v=v, a=a, p=step.p.copy(), t=nodes.t + dt)

@@ -26,15 +26,16 @@ from ..scenes.taylor import taylor_johnson_cook, taylor_material
 from .contact import StepContact, ToolContact, boundary_lengths, solve_with_active_set
 from .element import shape_gradients
 from .mesh import alpha_shape_mesh, triangle_quality
-from .solid import Loads, SolidLaw, commit, history_from_nodes, make_nodes, project_to_nodes, transfer_history
+from .solid import (TRAPEZOIDAL, Loads, Newmark, SolidLaw, commit, history_from_nodes, make_nodes, project_to_nodes,
+                    transfer_history)
 
 __all__ = ["pfem_taylor_2d"]
 
 
 def pfem_taylor_2d(dp: float, dt: float, t_end: float, alpha: float = 1.4, penalty: float = 50.0,
-                   remesh_quality: float = 0.3, progress=None) -> dict:
-    """The impact to ``t_end`` [s] at step ``dt`` [s]: final length and width [m], the history of both, the
-    mass and the Newton record."""
+                   remesh_quality: float = 0.3, progress=None, newmark: Newmark = TRAPEZOIDAL) -> dict:
+    """The impact to ``t_end`` [s] at step ``dt`` [s] (``newmark``: the time rule): final length and width [m],
+    the history of both, the mass and the Newton record."""
     g = TAYLOR_GEOMETRY
     L, R, v0 = g["length_m"], 0.5 * g["diameter_m"], g["impact_velocity_m_s"]
     nx, ny = max(1, round(R / dp)), max(1, round(L / dp))
@@ -59,8 +60,8 @@ def pfem_taylor_2d(dp: float, dt: float, t_end: float, alpha: float = 1.4, penal
         step_dt = min(dt, t_end - nodes.t)
         c = StepContact(contact, wall, [0.0, 0.0], [0.0, 0.0], nodes.x, np.zeros(nodes.n), nodes.T,
                         boundary_lengths(nodes.x, mesh.edges, nodes.n), np.flatnonzero(mesh.boundary))
-        r = solve_with_active_set(nodes, mesh, hist_e, law, step_dt, Loads(fixed, zero, contact=c))
-        nodes = commit(nodes, r, step_dt)
+        r = solve_with_active_set(nodes, mesh, hist_e, law, step_dt, Loads(fixed, zero, contact=c), dynamic=newmark)
+        nodes = commit(nodes, r, step_dt, newmark)
         heat = np.bincount(mesh.tri.ravel(), np.repeat(jc.chi * r.d_w_p * np.abs(r.area) / 3.0, 3),
                            minlength=nodes.n)
         nodes.T = nodes.T + heat / (nodes.m * jc.cp)

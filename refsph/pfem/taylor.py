@@ -7,12 +7,13 @@ body's boundary nodes lie on its surface, where SPH particles sit half a spacing
 symmetry plane), the wall a flat frictionless penalty contact (:mod:`refsph.pfem.contact`), the trapezoidal rule
 at a fixed step, remeshed when a triangle degrades. Length L = max y - min y and width 2 max x at the end.
 
-**Status (issue 24): a first look, not yet a check.** At dp = 0.5 mm, dt = 0.25 us the slab shortens like the SPH
-ones (36.27 mm at 10 us) but its foot spreads far more: 11.9 mm wide at 10 us and 13.5 mm at 15 us with a plastic
-strain of 3 at the corner, where the SPH slabs end at 10.7-10.9 mm (``refsph run taylor --dim 2 --dp 0.5e-3``).
-Suspected: the corner node, on the surface here (SPH's outer particles sit half a spacing inside), slides out
-along the frictionless wall with its triangles averaged at each remeshing; and the trapezoidal rule, which damps
-nothing, lets the impact face ring on the penalty wall (at dp = 1.5 mm the bottom had lifted 47 um after 3 us).
+**Status (issue 24): a first look, not yet a check.** dp = 0.5 mm, dt = 0.25 us. With the paper's trapezoidal rule
+the impact face rings on the penalty wall (it damps nothing: at dp = 1 mm the bottom had lifted 68 um after
+10 us) and the foot spreads fast: 11.9 mm wide at 10 us, 16.1 mm at 25 us, where Newton failed. With a damped
+Newmark rule (gamma = 0.7) the face stays on the wall and the slab shortens to 34.96 mm at 26 us (the SPH slabs,
+``refsph run taylor --dim 2 --dp 0.5e-3``: 35.2-35.4 mm at rest, foot 10.7-10.9 mm) with a foot of 13.3 mm; then
+the wall contact is lost (nodes 4.6 mm through the wall at 50 us, the slab "rebounds" to 39.5 mm): the contact
+node set (the alpha-shape boundary) or the penalty lets nodes through after the heavy deformation of the corner.
 """
 from __future__ import annotations
 

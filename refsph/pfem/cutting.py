@@ -20,7 +20,8 @@ at an impact, and the predictor du = dt v drove the contact nodes deep into the 
 du = 0 and freezes the contact and slip sets within a Newton solve
 (:func:`~refsph.pfem.contact.solve_with_active_set`). The quick cut (case 1, t_u/5, 4 t_u) then went past the
 first contact, at steps halved a few times, to 0.78 t_u (Fc about 110 N/mm, eps_p 0.8), where a Newton solve
-still needed more than 25 iterations at dt / 32. A flat contact with friction works (``tests/test_pfem.py``:
+still needed more than 25 iterations at dt / 32 (with a damped Newmark rule, gamma = 0.7, the same at 0.79 t_u).
+A flat contact with friction works (``tests/test_pfem.py``:
 stick, then slide at F_T / F_N = mu to round-off).
 
 The measures are the SPH scene's own functions (:func:`refsph.scenes.thermal_cutting.chip_measures`,

@@ -125,7 +125,7 @@ class StepContact:
         return f, k
 
 
-def solve_with_active_set(nodes, mesh, hist, law, dt, loads, max_outer: int = 8, dynamic=True):
+def solve_with_active_set(nodes, mesh, hist, law, dt, loads, max_outer: int = 8, dynamic=True, max_iter: int = 25):
     """Newton-Raphson with the contact and slip sets frozen (:meth:`StepContact.freeze`): set at the step's start
     (each solve starts from du = 0: the trapezoidal rule's velocities ring at an impact, and the predictor dt v
     would drive the contact nodes deep into the tool), solved, set again from the solution, until the sets stop
@@ -134,8 +134,9 @@ def solve_with_active_set(nodes, mesh, hist, law, dt, loads, max_outer: int = 8,
     c = loads.contact
     c.freeze(nodes.x)
     for _ in range(max_outer):
-        r = newton_step(nodes, mesh, hist, law, dt, loads, dynamic=dynamic, predictor=False)
+        r = newton_step(nodes, mesh, hist, law, dt, loads, dynamic=dynamic, predictor=False, max_iter=max_iter)
         if not c.freeze(nodes.x + r.du):
             c.active = c.slip = None
-            return newton_step(nodes, mesh, hist, law, dt, loads, dynamic=dynamic, predictor=False)   # free sets
+            return newton_step(nodes, mesh, hist, law, dt, loads, dynamic=dynamic, predictor=False,
+                               max_iter=max_iter)                                 # the sets free
     raise NewtonFailed(f"the contact's active set kept changing over {max_outer} solves", [])

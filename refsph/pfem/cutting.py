@@ -56,7 +56,7 @@ class PFEMCut:
     position ``shift0`` at t = 0 and velocity ``v_tool`` [m/s]), the ``contact``, ``alpha``, the step ``dt`` and
     ``t_end`` [s], the initial positions ``X0`` and ``info`` (the SPH scene's keys, for the measures); a remeshing
     every ``remesh_every`` steps and whenever a triangle's quality drops below ``remesh_quality``; ``newmark`` the
-    time rule (the paper's trapezoidal rule by default)."""
+    time rule (the paper's trapezoidal rule by default); ``max_iter`` Newton iterations per solve."""
 
     nodes: object
     h: np.ndarray
@@ -74,6 +74,7 @@ class PFEMCut:
     remesh_every: int = 1
     remesh_quality: float = 0.3
     newmark: Newmark = TRAPEZOIDAL
+    max_iter: int = 25
 
 
 def graded_workpiece(length: float, tu: float, dx: float) -> tuple[np.ndarray, np.ndarray]:
@@ -149,7 +150,7 @@ def run_pfem_cut(cut: PFEMCut, progress=None, max_steps: int | None = None) -> d
                                   np.flatnonzero(mesh.boundary))
             try:
                 r = solve_with_active_set(nodes, mesh, hist_e, law, dt, Loads(cut.fixed, zero, contact=contact),
-                                          dynamic=cut.newmark)
+                                          dynamic=cut.newmark, max_iter=cut.max_iter)
                 break
             except NewtonFailed as e:
                 dt, retries = 0.5 * dt, retries + 1

@@ -59,12 +59,12 @@ print(f"K = {mat.K / 1e9:.1f} GPa, G = {mat.G / 1e9:.1f} GPa, c0 = {mat.c0:.0f} 
 # the velocity gradient is $\mathbf l = \dot{\mathbf F}\mathbf F^{-1}$, the density needs no equation,
 # $\rho = \rho_0/J$ with $J = \det\mathbf F$ (2), the pressure is $p = K(\rho/\rho_0 - 1)$ (24), the deviatoric
 # stress follows the Jaumann rate (20)
-# $\dot{\mathbf s} = 2G(\dot{\boldsymbol\epsilon} - \tfrac13\mathrm{tr}\,\dot{\boldsymbol\epsilon}\,\mathbf I)
-# + \boldsymbol\omega\mathbf s - \mathbf s\boldsymbol\omega$ with $\dot{\boldsymbol\epsilon}$, $\boldsymbol\omega$
+# $\dot{\mathbf s} = 2G(\dot{\boldsymbol\epsilon} - \tfrac13\mathrm{tr}\,\dot{\boldsymbol\epsilon}\,\mathbf I) +
+# \boldsymbol\omega\mathbf s - \mathbf s\boldsymbol\omega$ with $\dot{\boldsymbol\epsilon}$, $\boldsymbol\omega$
 # the symmetric and skew parts of $\mathbf l$, and the momentum equation is
 #
-# $$\frac{d\mathbf v_i}{dt} = \sum_j m_j\left(\frac{\mathbf P_i}{\rho_{0i}^2} + \frac{\mathbf P_j}{\rho_{0j}^2}
-#   - \boldsymbol\Pi_{ij}\right)\nabla_i W_{ij}\quad(17).$$
+# $$\frac{d\mathbf v_i}{dt} = \sum_j m_j\left(\frac{\mathbf P_i}{\rho_{0i}^2} + \frac{\mathbf P_j}{\rho_{0j}^2} -
+#   \boldsymbol\Pi_{ij}\right)\nabla_i W_{ij}\quad(17).$$
 #
 # `refsph` differs from the printed text in three places, each one explained below:
 #

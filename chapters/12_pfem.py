@@ -156,8 +156,8 @@ plt.show()
 # have constant gradients, $\nabla N_a = (y_b - y_c,\ x_c - x_b)/(2A)$ for $(a, b, c)$ in cyclic order. The pressure
 # equation of one triangle, divided by $K$ (`refsph.pfem.solid`):
 #
-# $$r_{p,a} = \frac1K\Big(\sum_b \int N_aN_b\,dA\; p_b - \frac A3\,\hat p(J)\Big)
-#   + \frac1G\sum_b \int (N_a - \tfrac13)(N_b - \tfrac13)\,dA\; p_b ,$$
+# $$r_{p,a} = \frac1K\Big(\sum_b \int N_aN_b\,dA\; p_b - \frac A3\,\hat p(J)\Big) +
+#   \frac1G\sum_b \int (N_a - \tfrac13)(N_b - \tfrac13)\,dA\; p_b ,$$
 #
 # with $\hat p$ Eq. (13). The last term is Dohrmann & Bochev's pressure projection (the paper's $F_{stab}$, its
 # ref. [53]): $\frac13$ is the element mean of $N_a$, so it acts only on the part of $p$ that varies inside the

@@ -55,3 +55,12 @@ def test_answer_key_runs(path, monkeypatch, tmp_path):
     mod = answers_module(path)
     for name in sorted(n for n in dir(mod) if re.fullmatch(r"answer_\d+", n)):
         getattr(mod, name)()                 # each asserts what the student should see
+
+
+@pytest.mark.parametrize("path", CHAPTERS, ids=[p.stem for p in CHAPTERS])
+def test_no_formula_line_reads_as_a_markdown_bullet(path):
+    """A wrapped line of TeX that starts with '+ \\...' or '- \\...' is a Markdown bullet: the book then shows raw TeX
+    (chapter 03's Jaumann rate did). Keep the operator at the end of the line before."""
+    bad = [f"{path.name}:{k}: {line.strip()}" for k, line in enumerate(path.read_text().splitlines(), 1)
+           if re.match(r"#\s+[-+*]\s+\\", line)]
+    assert not bad, bad

@@ -41,9 +41,9 @@ from ..plasticity import JohnsonCook, ModifiedJohnsonCook
 from ..scenes.thermal_cutting import (CLEARANCE_DEG, EDGE_RADIUS, RAKE_DEG, chip_measures, thermal_cutting_metrics,
                                       tool_shape)
 from .contact import StepContact, ToolContact, boundary_lengths, solve_with_active_set
-from .mesh import alpha_shape_mesh, triangle_quality
+from .mesh import alpha_shape_mesh, remesh_needed
 from .solid import (TRAPEZOIDAL, Loads, Newmark, NewtonFailed, SolidLaw, commit, history_from_nodes, make_nodes,
-                    project_to_nodes, transfer_history)
+                    settle_nodes, transfer_history)
 
 __all__ = ["PFEMCut", "graded_workpiece", "pfem_cut", "run_pfem_cut"]
 
@@ -141,7 +141,6 @@ def run_pfem_cut(cut: PFEMCut, progress=None, max_steps: int | None = None) -> d
     hist_e = history_from_nodes(nodes, mesh)
     iters, retries, t0, step, remeshes = [], 0, time.perf_counter(), 0, 0
     zero = np.zeros_like(nodes.x)
-    cp = law.strength.cp
     while nodes.t < cut.t_end * (1 - 1e-9) and (max_steps is None or step < max_steps):
         dt = min(cut.dt, cut.t_end - nodes.t)
         for attempt in range(5):
@@ -164,12 +163,7 @@ def run_pfem_cut(cut: PFEMCut, progress=None, max_steps: int | None = None) -> d
         c = contact.last
         f_T = c["f_T"]
         F_tool = -r.contact_force.sum(axis=0) if r.contact_force is not None else np.zeros(2)
-        # plastic heat: chi dW_p A of each triangle, a third to each of its nodes, over m_i c_p (adiabatic)
-        q = law.strength.chi * r.d_w_p * np.abs(r.area) if getattr(law.strength, "heating", False) else 0 * r.area
-        heat = np.bincount(mesh.tri.ravel(), np.repeat(q / 3.0, 3), minlength=nodes.n)
-        nodes.T = nodes.T + heat / (nodes.m * cp)
-        for name in ("S", "S_zz", "eps_p", "W_p", "J", "eps_dot"):
-            setattr(nodes, name, project_to_nodes(mesh, r.area, getattr(r.history, name), nodes.n))
+        settle_nodes(nodes, mesh, r, law.strength)
         if remesh_needed(nodes.x, mesh, cut.remesh_quality) or step % cut.remesh_every == cut.remesh_every - 1:
             new = alpha_shape_mesh(nodes.x, cut.alpha, cut.h)            # Algorithm 1: "if remeshing is needed"
             hist_e, mesh = transfer_history(mesh, r.history, new, nodes), new
@@ -189,8 +183,3 @@ def run_pfem_cut(cut: PFEMCut, progress=None, max_steps: int | None = None) -> d
     metrics = thermal_cutting_metrics(hist, info, cut.t_end)
     return dict(nodes=nodes, mesh=mesh, history=hist, metrics=metrics, newton_iterations=iters, retries=retries,
                 wall_time_s=time.perf_counter() - t0, steps=step, remeshes=remeshes)
-
-
-def remesh_needed(x: np.ndarray, mesh, q_min: float) -> bool:
-    """Algorithm 1's test: a triangle of quality below ``q_min`` (:func:`triangle_quality`)."""
-    return bool(np.min(triangle_quality(x, mesh.tri)) < q_min)

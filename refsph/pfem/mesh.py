@@ -31,7 +31,7 @@ from scipy.spatial import Delaunay, cKDTree
 from ..surface import circumradius
 
 __all__ = ["Mesh", "nodal_spacing", "alpha_shape_mesh", "boundary_edges", "signed_areas", "triangle_quality",
-           "topology"]
+           "topology", "remesh_needed"]
 
 
 @dataclass
@@ -118,3 +118,7 @@ def topology(n: int, tri: np.ndarray) -> tuple[int, int]:
     bodies = len(np.unique(label[used]))
     return bodies, bodies - (len(used) - len(e) + len(tri))
 
+
+def remesh_needed(x: np.ndarray, mesh, q_min: float) -> bool:
+    """Algorithm 1's test: a triangle of quality below ``q_min`` (:func:`triangle_quality`)."""
+    return bool(np.min(triangle_quality(x, mesh.tri)) < q_min)

@@ -57,7 +57,7 @@ from .mesh import Mesh
 
 __all__ = ["SolidLaw", "Nodes", "History", "Loads", "StepResult", "element_response", "element_residual",
            "volumetric_pressure", "assemble", "newton_step", "commit", "project_to_nodes", "history_from_nodes",
-           "make_nodes", "NewtonFailed", "transfer_history", "Newmark", "TRAPEZOIDAL",
+           "make_nodes", "NewtonFailed", "transfer_history", "settle_nodes", "Newmark", "TRAPEZOIDAL",
            "newmark_of"]
 
 
@@ -437,6 +437,20 @@ def transfer_history(old: Mesh, hist: History, new: Mesh, nodes: Nodes) -> Histo
         if a is not None and b is not None:
             a[same] = b[src]
     return out
+
+
+def settle_nodes(nodes: Nodes, mesh: Mesh, step: StepResult, strength) -> None:
+    """After a converged step (in place): the plastic heat chi dW_p A of each triangle, a third to each of its
+    nodes, over m_i c_p (adiabatic; none for a law that does not heat), and the triangles' new history projected to
+    the nodes (:func:`project_to_nodes`), ready for a remeshing."""
+    if getattr(strength, "heating", False):
+        q = strength.chi * step.d_w_p * np.abs(step.area)
+        nodes.T = nodes.T + np.bincount(mesh.tri.ravel(), np.repeat(q / 3.0, 3), minlength=nodes.n) / (nodes.m
+                                                                                                       * strength.cp)
+    for name in ("S", "S_zz", "eps_p", "W_p", "J", "eps_dot"):
+        value = getattr(step.history, name)
+        if value is not None:
+            setattr(nodes, name, project_to_nodes(mesh, step.area, value, nodes.n))
 
 
 def history_from_nodes(nodes: Nodes, mesh: Mesh) -> History:

@@ -29,8 +29,8 @@ from ..penalty import RoundedPolygon
 from ..scenes.taylor import taylor_johnson_cook, taylor_material
 from .contact import StepContact, ToolContact, boundary_lengths, solve_with_active_set
 from .element import shape_gradients
-from .mesh import alpha_shape_mesh, triangle_quality
-from .solid import (TRAPEZOIDAL, Loads, Newmark, SolidLaw, commit, history_from_nodes, make_nodes, project_to_nodes,
+from .mesh import alpha_shape_mesh, remesh_needed
+from .solid import (TRAPEZOIDAL, Loads, Newmark, SolidLaw, commit, history_from_nodes, make_nodes, settle_nodes,
                     transfer_history)
 
 __all__ = ["pfem_taylor_2d"]
@@ -66,13 +66,9 @@ def pfem_taylor_2d(dp: float, dt: float, t_end: float, alpha: float = 1.4, penal
                         boundary_lengths(nodes.x, mesh.edges, nodes.n), np.flatnonzero(mesh.boundary))
         r = solve_with_active_set(nodes, mesh, hist_e, law, step_dt, Loads(fixed, zero, contact=c), dynamic=newmark)
         nodes = commit(nodes, r, step_dt, newmark)
-        heat = np.bincount(mesh.tri.ravel(), np.repeat(jc.chi * r.d_w_p * np.abs(r.area) / 3.0, 3),
-                           minlength=nodes.n)
-        nodes.T = nodes.T + heat / (nodes.m * jc.cp)
-        for name in ("S", "S_zz", "eps_p", "W_p", "J"):
-            setattr(nodes, name, project_to_nodes(mesh, r.area, getattr(r.history, name), nodes.n))
+        settle_nodes(nodes, mesh, r, jc)
         hist_e = r.history
-        if triangle_quality(nodes.x, mesh.tri).min() < remesh_quality:
+        if remesh_needed(nodes.x, mesh, remesh_quality):
             new = alpha_shape_mesh(nodes.x, alpha, h)
             hist_e, mesh = transfer_history(mesh, r.history, new, nodes), new
         out["t"].append(nodes.t)

@@ -186,12 +186,20 @@ def get_kernel(name: str) -> Kernel:
         raise ValueError(f"unknown kernel {name!r}; choose one of {sorted(KERNELS)}") from None
 
 
-def correction_matrix(M: np.ndarray, tol: float = 1e-6) -> tuple[np.ndarray, np.ndarray]:
+def correction_matrix(M: np.ndarray, tol: float = 1e-6, max_condition: float | None = None
+                      ) -> tuple[np.ndarray, np.ndarray]:
     """L_i = M_i^-T (Bonet & Lok 1999). Where M_i is (nearly) singular -- a particle whose neighbours do not
     span every direction (no neighbours, a single row of particles) -- the Moore-Penrose pseudo-inverse is used
     instead (Bonet & Lok's correction restricted to the directions the neighbours span), so the operator stays
     finite. Returns (L, indices of those degenerate particles); F of such a particle is singular in the
-    missing direction, so a run that depends on it stops with a non-finite-state error that names it."""
+    missing direction, so a run that depends on it stops with a non-finite-state error that names it.
+
+    ``max_condition`` (None: no limit, the paper's correction): where M_i = U diag(s) V^T is invertible but its
+    condition number s_max / s_min exceeds it -- a particle on a ragged free surface whose few neighbours lie
+    nearly in one line -- L_i = U diag(1 / max(s, s_max / max_condition)) V^T: the correction of the well-spanned
+    directions kept, the amplification of the poorly spanned one bounded by max_condition / s_max (a truncated,
+    Tikhonov-like pseudo-inverse; refsph's choice, module text of :mod:`refsph.tlsph`). Every particle below the
+    limit keeps its exact M_i^-T, to the bit."""
     d = M.shape[1]
     detM = det(M)
     scale = np.maximum(np.abs(np.trace(M, axis1=1, axis2=2)) / d, np.finfo(float).tiny) ** d
@@ -201,4 +209,13 @@ def correction_matrix(M: np.ndarray, tol: float = 1e-6) -> tuple[np.ndarray, np.
     L = np.swapaxes(inv(safe), 1, 2)
     if len(bad):
         L[bad] = np.swapaxes(np.linalg.pinv(M[bad]), 1, 2)
+    if max_condition is not None and len(M):
+        good = np.ones(len(M), dtype=bool)
+        good[bad] = False
+        s = np.linalg.svd(M, compute_uv=False)
+        capped = np.flatnonzero(good & (s[:, 0] > max_condition * s[:, -1]))
+        if len(capped):
+            U, s_c, Vt = np.linalg.svd(M[capped])
+            floor = np.maximum(s_c, s_c[:, :1] / max_condition)
+            L[capped] = np.einsum("nij,nj,njk->nik", U, 1.0 / floor, Vt)     # (V diag(1/s) U^T)^T
     return L, bad

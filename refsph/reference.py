@@ -68,13 +68,13 @@ class ReferenceConfiguration:
             ids = body.body if several_bodies else None
             if self.mirror is None:
                 self.op = ReferenceOperator(body.X, body.V0, p.h, p.kernel, p.corrected, threads=self.threads,
-                                            body=ids)
+                                            body=ids, max_condition=p.max_condition)
             else:
                 g = self.mirror.ghosts(body.X, p.kernel.support * p.h)
                 self.ghost_constant = g.extend_constant(body)   # m, X, V0: fixed with the operator
                 _, X, V0 = self.ghost_constant
                 self.op = ReferenceOperator(X, V0, p.h, p.kernel, p.corrected, ghosts=g, threads=self.threads,
-                                            body=ids)
+                                            body=ids, max_condition=p.max_condition)
         return self.op
 
     def extended(self, body: State, op: ReferenceOperator) -> State:

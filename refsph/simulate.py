@@ -95,6 +95,8 @@ def make_solver(method: str, setup: Setup) -> Solver:
         if nm.hourglass:
             raise ValueError("hourglass control is a TLSPH option (ESPH's neighbours change every step, its zig-zag "
                              "modes are the tensile instability's, see gamma)")
+        if nm.max_condition is not None:
+            raise ValueError("max_condition limits TLSPH's kernel-gradient correction; ESPH has none to limit")
         prm = ESPHParams(h=h, dp=setup.dp, beta1=nm.beta1, beta2=nm.beta2, gamma=nm.gamma, n_ap=nm.n_ap,
                          eps=nm.eps, kernel=kernel, correction=bool(nm.esph_correction))
         return ESPHSolver(setup.material, prm, skin_factor=nm.skin_factor, **common)
@@ -105,7 +107,8 @@ def make_solver(method: str, setup: Setup) -> Solver:
             raise ValueError("esph_correction is an ESPH option; TLSPH's kernel-gradient correction is 'corrected'")
         prm = TLSPHParams(h=h, beta1=nm.beta1, beta2=nm.beta2, eps=nm.eps, kernel=kernel,
                           corrected=nm.corrected, ref_update_strain=nm.ref_update_strain,
-                          hourglass=float(nm.hourglass), viscous_heat=bool(setup.dissipation_heat))
+                          hourglass=float(nm.hourglass), viscous_heat=bool(setup.dissipation_heat),
+                          max_condition=nm.max_condition)
         contact = None
         if setup.friction is not None and not setup.rigid:
             raise ValueError("friction acts in the contact with rigid bodies, and this setup has none")

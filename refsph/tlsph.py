@@ -59,7 +59,8 @@ class TLSPHParams:
     E = (F^T F - I)/2 the Green-Lagrange strain (None: never); hourglass: the coefficient alpha of
     :func:`hourglass_acceleration` (0: off, as in the paper); viscous_heat: also return the power the artificial
     viscosity dissipates in each particle (``Rates.heat_power``, :func:`reference_viscosity`), for a run that turns
-    it into heat (``Setup.dissipation_heat``)."""
+    it into heat (``Setup.dissipation_heat``); max_condition: the largest condition number of the moment matrix the
+    kernel-gradient correction inverts as it is (None: no limit; :func:`refsph.kernels.correction_matrix`)."""
 
     h: float
     beta1: float
@@ -70,6 +71,7 @@ class TLSPHParams:
     ref_update_strain: float | None
     hourglass: float = 0.0
     viscous_heat: bool = False
+    max_condition: float | None = None
 
 
 class ReferenceOperator:
@@ -91,7 +93,8 @@ class ReferenceOperator:
     """
 
     def __init__(self, X: np.ndarray, V: np.ndarray, h: float, kernel: Kernel, corrected: bool,
-                 ghosts=None, threads: int = 1, block_size: int | None = None, body: np.ndarray | None = None):
+                 ghosts=None, threads: int = 1, block_size: int | None = None, body: np.ndarray | None = None,
+                 max_condition: float | None = None):
         X = np.asarray(X, dtype=float)
         n, d = X.shape
         self.n, self.dim, self.h, self.kernel, self.corrected = n, d, float(h), kernel, bool(corrected)
@@ -124,7 +127,7 @@ class ReferenceOperator:
             # a ghost's own neighbourhood is cut off; its moment matrix is the mirror image of its source's
             nr = ghosts.n_real
             self.M[nr:] = ghosts.tensors(self.M[:nr])
-        self.L, self.degenerate = (correction_matrix(self.M) if corrected
+        self.L, self.degenerate = (correction_matrix(self.M, max_condition=max_condition) if corrected
                                    else (identity(n, d), np.zeros(0, dtype=np.intp)))
         if ghosts is not None:
             self.degenerate = self.degenerate[self.degenerate < ghosts.n_real]

@@ -302,3 +302,33 @@ def test_viscous_heat_is_the_work_the_viscosity_takes(corrected):
     assert np.count_nonzero(q > 1e-6 * q.max()) > 0.5 * st.n
     many = ReferenceOperator(st.X, st.V0, H, KERNEL, corrected, threads=2, block_size=53)
     np.testing.assert_allclose(tlsph_rates(st, MAT, with_heat, many).heat_power, q, rtol=1e-10, atol=1e-12 * q.max())
+
+
+def test_condition_limit_bounds_the_correction_and_leaves_the_rest():
+    """max_condition (issue 22's Ti6Al4V cut at t_u/10: a surface particle with 6 nearly collinear neighbours after
+    a reference update had a moment matrix of condition 73, its correction amplified the error of F ~100-fold, and
+    its pressure reached -45 GPa): above the limit the smallest singular value is floored at s_max / limit, below it
+    L = M^-T to the bit."""
+    from refsph.kernels import correction_matrix
+
+    rng = np.random.default_rng(3)
+    R1, R2 = rot(0.3), rot(-1.1)
+    s = np.array([[1.0, 0.9], [1.0, 0.01], [2.0, 0.05], [1.0, 0.2]])       # conditions 1.1, 100, 40, 5
+    M = np.einsum("ij,nj,jk->nik", R1, s, R2) + 1e-3 * rng.standard_normal((4, 2, 2)) * s[:, 1:2, None]
+    cond = np.linalg.cond(M)
+    free, _ = correction_matrix(M)
+    capped, bad = correction_matrix(M, max_condition=20.0)
+    assert len(bad) == 0
+    below = cond <= 20.0
+    assert below.tolist() == [True, False, False, True]
+    np.testing.assert_array_equal(capped[below], free[below])                     # untouched, bit for bit
+    np.testing.assert_allclose(np.einsum("nji,njk->nik", free, M), np.broadcast_to(np.eye(2), M.shape), atol=1e-9)
+    # above: the largest amplification of L is limit / s_max instead of 1 / s_min
+    amp = np.linalg.norm(capped, 2, axis=(1, 2))
+    smax = np.linalg.svd(M, compute_uv=False)[:, 0]
+    np.testing.assert_allclose(amp[~below], 20.0 / smax[~below], rtol=1e-12)
+    assert np.all(np.linalg.norm(free, 2, axis=(1, 2))[~below] > 1.9 * amp[~below])
+    # the well-spanned direction keeps its exact inverse: L^T M v1 = v1 for M's leading right singular vector
+    U, sv, Vt = np.linalg.svd(M[~below])
+    v1 = Vt[:, 0, :]
+    np.testing.assert_allclose(np.einsum("nji,njk,nk->ni", capped[~below], M[~below], v1), v1, atol=1e-12)

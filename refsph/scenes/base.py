@@ -36,7 +36,9 @@ class Numerics:
     control coefficient (Ganzenmueller 2015, :mod:`refsph.tlsph`; 0 = off, as in the paper); contact: the TLSPH
     contact with rigid tools, 'pinball' (Eqs. (32)-(36), the paper's) or 'penalty' (:mod:`refsph.penalty`, on the
     tools' exact geometry, ``RigidBody.shape``); penalty_alpha: the penalty stiffness alpha m / dt^2 (the fraction of
-    the penetration removed per step); penalty_damping: the damping ratio of the penalty's normal spring. The
+    the penetration removed per step); penalty_damping: the damping ratio of the penalty's normal spring;
+    max_condition: TLSPH's kernel-gradient correction inverts a moment matrix whose condition number exceeds it
+    only up to it (:func:`refsph.kernels.correction_matrix`; None = no limit, as in the paper). The
     numbers of a run do not depend on ``threads``, only its speed does.
     """
 
@@ -60,6 +62,7 @@ class Numerics:
     contact: str = "pinball"
     penalty_alpha: float = 0.1
     penalty_damping: float = 0.5
+    max_condition: float | None = None
 
     def __post_init__(self):
         """Every parameter checked when the Numerics is made (a scene's, or ``--set``'s replacement of it), so that
@@ -84,6 +87,7 @@ class Numerics:
         real("ref_update_strain", 0.0, lo_open=True, optional=True)
         real("contact_k", 0.0, lo_open=True, optional=True)
         real("penalty_alpha", 0.0, 4.0, lo_open=True)
+        real("max_condition", 1.0, lo_open=True, optional=True)
         if not (isinstance(self.threads, int) and not isinstance(self.threads, bool) and self.threads >= 0):
             raise ValueError(f"numerical parameter threads must be a whole number >= 0, got {self.threads!r}")
         for name, choices in (("kernel", tuple(KERNELS)), ("contact", ("pinball", "penalty"))):

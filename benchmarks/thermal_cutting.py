@@ -16,8 +16,8 @@ penalty contact, the numerical dissipation turned into heat; means over the last
 ``runs/thermal_cutting/<key>/`` on one core (about 40 minutes for a steel case). The studies (``--study``):
 ``coarse`` (all 18 cases at t_u/5, keys 'case N n_tu 5': the complete table while the t_u/10 sweep runs, and the
 only Ti6Al4V one so far: case 10 breaks down at t_u/10, see the page), ``scaling`` (s halved: cases 1 and 10),
-``scatter`` (case 1 with its particles jittered by 0.01 dx, three seeds; first at t_u/5), ``resolution`` (t_u/5 and t_u/15 for cases 1 and 10), ``tool`` (the first sweep's tool 5 t_u x 3 t_u
-and 4 t_u left uncut, one change at a time, at t_u/5 and t_u/10), ``contact`` (the pinball; all the frictional heat
+``scatter`` (case 1 with its particles jittered by 0.01 dx, three seeds; first at t_u/5), ``resolution`` (t_u/5
+and t_u/15 for cases 1 and 10), ``tool`` (the first sweep's tool 5 t_u x 3 t_u and 4 t_u left uncut, one change at a time, at t_u/5 and t_u/10), ``contact`` (the pinball; all the frictional heat
 to the chip). Resumable twice over: a finished run is a record in ``benchmarks/thermal_cutting.json`` and is
 skipped; a run that was killed continues from its last snapshot (``refsph run --restart``). A run that fails
 (non-finite state, lost chip) is a record with its status and error; it stays in the table until ``--redo`` runs it

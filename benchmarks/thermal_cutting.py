@@ -10,18 +10,19 @@ that say which digits of them mean something (issue 22).
     python benchmarks/thermal_cutting.py --report            # page and figures from the committed JSON only
     python benchmarks/thermal_cutting.py --quick --json /tmp/q.json --only 1 2   # a try-out (quick cuts)
 
-Each run is ``refsph run thermal_cutting --case N`` with the sweep's numerics (:func:`converged`: dx = t_u / 10,
-16 t_u of cut on a workpiece 28 t_u long, a tool 10 t_u x 6 t_u, the mass-scaling rule s rho vc^2 = 0.01 A, the
-penalty contact, the numerical dissipation turned into heat; means over the last quarter of the cut) in
+Each run is ``refsph run thermal_cutting --case N`` with the sweep's numerics (:func:`converged`: dx = t_u / 10, 16
+t_u of cut on a workpiece 28 t_u long, a tool 10 t_u x 6 t_u, the mass-scaling rule s rho vc^2 = 0.01 A, the penalty
+contact, the numerical dissipation turned into heat; means over the last quarter of the cut) in
 ``runs/thermal_cutting/<key>/`` on one core (about 40 minutes for a steel case). The studies (``--study``):
 ``coarse`` (all 18 cases at t_u/5, keys 'case N n_tu 5': the complete table while the t_u/10 sweep runs, and the
 only Ti6Al4V one so far: case 10 breaks down at t_u/10, see the page), ``scaling`` (s halved: cases 1 and 10),
-``scatter`` (case 1 with its particles jittered by 0.01 dx, three seeds; first at t_u/5), ``resolution`` (t_u/5
-and t_u/15 for cases 1 and 10), ``tool`` (the first sweep's tool 5 t_u x 3 t_u and 4 t_u left uncut, one change at a time, at t_u/5 and t_u/10), ``contact`` (the pinball; all the frictional heat
-to the chip). Resumable twice over: a finished run is a record in ``benchmarks/thermal_cutting.json`` and is
-skipped; a run that was killed continues from its last snapshot (``refsph run --restart``). A run that fails
-(non-finite state, lost chip) is a record with its status and error; it stays in the table until ``--redo`` runs it
-again, and a failed rerun never replaces a good record. A rerun with nothing to do writes nothing.
+``scatter`` (case 1 with its particles jittered by 0.01 dx, three seeds; first at t_u/5), ``resolution`` (t_u/5 and
+t_u/15 for cases 1 and 10), ``tool`` (the first sweep's tool 5 t_u x 3 t_u and 4 t_u left uncut, one change at a
+time, at t_u/5 and t_u/10), ``contact`` (the pinball; all the frictional heat to the chip). Resumable twice over: a
+finished run is a record in ``benchmarks/thermal_cutting.json`` and is skipped; a run that was killed continues from
+its last snapshot (``refsph run --restart``). A run that fails (non-finite state, lost chip) is a record with its
+status and error; it stays in the table until ``--redo`` runs it again, and a failed rerun never replaces a good
+record. A rerun with nothing to do writes nothing.
 
 The experimental values are not printed in the paper: ``refsph.paper_data.RLA_CUTTING_CASES`` recovers them from
 each printed prediction and its printed percent error. The paper does not state the width of cut, so forces are

@@ -105,7 +105,9 @@ class StepContact:
         return dict(f=fN[:, None] * n + fT[:, None] * t, f_N=fN, f_T=fT, slip=np.where(on, s, 0.0), gap=g,
                     slip_raw=s)
 
-    def __call__(self, x_new: np.ndarray):
+    def __call__(self, x_new: np.ndarray, stiffness: bool = True):
+        """(f (N, 2), df/dx (N, 2, 2)) at positions x_new; ``stiffness=False``: the derivative left zero (a line
+        search's trial point needs the force only)."""
         N = len(x_new)
         f, k = np.zeros((N, 2)), np.zeros((N, 2, 2))
         idx = self.nodes
@@ -113,7 +115,7 @@ class StepContact:
         res = self.forces(xi, idx)
         f[idx] = res["f"]
         eps = 1e-7 * np.maximum(self.length[idx], 1e-12)
-        for d in range(2):
+        for d in range(2 if stiffness else 0):
             e = np.zeros_like(xi)
             e[:, d] = eps
             k[idx, :, d] = (self.forces(xi + e, idx)["f"] - self.forces(xi - e, idx)["f"]) / (2 * eps[:, None])
@@ -125,7 +127,8 @@ class StepContact:
         return f, k
 
 
-def solve_with_active_set(nodes, mesh, hist, law, dt, loads, max_outer: int = 8, dynamic=True, max_iter: int = 25):
+def solve_with_active_set(nodes, mesh, hist, law, dt, loads, max_outer: int = 8, dynamic=True, max_iter: int = 25,
+                          max_move: float | None = None):
     """Newton-Raphson with the contact and slip sets frozen (:meth:`StepContact.freeze`): set at the step's start
     (each solve starts from du = 0: the trapezoidal rule's velocities ring at an impact, and the predictor dt v
     would drive the contact nodes deep into the tool), solved, set again from the solution, until the sets stop
@@ -134,9 +137,10 @@ def solve_with_active_set(nodes, mesh, hist, law, dt, loads, max_outer: int = 8,
     c = loads.contact
     c.freeze(nodes.x)
     for _ in range(max_outer):
-        r = newton_step(nodes, mesh, hist, law, dt, loads, dynamic=dynamic, predictor=False, max_iter=max_iter)
+        r = newton_step(nodes, mesh, hist, law, dt, loads, dynamic=dynamic, predictor=False, max_iter=max_iter,
+                        max_move=max_move)
         if not c.freeze(nodes.x + r.du):
             c.active = c.slip = None
             return newton_step(nodes, mesh, hist, law, dt, loads, dynamic=dynamic, predictor=False,
-                               max_iter=max_iter)                                 # the sets free
+                               max_iter=max_iter, max_move=max_move)              # the sets free
     raise NewtonFailed(f"the contact's active set kept changing over {max_outer} solves", [])

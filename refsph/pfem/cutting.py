@@ -57,7 +57,8 @@ class PFEMCut:
     position ``shift0`` at t = 0 and velocity ``v_tool`` [m/s]), the ``contact``, ``alpha``, the step ``dt`` and
     ``t_end`` [s], the initial positions ``X0`` and ``info`` (the SPH scene's keys, for the measures); a remeshing
     every ``remesh_every`` steps and whenever a triangle's quality drops below ``remesh_quality``; ``newmark`` the
-    time rule (the paper's trapezoidal rule by default); ``max_iter`` Newton iterations per solve."""
+    time rule (the paper's trapezoidal rule by default); ``max_iter`` Newton iterations per solve; ``max_move`` the
+    largest Newton correction of a node, in its local sizes (:func:`refsph.pfem.solid.newton_step`)."""
 
     nodes: object
     h: np.ndarray
@@ -76,6 +77,7 @@ class PFEMCut:
     remesh_quality: float = 0.3
     newmark: Newmark = TRAPEZOIDAL
     max_iter: int = 80
+    max_move: float | None = 0.05
 
 
 def graded_workpiece(length: float, tu: float, dx: float) -> tuple[np.ndarray, np.ndarray]:
@@ -150,7 +152,7 @@ def run_pfem_cut(cut: PFEMCut, progress=None, max_steps: int | None = None) -> d
                                   np.flatnonzero(mesh.boundary))
             try:
                 r = solve_with_active_set(nodes, mesh, hist_e, law, dt, Loads(cut.fixed, zero, contact=contact),
-                                          dynamic=cut.newmark, max_iter=cut.max_iter)
+                                          dynamic=cut.newmark, max_iter=cut.max_iter, max_move=cut.max_move)
                 break
             except NewtonFailed as e:
                 dt, retries = 0.5 * dt, retries + 1

@@ -53,7 +53,7 @@ import scipy.sparse as sp
 from scipy.sparse.linalg import spsolve
 
 from .element import ppp_stabilisation, pressure_mass, shape_gradients
-from .mesh import Mesh
+from .mesh import Mesh, signed_areas
 
 __all__ = ["SolidLaw", "Nodes", "History", "Loads", "StepResult", "element_response", "element_residual",
            "volumetric_pressure", "assemble", "newton_step", "commit", "project_to_nodes", "history_from_nodes",
@@ -144,7 +144,8 @@ class Loads:
     """What acts on the nodes in a step: ``fixed`` (N, 2) bool, the prescribed displacement components, and
     ``du_fixed`` (N, 2) [m] their increments in the step; ``f_ext`` (N, 2) [N/m] nodal forces (None: none);
     ``contact``: None, or a function x_{n+1} (N, 2) -> (f (N, 2) [N/m], k (N, 2, 2) [N/m^2]) giving the contact
-    force on each node and its derivative df/dx (the Newton matrix adds -k)."""
+    force on each node and its derivative df/dx (the Newton matrix adds -k); called with ``stiffness=False`` where
+    only f is needed (k may then be zeros)."""
 
     fixed: np.ndarray
     du_fixed: np.ndarray
@@ -222,9 +223,10 @@ def element_response(xe: np.ndarray, due: np.ndarray, hist: History, Te: np.ndar
     g_half, _ = shape_gradients(xe + 0.5 * due)
     g_end, A_end = shape_gradients(xe + due)
     g_n, A_n = shape_gradients(xe)
-    H = np.einsum("mai,maj->mij", due, g_n)                        # grad_n du: det f - 1 = tr H + det H, exactly
+    dueT = np.swapaxes(due, 1, 2)
+    H = dueT @ g_n                                                 # grad_n du: det f - 1 = tr H + det H, exactly
     dJ = H[:, 0, 0] + H[:, 1, 1] + H[:, 0, 0] * H[:, 1, 1] - H[:, 0, 1] * H[:, 1, 0]
-    L = np.einsum("mai,maj->mij", due, g_half)                    # L_ij = sum_a du_a,i dN_a/dx_j
+    L = dueT @ g_half                                              # L_ij = sum_a du_a,i dN_a/dx_j
     d = 0.5 * (L + np.swapaxes(L, 1, 2))
     w = 0.5 * (L[:, 0, 1] - L[:, 1, 0])
     q = 1.0 / (1.0 + 0.25 * w * w)                                 # Q = (I - W/2)^-1 (I + W/2), W = [[0, w], [-w, 0]]
@@ -233,7 +235,7 @@ def element_response(xe: np.ndarray, due: np.ndarray, hist: History, Te: np.ndar
     tr = d[:, 0, 0] + d[:, 1, 1]
     dev = d - (tr / 3.0)[:, None, None] * np.eye(2)
     dev_zz = -tr / 3.0
-    S_trial = np.einsum("mik,mkl,mjl->mij", Q, hist.S, Q) + 2.0 * law.G * dev
+    S_trial = Q @ hist.S @ np.swapaxes(Q, 1, 2) + 2.0 * law.G * dev
     S_zz_trial = hist.S_zz + 2.0 * law.G * dev_zz
     eps_dot = np.sqrt(np.maximum(2.0 / 3.0 * (np.einsum("mij,mij->m", dev, dev) + dev_zz * dev_zz), 0.0)) / dt
     rate = eps_dot if hist.eps_dot is None else hist.eps_dot
@@ -249,9 +251,9 @@ def element_residual(xe, due, pe, hist, Te, dt, law) -> tuple[np.ndarray, np.nda
     r = element_response(xe, due, hist, Te, dt, law)
     A = r["area"]
     sigma = r["S"] + pe.mean(axis=1)[:, None, None] * np.eye(2)
-    r_u = A[:, None, None] * np.einsum("mij,maj->mai", sigma, r["grad"])
-    r_p = (np.einsum("mab,mb->ma", pressure_mass(A), pe) - (A / 3.0 * r["p_hat"])[:, None]) / law.K \
-        + np.einsum("mab,mb->ma", ppp_stabilisation(A), pe) / law.G
+    r_u = A[:, None, None] * (r["grad"] @ np.swapaxes(sigma, 1, 2))       # sum_j sigma_ij dN_a/dx_j
+    r_p = ((pressure_mass(A) @ pe[:, :, None])[:, :, 0] - (A / 3.0 * r["p_hat"])[:, None]) / law.K \
+        + (ppp_stabilisation(A) @ pe[:, :, None])[:, :, 0] / law.G
     return r_u, r_p, r
 
 
@@ -312,12 +314,22 @@ def assemble(nodes: Nodes, mesh: Mesh, hist: History, law: SolidLaw, du: np.ndar
 
 
 def newton_step(nodes: Nodes, mesh: Mesh, hist: History, law: SolidLaw, dt: float, loads: Loads,
-                dynamic: bool = True, tol: float = 1e-10, max_iter: int = 25, predictor: bool = True) -> StepResult:
+                dynamic: bool = True, tol: float = 1e-10, max_iter: int = 25, predictor: bool = True,
+                max_move: float | None = None) -> StepResult:
     """Solve Eqs. (19)-(20) for the step's du and p by Newton-Raphson. Converged when the residual of the free
     displacement rows and that of the pressure rows are below ``tol`` times their scales (:func:`assemble`), or
     below 100 tol and no longer falling (the round-off floor of a large system: the sums of many forces).
-    Nodes without a triangle keep p = 0 (and, quasi-static, du = 0). Raises :class:`NewtonFailed`."""
+    Nodes without a triangle keep p = 0 (and, quasi-static, du = 0). ``max_move``: no Newton correction moves a
+    node by more than this fraction of its local size sqrt(mean area of its triangles) (the whole correction scaled
+    down, before the line search; None: no limit). Where elements flow plastically the tangent is soft, and a node
+    on the tool (sliding, or frictionless) can get a correction of ten spacings from a residual that a few tenths
+    of one remove; the line search alone then crawls (chapter 12). Raises :class:`NewtonFailed`."""
     n = nodes.n
+    if max_move is not None:
+        a = np.repeat(np.abs(signed_areas(nodes.x, mesh.tri)), 3)
+        cnt = np.bincount(mesh.tri.ravel(), minlength=n)
+        size = np.sqrt(np.bincount(mesh.tri.ravel(), a, minlength=n) / np.maximum(cnt, 1))
+        size[cnt == 0] = np.inf
     fixed = np.asarray(loads.fixed, dtype=bool).copy()
     meshed = mesh.meshed
     if not dynamic:
@@ -360,8 +372,10 @@ def newton_step(nodes: Nodes, mesh: Mesh, hist: History, law: SolidLaw, dt: floa
         step = spsolve(Kf, -(R_free + keep @ (Kg @ lift))) + lift
         if not np.all(np.isfinite(step)):
             break
-        s = 1.0                                                   # backtracking on the scaled residual (a contact
-        for _ls in range(12):                                     # that switches on and off, an inverted triangle)
+        s = 1.0 if max_move is None else min(1.0, max_move / max(float(np.max(
+            np.hypot(step[0:2 * n:2], step[1:2 * n:2]) / size)), 1e-300))      # the step limit (docstring)
+        for _ls in range(12):                                     # backtracking on the scaled residual (a contact
+            #                                                       that switches on and off, an inverted triangle)
             trial = evaluate(du + s * step[:2 * n].reshape(n, 2), p + s * step[2 * n:], False)
             common = (max(scale[0], trial[3][0]), max(scale[1], trial[3][1]))   # both points on one scale (a
             m0, mt = norms(R, common)[1], norms(trial[0], common)[1]            # stress-free start has a tiny one)
@@ -385,11 +399,13 @@ def _residual(nodes, mesh, hist, law, du, p, dt, dynamic, f_ext, contact, tangen
     scale = (float(np.sqrt(scale[0] ** 2 + np.sum(f_ext**2) + floor**2)), scale[1])
     fc = None
     if contact is not None:
-        fc, kc = contact(nodes.x + du)
+        fc, kc = contact(nodes.x + du, stiffness=tangent)
         R[:2 * n] -= fc.ravel()
         scale = (float(np.hypot(scale[0], np.linalg.norm(fc))), scale[1])
-        if Kg is not None:
-            Kg = Kg - sp.block_diag([sp.block_diag(list(kc)), sp.csr_matrix((n, n))], format="csr")
+        if Kg is not None:                                # each node's 2 x 2 block df_i/dx_i on the diagonal
+            i = np.arange(2 * n).reshape(n, 2)
+            rows, cols = np.repeat(i, 2, axis=1).ravel(), np.tile(i, (1, 2)).ravel()
+            Kg = Kg - sp.csr_matrix((kc.reshape(-1), (rows, cols)), shape=(3 * n, 3 * n))
     return R, Kg, resp, scale, fc
 
 

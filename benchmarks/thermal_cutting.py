@@ -5,6 +5,7 @@ that say which digits of them mean something (issue 22).
     python benchmarks/thermal_cutting.py                     # every run not yet recorded, in jobs() order, 2 processes
     python benchmarks/thermal_cutting.py --jobs 1 --study tool scatter   # only these studies, one process
     python benchmarks/thermal_cutting.py --study cases --only 1 4 7      # some of the 18 cases
+    python benchmarks/thermal_cutting.py --study pfem --only 1 10        # the PFEM's cuts of cases 1 and 10
     python benchmarks/thermal_cutting.py --scheduler tcp://HOST:8786     # the same on a dask.distributed cluster
     python benchmarks/thermal_cutting.py --redo "case 3"     # run one again (a failed record is kept until then)
     python benchmarks/thermal_cutting.py --report            # page and figures from the committed JSON only
@@ -81,18 +82,21 @@ def _s(case: int) -> float:
     return mass_scale_for(MATERIALS[row["material"]], row["vc_m_per_min"] / 60.0, INERTIA)
 
 
-STUDY_NAMES = ("cases", "coarse", "scaling", "scatter", "resolution", "tool", "contact")
+STUDY_NAMES = ("cases", "coarse", "pfem", "scaling", "scatter", "resolution", "tool", "contact")
 COARSE = " n_tu 5"                         # the key suffix of the 'coarse' study: all 18 cases at dx = t_u / 5
+PFEM = " pfem n_tu 5"                      # the key suffix of the 'pfem' study: the 18 cases with the PFEM at t_u / 5
+PFEM_OPTIONS = ("case", "n_tu", "travel", "length")     # the sweep's options the PFEM cut takes (its tool is TOOL)
 
 
 def jobs(studies=STUDY_NAMES, only=None) -> dict:
     """{key: (scene options, Numerics overrides)} of the runs asked for, in the order they run (a sweep that spans
     sessions does the informative ones first: case 1 and what tests its numerics, then the 18 cases, then the
-    long resolution checks). ``only``: case numbers (the 'cases' study)."""
+    long resolution checks). ``only``: case numbers (of the 'cases', 'coarse' and 'pfem' studies)."""
     todo = {}
 
     def add(study_name, key, options, numerics=None):
-        if study_name in studies and (study_name != "cases" or only is None or options["case"] in only):
+        if study_name in studies and (study_name not in ("cases", "coarse", "pfem") or only is None
+                                      or options["case"] in only):
             todo[key] = (options, dict(numerics or {}))
     add("cases", "case 1", converged(1))
     for seed in (1, 2, 3):                                   # the scatter: first at t_u/5 (an eighth of the cost)
@@ -101,6 +105,8 @@ def jobs(studies=STUDY_NAMES, only=None) -> dict:
         if n == 1 or n == 10:
             add("resolution", f"case {n}{COARSE}", converged(n, n_tu=5.0))
         add("coarse", f"case {n}{COARSE}", converged(n, n_tu=5.0))
+    for n in [1, 10] + [k for k in range(2, 19) if k != 10]:   # the PFEM: cases 1 and 10 first
+        add("pfem", f"case {n}{PFEM}", converged(n, n_tu=5.0), dict(method="pfem"))
     add("scaling", "case 1 s/2", converged(1, mass_scale=_s(1) / 2))
     add("cases", "case 10", converged(10))
     add("scaling", "case 10 s/2", converged(10, mass_scale=_s(10) / 2))
@@ -124,15 +130,24 @@ QUICK = dict(length=1.2e-3, travel=4.0, n_tu=5.0)   # --quick: chapter 11's shor
 
 
 def run_case(key: str, options: dict, numerics: dict, quick: bool = False) -> dict:
-    """One run (continued from its checkpoint if an earlier attempt was killed); its record."""
+    """One run (continued from its checkpoint if an earlier attempt was killed); its record. ``numerics`` with
+    method 'pfem': the PFEM cut (:mod:`refsph.pfem_run`) with the options it takes (PFEM_OPTIONS; its tool is the
+    sweep's, TOOL)."""
     from refsph.simulate import SimulationError, run
     out = RUNS / (key.replace(" ", "_").replace("/", "") + ("_quick" if quick else ""))
     restart = (out / "snapshots" / "restart.npz").exists()
     t0 = time.perf_counter()
     rec = dict(key=key, options=options, numerics=numerics, quick=quick)
     try:
-        res = run("thermal_cutting", "tlsph", out=out, progress=False, restart=restart, quick=quick,
-                  options=dict(options, **(QUICK if quick else {})), numerics=dict(numerics, threads=1))
+        if numerics.get("method") == "pfem":
+            from refsph.pfem_run import run_pfem
+            if any(options.get(k, v) != v for k, v in TOOL.items()):
+                raise ValueError(f"the PFEM cut's tool is {TOOL}, asked {options}")
+            res = run_pfem("thermal_cutting", out=out, progress=False, restart=restart, quick=quick,
+                           options={k: options[k] for k in PFEM_OPTIONS if k in options and (k == "case" or not quick)})
+        else:
+            res = run("thermal_cutting", "tlsph", out=out, progress=False, restart=restart, quick=quick,
+                      options=dict(options, **(QUICK if quick else {})), numerics=dict(numerics, threads=1))
         s = res.summary
     except SimulationError as e:
         s = json.loads((out / "summary.json").read_text())
@@ -253,6 +268,10 @@ def report(res: dict, before: dict | None = None) -> str:
     coarse = comparison(res, COARSE)
     lines += ["", P("coarse", done=sum(r["status"] == "ok" for r in coarse))] + [_case_line(r) for r in coarse]
     lines += ["", P("coarse_errors")] + _mean_error_lines(coarse, old)
+    pfem = comparison(res, PFEM)
+    lines += ["", P("pfem", done=sum(r["status"] == "ok" for r in pfem))] + [_case_line(r) for r in pfem]
+    lines += ["", P("pfem_errors")] + _mean_error_lines(pfem, old)
+    lines += ["", P("pfem_forces")] + [_pfem_force_line(r, res) for r in pfem]
     lines += ["", P("forces")]
     for r in rows:
         lines.append(f"| {r['case']} | {_f(r['Fc_N_per_mm'], '.1f')} | {_f(r['Fp_N_per_mm'], '.1f')} | "
@@ -273,6 +292,18 @@ def report(res: dict, before: dict | None = None) -> str:
     lines += ["", P("total", n=len(recorded), minutes=f"{sum(r['wall_time_s'] for r in recorded) / 60:.1f}",
                     todo=len(todo), keys=", ".join(f"'{k}'" for k in todo) or "none"), ""]
     return "\n".join(lines)
+
+
+def _pfem_force_line(r: dict, res: dict) -> str:
+    """A PFEM case's forces next to refsph's SPH at the same spacing, with the cost of each."""
+    sph = res["runs"].get(f"case {r['case']}{COARSE}") or {}
+    pf = res["runs"].get(f"case {r['case']}{PFEM}") or {}
+    m = sph.get("metrics", {}) if sph.get("status") == "ok" else {}
+    fc = 1e-3 * m["cutting_force_N_per_m"] if "cutting_force_N_per_m" in m else None
+    return (f"| {r['case']} | {_f(r['Fc_N_per_mm'], '.1f')} | {_f(fc, '.1f')} | {_f(r['Fp_N_per_mm'], '.1f')} | "
+            f"{_f(r['chip_mm'], '.3f')} | {_f(m.get('chip_thickness_mm'), '.3f')} | {_f(r['contact_mm'], '.3f')} | "
+            f"{_f(pf.get('n_particles'), 'd')} | {_f(sph.get('n_particles'), 'd')} | "
+            f"{_f(pf.get('wall_time_s'), '.0f')} | {_f(sph.get('wall_time_s'), '.0f')} |")
 
 
 def _mean_error_lines(rows: list, old: list | None) -> list[str]:

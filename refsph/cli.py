@@ -61,8 +61,10 @@ def _parser() -> argparse.ArgumentParser:
     r.add_argument("--restart", default=None, metavar="RUN_DIR",
                    help="continue the run in RUN_DIR from its last snapshot, with the arguments it was started with "
                         "(bit for bit the same as the uninterrupted run)")
-    r.add_argument("--method", choices=METHODS + ("both",), default=None,
-                   help="formulation (default: the scene's; 'both' runs ESPH then TLSPH)")
+    r.add_argument("--method", choices=METHODS + ("both", "pfem"), default=None,
+                   help="formulation (default: the scene's; 'pfem': the Particle Finite Element Method, for "
+                        "thermal_cutting; 'both' runs ESPH then TLSPH, or for a scene with a PFEM version its SPH "
+                        "method then the PFEM)")
     r.add_argument("--dim", type=int, choices=(2, 3), default=None, help="dimension (default: the scene's)")
     r.add_argument("--dp", type=float, default=None, help="particle spacing [m] (default: the scene's)")
     r.add_argument("--t-end", type=float, default=None, help="end time [s] (default: the scene's)")
@@ -200,7 +202,9 @@ def _restart(args, extra=()) -> int:
         print(f"refsph: --restart continues the run in RUN_DIR with the scene and settings of its summary.json; it "
               f"takes no {', '.join(given + list(extra))} (only --quiet)", file=sys.stderr)
         return 2
-    res, code = _attempt(lambda: restart_run(args.restart, progress=not args.quiet))
+    from .pfem_run import is_pfem_run, restart_pfem
+    again = restart_pfem if is_pfem_run(args.restart) else restart_run
+    res, code = _attempt(lambda: again(args.restart, progress=not args.quiet))
     if code:
         return code
     s = res.summary
@@ -249,10 +253,18 @@ def _run(args, extra) -> int:
         print(f"refsph: {e}", file=sys.stderr)
         return 2
     dim = args.dim if args.dim is not None else scene.default_dim
-    methods = scene.methods if args.method is None else (METHODS if args.method == "both" else (args.method,))
+    from .pfem_run import PFEM_SCENES
+    both = tuple(scene.methods) + ("pfem",) if args.scene in PFEM_SCENES else METHODS
+    methods = scene.methods if args.method is None else (both if args.method == "both" else (args.method,))
+    if "pfem" in methods:
+        code = _pfem_refusals(args, dim)
+        if code:
+            return code
     summaries = []
     if len(methods) > 1:                               # both methods' refusals before either runs
         for method in methods:
+            if method == "pfem":
+                continue
             _, code = _attempt(lambda: check_run(args.scene, method, dim=dim, dp=args.dp, t_end=args.t_end,
                                                  quick=args.quick, dt=args.dt, options=options, numerics=numerics,
                                                  particles=args.particles))
@@ -262,10 +274,18 @@ def _run(args, extra) -> int:
         out = args.out or f"runs/{args.scene}-{method}-{dim}d"
         if args.out and len(methods) > 1:
             out = f"{args.out}/{method}"
-        res, code = _attempt(lambda: run(args.scene, method, dim=dim, dp=args.dp, t_end=args.t_end, out=out,
-                                         quick=args.quick, dt=args.dt, progress=not args.quiet, options=options,
-                                         numerics=numerics, particles=args.particles,
-                                         overwrite=args.overwrite))
+        if method == "pfem":
+            from .pfem_run import run_pfem
+            out = args.out or f"runs/{args.scene}-pfem-2d"
+            if args.out and len(methods) > 1:
+                out = f"{args.out}/pfem"
+            res, code = _attempt(lambda: run_pfem(args.scene, out=out, options=options, quick=args.quick,
+                                                  progress=not args.quiet, overwrite=args.overwrite))
+        else:
+            res, code = _attempt(lambda: run(args.scene, method, dim=dim, dp=args.dp, t_end=args.t_end, out=out,
+                                             quick=args.quick, dt=args.dt, progress=not args.quiet,
+                                             options=options, numerics=numerics, particles=args.particles,
+                                             overwrite=args.overwrite))
         if code:
             return code
         s = res.summary
@@ -279,6 +299,24 @@ def _run(args, extra) -> int:
     if scene.report is not None:
         print()
         print(scene.report(summaries))
+    return 0
+
+
+def _pfem_refusals(args, dim) -> int:
+    """2 with a message if the PFEM cannot take what was asked (it is 2D, its spacing and end come from the scene
+    options, it has no SPH numerics); 0 otherwise."""
+    from .pfem_run import PFEM_SCENES
+    if args.scene not in PFEM_SCENES:
+        print(f"refsph: scene {args.scene!r} has no PFEM version (PFEM scenes: {', '.join(PFEM_SCENES)})",
+              file=sys.stderr)
+        return 2
+    given = [flag for flag, value in (("--dp", args.dp), ("--t-end", args.t_end), ("--dt", args.dt),
+                                      ("--set", args.set or None), ("--from", args.particles)) if value is not None]
+    if dim != 2 or given:
+        what = ", ".join(given + ([f"--dim {dim}"] if dim != 2 else []))
+        print(f"refsph: the PFEM cut is 2D and takes its spacing and length from the scene options (n_tu, travel; "
+              f"'refsph list'), not {what}", file=sys.stderr)
+        return 2
     return 0
 
 

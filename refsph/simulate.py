@@ -672,7 +672,8 @@ def _tolerant(metrics):
 
 def restart_run(run_dir, progress: bool = True) -> RunResult:
     """Continue the run in ``run_dir`` (made by :func:`run` / ``refsph run``) from its last checkpoint, with the
-    arguments it was started with (``summary.json``'s ``run_args``)."""
+    arguments it was started with (``summary.json``'s ``run_args``). A PFEM run folder is continued by
+    :func:`refsph.pfem_run.restart_pfem` (``refsph run --restart`` takes either)."""
     path = Path(run_dir) / "summary.json"
     try:
         summary = json.loads(path.read_text())

@@ -85,7 +85,8 @@ EQUATION_MODULES = {f"refsph.{m}" for m in (
     "kernels", "esph", "tlsph", "material", "plasticity", "strength", "contact", "penalty", "thermal", "surface",
     "neighbours", "tensor", "state", "boundaries", "integrate", "stability", "paper_data")}
 RUN_LOOP_MODULES = {"refsph", "refsph.simulate", "refsph.solvers", "refsph.reference", "refsph.coupling",
-                    "refsph.cli", "refsph.io"}  # refsph: the root; reference, coupling: parts of the TLSPH solver
+                    "refsph.cli", "refsph.io", "refsph.pfem_run"}   # refsph: the root; reference, coupling: parts of
+#                                                   the TLSPH solver; pfem_run: the PFEM's run folders
 FLAT_LAYERS = {"equations": EQUATION_MODULES, "run loop": RUN_LOOP_MODULES}
 FOLDER_LAYERS = {"scenes": "refsph.scenes", "pfem": "refsph.pfem", "crosscheck": "refsph.crosscheck",
                  "teaching": "refsph.teaching"}

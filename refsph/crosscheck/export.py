@@ -1,10 +1,11 @@
 """``refsph export RUN_DIR --vtk``: a run's snapshots as a time series ParaView opens.
 
-One VTU file per snapshot (the particles as vertex cells, every snapshot array as point data: vectors as 3 components,
-tensors as 9; a 2D run's tensors get their plane-strain zz component: S_zz for S (the snapshot's own array), 1 for the
-deformation gradient F (no stretch across the plane, so ParaView's det F is J), 0 otherwise) and a ParaView collection
-``RUN_DIR/vtk/run.pvd`` that gives each file its time. The file format is written by meshio (an optional extra: ``pip
-install -e '.[vtk]'``), not by hand; the units of every field go into the collection's comments and ``vtk/units.json``.
+One VTU file per snapshot (the particles as vertex cells, a PFEM run's nodes with its triangles as cells, every
+snapshot array as point data: vectors as 3 components, tensors as 9; a 2D run's tensors get their plane-strain zz
+component: S_zz for S (the snapshot's own array), 1 for the deformation gradient F (no stretch across the plane, so
+ParaView's det F is J), 0 otherwise) and a ParaView collection ``RUN_DIR/vtk/run.pvd`` that gives each file its time.
+The file format is written by meshio (an optional extra: ``pip install -e '.[vtk]'``), not by hand; the units of every
+field go into the collection's comments and ``vtk/units.json``.
 """
 from __future__ import annotations
 
@@ -19,11 +20,14 @@ from ..io import load_run, load_snapshot
 __all__ = ["export_vtk"]
 
 
+MESH_ARRAYS = ("triangles", "boundary_edges", "tool_x", "tool_T")   # a PFEM snapshot's mesh and tool (refsph.pfem_run)
+
+
 def _point_data(z: dict, d: int) -> dict:
     out = {}
     n = len(z["x"])
     for k, a in z.items():
-        if k in ("t", "units") or not isinstance(a, np.ndarray) or a.shape[:1] != (n,):
+        if k in ("t", "units") + MESH_ARRAYS or not isinstance(a, np.ndarray) or a.shape[:1] != (n,):
             continue
         if a.ndim == 2 and a.shape[1] == d:                 # vectors -> 3 components
             b = np.zeros((n, 3))
@@ -60,7 +64,8 @@ def export_vtk(run_dir) -> Path:
         pts = np.zeros((n, 3))
         pts[:, :d] = x
         units = z["units"]
-        mesh = meshio.Mesh(pts, [("vertex", np.arange(n).reshape(-1, 1))], point_data=_point_data(z, d))
+        cells = [("triangle", z["triangles"])] if "triangles" in z else [("vertex", np.arange(n).reshape(-1, 1))]
+        mesh = meshio.Mesh(pts, cells, point_data=_point_data(z, d))
         name = p.stem + ".vtu"
         mesh.write(out / name)
         entries.append(f'    <DataSet timestep="{z["t"]!r}" group="" part="0" file="{escape(name)}"/>')

@@ -14,40 +14,79 @@ on); the history goes to the nodes and the nodes are meshed again (remeshing eve
 is retried at half the step (up to four times). dt = ``courant`` dx / v_c: the tool moves a fraction of the finest
 spacing per step (the mesh, not stability, limits it).
 
-**Status (issue 24): the first tool contact is passed, the 18 cuts are not yet run.** Newton-Raphson had stalled
-at the first contact (at a scaled residual ~0.3, however small the step): the trapezoidal rule's velocities ring
-at an impact, and the predictor du = dt v drove the contact nodes deep into the tool. Each step now starts from
-du = 0 and freezes the contact and slip sets within a Newton solve
-(:func:`~refsph.pfem.contact.solve_with_active_set`). The quick cut (case 1, t_u/5, 4 t_u) then went past the
-first contact, at steps halved a few times, to 0.78 t_u (Fc about 110 N/mm, eps_p 0.8), where a Newton solve
-still needed more than 25 iterations at dt / 32 (with a damped Newmark rule, gamma = 0.7, the same at 0.79 t_u);
-allowed 80 iterations (now the default; 43 were needed once) it went on past 1 t_u.
-A flat contact with friction works (``tests/test_pfem.py``:
-stick, then slide at F_T / F_N = mu to round-off).
+**Heat** (``conduction``, on by default; :class:`CutHeat`): after each mechanical step, one backward-Euler step of
+Eq. (22) (:func:`refsph.pfem.thermal.thermal_step`) on the workpiece's mesh and the tool's, solved together: the
+plastic heat of the step (Eq. (5), chi dW_p A of each triangle, a third to each node) and the frictional heat
+(Eq. (7), eta |f_T| |slip| of each sliding node, ``chip_fraction`` of it to the node, the rest to the nearest tool
+node) as sources; conduction in both bodies; between them a contact conductance (:func:`~refsph.pfem.thermal.
+contact_conductance`) from each workpiece node that carries a contact force to the nearest tool node, h_int =
+(2 k_w k_t / (k_w + k_t)) / dx: the two bodies' harmonic-mean conductivity over one spacing, i.e. contact as good
+as the material itself (the paper gives no interface conductance); the tool's top and back faces and the
+workpiece's held bottom row and left column at 293 K; convection and radiation (Eq. (6)) on both bodies' free
+boundary edges (the alpha-shape's; edges in contact left out). The tool is a lattice of nodes like the SPH scene's
+tool particles (same size, the paper's reduced c_p = 15 J/(kg K)), meshed once and moved rigidly. The heat ledger
+(``CutRun.ledger``) closes to round-off. ``conduction=False``: adiabatic (the plastic heat stays where it is made).
+
+**Newton-Raphson at the tool.** At the first contact Newton-Raphson used to stall (a scaled residual ~0.3 for tens
+of iterations, then a halved step): a node on the tool, where the flowing elements' tangent is soft, got a
+correction of about 12 spacings from a residual that a few tenths of one remove, and the line search crawled. Each
+step starts from du = 0, freezes the contact and slip sets within a Newton solve
+(:func:`~refsph.pfem.contact.solve_with_active_set`), and limits each correction to ``max_move`` = 0.05 of a node's
+local size (:func:`~refsph.pfem.solid.newton_step`). The quick cut's first 15 steps: 140 s and 10 halved steps with a
+limit of 0.25, 43 s and 1 with 0.05.
 
 The measures are the SPH scene's own functions (:func:`refsph.scenes.thermal_cutting.chip_measures`,
 :func:`~refsph.scenes.thermal_cutting.thermal_cutting_metrics`), so the two methods are measured alike.
 """
 from __future__ import annotations
 
+import json
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 
 import numpy as np
+from scipy.spatial import cKDTree
 
 from ..contact import CoulombFriction
-from ..paper_data import AISI1045_RLA, CONTACT_RLA, TI6AL4V_RLA, rla_cutting_case
+from ..paper_data import AISI1045_RLA, CONTACT_RLA, RLA_SURFACE_LOSS, TI6AL4V_RLA, TOOL_CARBIDE_RLA, rla_cutting_case
 from ..plasticity import JohnsonCook, ModifiedJohnsonCook
 from ..scenes.thermal_cutting import (CLEARANCE_DEG, EDGE_RADIUS, RAKE_DEG, chip_measures, thermal_cutting_metrics,
-                                      tool_shape)
+                                      tool_particles, tool_shape)
+from ..thermal import SurfaceLoss
 from .contact import StepContact, ToolContact, boundary_lengths, solve_with_active_set
-from .mesh import alpha_shape_mesh, remesh_needed
-from .solid import (TRAPEZOIDAL, Loads, Newmark, NewtonFailed, SolidLaw, commit, history_from_nodes, make_nodes,
-                    settle_nodes, transfer_history)
+from .mesh import Mesh, alpha_shape_mesh, boundary_edges, remesh_needed, signed_areas
+from .solid import (TRAPEZOIDAL, History, Loads, Newmark, NewtonFailed, Nodes, SolidLaw, commit, history_from_nodes,
+                    make_nodes, plastic_heat, settle_nodes, transfer_history)
+from .thermal import contact_conductance, thermal_step
 
-__all__ = ["PFEMCut", "graded_workpiece", "pfem_cut", "run_pfem_cut"]
+__all__ = ["PFEMCut", "CutHeat", "CutRun", "graded_workpiece", "pfem_cut", "heat_step", "run_pfem_cut"]
 
 MATERIALS = {"AISI1045": AISI1045_RLA, "Ti6Al4V": TI6AL4V_RLA}
+HISTORY_KEYS = ("t", "T_RF", "T_RF_max", "T_FCS", "chip_mm", "contact_mm", "max_T", "max_eps_p")
+LEDGER = ("plastic", "friction", "friction_to_tool", "stored", "lost", "removed")
+
+
+@dataclass
+class CutHeat:
+    """The cut's heat model (module text): the workpiece's k [W/(m K)] and c_p [J/(kg K)]; the tool's nodes ``x_tool``
+    (P, 2) at t = 0, its triangles ``tool_tri`` (Q, 3), its k, and m c_p of each tool node ``tool_mc`` (P,) [J/(m K)];
+    ``tool_fixed`` (tool node indices held at ``T_fixed``), the workpiece's ``work_fixed`` (node indices) likewise;
+    ``h_int`` [W/(m^2 K)] the contact conductance; ``loss`` the losses of Eq. (6); ``chip_fraction`` of the frictional
+    heat into the workpiece; ``eta`` the fraction of the frictional work that becomes heat. No defaults."""
+
+    k_work: float
+    cp_work: float
+    x_tool: np.ndarray
+    tool_tri: np.ndarray
+    k_tool: float
+    tool_mc: np.ndarray
+    tool_fixed: np.ndarray
+    work_fixed: np.ndarray
+    T_fixed: float
+    h_int: float
+    loss: SurfaceLoss
+    chip_fraction: float
+    eta: float
 
 
 @dataclass
@@ -55,10 +94,11 @@ class PFEMCut:
     """A PFEM cut as data: the nodes (:class:`refsph.pfem.solid.Nodes`), their spacing ``h`` (N,) [m] (the
     alpha-shape's local size), the held components ``fixed`` (N, 2), the ``law``, the tool (``shape``, its core's
     position ``shift0`` at t = 0 and velocity ``v_tool`` [m/s]), the ``contact``, ``alpha``, the step ``dt`` and
-    ``t_end`` [s], the initial positions ``X0`` and ``info`` (the SPH scene's keys, for the measures); a remeshing
-    every ``remesh_every`` steps and whenever a triangle's quality drops below ``remesh_quality``; ``newmark`` the
-    time rule (the paper's trapezoidal rule by default); ``max_iter`` Newton iterations per solve; ``max_move`` the
-    largest Newton correction of a node, in its local sizes (:func:`refsph.pfem.solid.newton_step`)."""
+    ``t_end`` [s], the initial positions ``X0`` and ``info`` (the SPH scene's keys, for the measures); ``heat`` the
+    heat model (:class:`CutHeat`; None: adiabatic); a remeshing every ``remesh_every`` steps and whenever a
+    triangle's quality drops below ``remesh_quality``; ``newmark`` the time rule (the paper's trapezoidal rule by
+    default); ``max_iter`` Newton iterations per solve; ``max_move`` the largest Newton correction of a node, in its
+    local sizes (:func:`refsph.pfem.solid.newton_step`)."""
 
     nodes: object
     h: np.ndarray
@@ -73,6 +113,7 @@ class PFEMCut:
     t_end: float
     X0: np.ndarray
     info: dict = field(default_factory=dict)
+    heat: CutHeat | None = None
     remesh_every: int = 1
     remesh_quality: float = 0.3
     newmark: Newmark = TRAPEZOIDAL
@@ -95,14 +136,23 @@ def graded_workpiece(length: float, tu: float, dx: float) -> tuple[np.ndarray, n
 
 
 def pfem_cut(case: int, n_tu: float = 10.0, travel: float = 16.0, length: float | None = None,
-             courant: float = 0.25, alpha: float = 1.4, penalty: float = 200.0, friction: bool = True) -> PFEMCut:
+             courant: float = 0.25, alpha: float = 1.4, penalty: float = 20.0, friction: bool = True,
+             conduction: bool = True, chip_fraction: float = 0.5) -> PFEMCut:
     """The cut of row ``case`` of the paper's Appendix B: dx = t_u / n_tu, ``travel`` t_u of cut on a workpiece
-    ``length`` [m] long (default (travel + 12) t_u), dt = courant dx / v_c, contact penalties ``penalty`` G / dx."""
+    ``length`` [m] long (default (travel + 12) t_u), dt = courant dx / v_c, contact penalties ``penalty`` G / dx;
+    ``conduction``: the heat step (module text; False: adiabatic), ``chip_fraction`` of the frictional heat into
+    the chip."""
     row = rla_cutting_case(int(case))
     mat = MATERIALS[row["material"]]
     vc, tu = row["vc_m_per_min"] / 60.0, row["tu_mm"] * 1e-3
     dx = tu / n_tu
     length = (travel + 12.0) * tu if length is None else length
+    if not (n_tu >= 2 and travel > 0 and length > 1.25 * travel * tu and courant > 0 and penalty > 0
+            and 0.0 <= chip_fraction <= 1.0):
+        raise ValueError(f"PFEM cut: need n_tu >= 2, travel > 0, a cut within 80 % of the workpiece, courant > 0, "
+                         f"penalty > 0 and 0 <= chip_fraction <= 1; got n_tu = {n_tu!r}, travel = {travel!r} tu, "
+                         f"length = {length!r} m, courant = {courant!r}, penalty = {penalty!r}, "
+                         f"chip_fraction = {chip_fraction!r}")
     x, h = graded_workpiece(length, tu, dx)
     H = 3.0 * tu
     y0 = H - tu
@@ -115,7 +165,8 @@ def pfem_cut(case: int, n_tu: float = 10.0, travel: float = 16.0, length: float 
     law = SolidLaw(rho0=mat["rho"], G=E / (2 * (1 + nu)), K=E / (3 * (1 - 2 * nu)), alpha_T=0.0, T_ref=T0,
                    strength=strength)
     apex = np.array([x[:, 0].max() + 0.5 * dx, y0])
-    centroid = apex + np.array([2.0 * tu, 2.0 * tu])
+    xt, tool_held = tool_particles(dx, tu, apex, 10.0, 6.0)
+    centroid = xt.mean(axis=0)
     shape = tool_shape(tu, apex, centroid, 10.0, 6.0)
     mu = CoulombFriction(mu0=mat["mu0"], q=mat["q_friction"], T_room=T0, T_melt=mat["T_melt_K"]) if friction else None
     contact = ToolContact(k_normal=penalty * law.G / dx, k_tangent=penalty * law.G / dx, friction=mu)
@@ -123,65 +174,208 @@ def pfem_cut(case: int, n_tu: float = 10.0, travel: float = 16.0, length: float 
     fixed[(x[:, 1] < 1e-12) | (x[:, 0] < 1e-12)] = True
     A_cell = np.where(h > dx * 1.5, 4 * dx * dx, dx * dx)
     nodes = make_nodes(x, mat["rho"] * A_cell, T0)
+    heat = None
+    if conduction:
+        tool = TOOL_CARBIDE_RLA
+        tmesh = alpha_shape_mesh(xt, 1.4, np.full(len(xt), dx))
+        area = np.repeat(np.abs(signed_areas(xt, tmesh.tri)) / 3.0, 3)
+        tool_mc = tool["rho"] * tool["cp_J_kgK"] * np.bincount(tmesh.tri.ravel(), area, minlength=len(xt))
+        k_w, k_t = mat["k_W_mK"], tool["k_W_mK"]
+        heat = CutHeat(k_work=k_w, cp_work=mat["cp_J_kgK"], x_tool=xt, tool_tri=tmesh.tri, k_tool=k_t,
+                       tool_mc=tool_mc, tool_fixed=np.flatnonzero(tool_held), work_fixed=np.flatnonzero(fixed[:, 0]),
+                       T_fixed=T0, h_int=2.0 * k_w * k_t / (k_w + k_t) / dx,
+                       loss=SurfaceLoss(**RLA_SURFACE_LOSS, T_ambient=T0), chip_fraction=float(chip_fraction),
+                       eta=CONTACT_RLA["friction_work_to_heat"])
     info = dict(case=int(case), material=row["material"], vc_m_s=vc, tu_m=tu, dx=dx, length_m=float(x[:, 0].max()),
-                height_m=H, y0=y0, n_work=len(x), travel_m=travel * tu, mass_scale=1.0,
+                height_m=H, y0=y0, n_work=len(x), n_tool=len(xt), travel_m=travel * tu, mass_scale=1.0,
                 inertia_ratio=mat["rho"] * vc * vc / mat["A_Pa"], rake_deg=RAKE_DEG, clearance_deg=CLEARANCE_DEG,
                 edge_radius_m=EDGE_RADIUS, apex0=apex.tolist(), measured=row, method="pfem", alpha=alpha,
-                courant=courant, penalty=penalty)
+                courant=courant, penalty=penalty, conduction=bool(conduction), chip_fraction=float(chip_fraction),
+                h_int=None if heat is None else heat.h_int)
     return PFEMCut(nodes=nodes, h=h, fixed=fixed, law=law, shape=shape, shift0=centroid, v_tool=np.array([-vc, 0.0]),
-                   contact=contact, alpha=alpha, dt=courant * dx / vc, t_end=travel * tu / vc, X0=x.copy(), info=info)
+                   contact=contact, alpha=alpha, dt=courant * dx / vc, t_end=travel * tu / vc, X0=x.copy(), info=info,
+                   heat=heat)
 
 
-def run_pfem_cut(cut: PFEMCut, progress=None, max_steps: int | None = None) -> dict:
-    """Algorithm 1 to t_end (module text); the run's history and metrics (the SPH scene's keys), its nodes and mesh
-    at the end, and the Newton record (iterations per step, retries, wall time)."""
-    nodes, law, info = cut.nodes, cut.law, cut.info
-    hist = {k: [] for k in ("t", "T_RF", "T_RF_max", "T_FCS", "chip_mm", "contact_mm", "max_T", "max_eps_p")}
-    reaction = dict(t=[], dt=[], tool=[])
-    f_T = np.zeros(nodes.n)
-    mesh = alpha_shape_mesh(nodes.x, cut.alpha, cut.h)
-    hist_e = history_from_nodes(nodes, mesh)
-    iters, retries, t0, step, remeshes = [], 0, time.perf_counter(), 0, 0
-    zero = np.zeros_like(nodes.x)
-    while nodes.t < cut.t_end * (1 - 1e-9) and (max_steps is None or step < max_steps):
+class CutRun:
+    """A PFEM cut in progress (Algorithm 1, one :meth:`step` at a time): the nodes, their mesh and the triangles'
+    history, the tool's temperatures, the contact's tangential forces, the recorded history, the heat ledger
+    (``ledger`` [J/m]: plastic, friction, friction_to_tool, stored, lost, removed) and the Newton record.
+    :meth:`checkpoint` / :meth:`restore` save and continue it exactly (the run folder's restart.npz)."""
+
+    def __init__(self, cut: PFEMCut):
+        self.cut = cut
+        self.nodes = cut.nodes
+        self.mesh = alpha_shape_mesh(self.nodes.x, cut.alpha, cut.h)
+        self.hist_e = history_from_nodes(self.nodes, self.mesh)
+        self.f_T = np.zeros(self.nodes.n)
+        self.T_tool = None if cut.heat is None else np.full(len(cut.heat.x_tool), cut.heat.T_fixed)
+        self.hist = {k: [] for k in HISTORY_KEYS}
+        self.reaction = dict(t=[], dt=[], tool=[])
+        self.iterations, self.retries, self.steps, self.remeshes, self.wall = [], 0, 0, 0, 0.0
+        self.ledger = {k: 0.0 for k in LEDGER}
+
+    @property
+    def done(self) -> bool:
+        return self.nodes.t >= self.cut.t_end * (1 - 1e-9)
+
+    def step(self):
+        """One step: the mechanics with the contact (halving the step up to four times if Newton fails), the heat
+        step, the remeshing and the measures; returns the converged :class:`refsph.pfem.solid.StepResult`."""
+        t0 = time.perf_counter()
+        cut, nodes, mesh = self.cut, self.nodes, self.mesh
         dt = min(cut.dt, cut.t_end - nodes.t)
-        for attempt in range(5):
+        zero = np.zeros_like(nodes.x)
+        for _ in range(5):
             t1 = nodes.t + dt
             contact = StepContact(cut.contact, cut.shape, cut.shift0 + cut.v_tool * t1, cut.v_tool * dt, nodes.x,
-                                  f_T, nodes.T, boundary_lengths(nodes.x, mesh.edges, nodes.n),
+                                  self.f_T, nodes.T, boundary_lengths(nodes.x, mesh.edges, nodes.n),
                                   np.flatnonzero(mesh.boundary))
             try:
-                r = solve_with_active_set(nodes, mesh, hist_e, law, dt, Loads(cut.fixed, zero, contact=contact),
+                r = solve_with_active_set(nodes, mesh, self.hist_e, cut.law, dt, Loads(cut.fixed, zero,
+                                                                                         contact=contact),
                                           dynamic=cut.newmark, max_iter=cut.max_iter, max_move=cut.max_move)
                 break
             except NewtonFailed as e:
-                dt, retries = 0.5 * dt, retries + 1
-                last_failure = e
+                dt, self.retries = 0.5 * dt, self.retries + 1
+                failure = e
         else:
             raise NewtonFailed(f"PFEM cut: Newton failed at t = {nodes.t:.3e} s even at dt = {dt:.2e} s",
-                               *last_failure.args[1:])
-        iters.append(r.iterations)
+                               *failure.args[1:])
+        self.iterations.append(r.iterations)
         nodes = commit(nodes, r, dt, cut.newmark)
         c = contact.last
-        f_T = c["f_T"]
+        self.f_T = c["f_T"]
         F_tool = -r.contact_force.sum(axis=0) if r.contact_force is not None else np.zeros(2)
-        settle_nodes(nodes, mesh, r, law.strength)
-        if remesh_needed(nodes.x, mesh, cut.remesh_quality) or step % cut.remesh_every == cut.remesh_every - 1:
-            new = alpha_shape_mesh(nodes.x, cut.alpha, cut.h)            # Algorithm 1: "if remeshing is needed"
-            hist_e, mesh = transfer_history(mesh, r.history, new, nodes), new
-            remeshes += 1
+        settle_nodes(nodes, mesh, r, cut.law.strength, heat=cut.heat is None)
+        if cut.heat is not None:
+            heat_step(self, nodes, mesh, r, contact, dt)
+        if remesh_needed(nodes.x, mesh, cut.remesh_quality) or self.steps % cut.remesh_every == cut.remesh_every - 1:
+            new = alpha_shape_mesh(nodes.x, cut.alpha, cut.h)              # Algorithm 1: "if remeshing is needed"
+            self.hist_e, self.mesh = transfer_history(mesh, r.history, new, nodes), new
+            self.remeshes += 1
         else:
-            hist_e = r.history
-        reaction["t"].append(nodes.t)
-        reaction["dt"].append(dt)
-        reaction["tool"].append(F_tool)
-        m = chip_measures(nodes.x, cut.X0, nodes.T, nodes.t, info)
+            self.hist_e = r.history
+        self.nodes = nodes
+        self.reaction["t"].append(nodes.t - 0.5 * dt)                     # the step's midpoint, as the SPH runs
+        self.reaction["dt"].append(dt)
+        self.reaction["tool"].append(F_tool)
+        m = chip_measures(nodes.x, cut.X0, nodes.T, nodes.t, cut.info)
         for k, v in dict(t=nodes.t, max_T=float(nodes.T.max()), max_eps_p=float(nodes.eps_p.max()), **m).items():
-            hist[k].append(v)
-        step += 1
+            self.hist[k].append(v)
+        self.steps += 1
+        self.wall += time.perf_counter() - t0
+        return r
+
+    def tool_x(self, t: float) -> np.ndarray:
+        """The tool's nodes at time t (moved rigidly)."""
+        return self.cut.heat.x_tool + self.cut.v_tool * t
+
+    def heat_balance(self) -> dict | None:
+        """The heat ledger [J/m] with its residual made - stored - lost - removed (made: plastic + friction)."""
+        if self.cut.heat is None:
+            return None
+        L = self.ledger
+        made = L["plastic"] + L["friction"]
+        res = made - L["stored"] - L["lost"] - L["removed"]
+        return dict(plastic_J=L["plastic"], friction_J=L["friction"], friction_to_tool_J=L["friction_to_tool"],
+                    stored_J=L["stored"], lost_J=L["lost"], removed_J=L["removed"], residual_J=res,
+                    residual_rel=res / made if made > 0 else 0.0)
+
+    def result(self) -> dict:
+        """The run's history and metrics (the SPH scene's keys), its nodes and mesh, the Newton record."""
+        hist = {k: list(v) for k, v in self.hist.items()}
+        hist["reaction"] = {k: np.asarray(v) for k, v in self.reaction.items()}
+        metrics = thermal_cutting_metrics(hist, self.cut.info, self.cut.t_end) if self.steps else {}
+        return dict(nodes=self.nodes, mesh=self.mesh, history=hist, metrics=metrics, newton_iterations=self.iterations,
+                    retries=self.retries, wall_time_s=self.wall, steps=self.steps, remeshes=self.remeshes,
+                    heat_balance=self.heat_balance(), T_tool=self.T_tool)
+
+    def checkpoint(self) -> dict:
+        """Everything :meth:`restore` needs, as arrays (one .npz)."""
+        out = {f"nodes/{f.name}": np.asarray(getattr(self.nodes, f.name)) for f in fields(Nodes)}
+        out.update({f"mesh/{k}": getattr(self.mesh, k) for k in ("tri", "edges", "boundary")})
+        out.update({f"hist/{f.name}": getattr(self.hist_e, f.name) for f in fields(History)
+                    if getattr(self.hist_e, f.name) is not None})
+        out["f_T"] = self.f_T
+        if self.T_tool is not None:
+            out["T_tool"] = self.T_tool
+        out["record"] = np.array(json.dumps(dict(
+            hist=self.hist, reaction={k: np.asarray(v).tolist() for k, v in self.reaction.items()},
+            iterations=self.iterations, retries=self.retries, steps=self.steps, remeshes=self.remeshes, wall=self.wall,
+            ledger=self.ledger)))
+        return out
+
+    @classmethod
+    def restore(cls, cut: PFEMCut, arrays: dict) -> "CutRun":
+        """The run a :meth:`checkpoint` saved, continued with ``cut`` (the same scene)."""
+        run = cls.__new__(cls)
+        run.cut = cut
+        kw = {f.name: arrays[f"nodes/{f.name}"] for f in fields(Nodes)}
+        kw["t"] = float(kw["t"])
+        run.nodes = Nodes(**kw)
+        run.mesh = Mesh(tri=arrays["mesh/tri"], edges=arrays["mesh/edges"], boundary=arrays["mesh/boundary"],
+                        alpha=cut.alpha)
+        run.hist_e = History(**{f.name: arrays.get(f"hist/{f.name}") for f in fields(History)})
+        run.f_T = arrays["f_T"]
+        run.T_tool = arrays.get("T_tool")
+        rec = json.loads(str(arrays["record"]))
+        run.hist = rec["hist"]
+        run.reaction = {k: [np.asarray(row) if k == "tool" else row for row in v] for k, v in rec["reaction"].items()}
+        run.iterations, run.retries, run.steps = rec["iterations"], rec["retries"], rec["steps"]
+        run.remeshes, run.wall, run.ledger = rec["remeshes"], rec["wall"], rec["ledger"]
+        return run
+
+
+def heat_step(run: "CutRun", nodes: Nodes, mesh: Mesh, r, contact: StepContact, dt: float) -> None:
+    """The heat step of the cut (module text), in place: nodes.T, the tool's temperatures and the ledger of ``run``.
+    The frictional work of a node is |f_T| times its slip less the elastic part (f_T^n - f_T) / (k_T l) of it: what
+    the return map dissipates (zero where the node sticks)."""
+    hm, n, c = run.cut.heat, nodes.n, contact.last
+    xt = run.tool_x(nodes.t)
+    q_p = plastic_heat(mesh, r, run.cut.law.strength, n)                      # [J/m] per node
+    kl = contact.p.k_tangent * np.maximum(contact.length, 1e-300)
+    q_f = hm.eta * np.abs(c["f_T"]) * np.abs(c["slip"] - (contact.f_T_n - c["f_T"]) / kl)
+    q_f[c["f_N"] <= 0] = 0.0
+    touching = np.flatnonzero(c["f_N"] > 0)
+    nearest = cKDTree(xt).query(nodes.x[touching])[1] if len(touching) else np.zeros(0, dtype=np.int64)
+    P = np.zeros(n + len(xt))
+    P[:n] = (q_p + hm.chip_fraction * q_f) / dt
+    np.add.at(P, n + nearest, (1.0 - hm.chip_fraction) * q_f[touching] / dt)
+    length = boundary_lengths(nodes.x, mesh.edges, n)[touching]
+    G = contact_conductance(np.stack([touching, n + nearest], axis=1), length, hm.h_int, n + len(xt))
+    free = mesh.edges[~np.isin(mesh.edges, touching).any(axis=1)]
+    tedges = _tool_edges(hm)
+    x_all = np.concatenate([nodes.x, xt])
+    tri = np.concatenate([mesh.tri, hm.tool_tri + n])
+    k = np.concatenate([np.full(len(mesh.tri), hm.k_work), np.full(len(hm.tool_tri), hm.k_tool)])
+    mc = np.concatenate([nodes.m * hm.cp_work, hm.tool_mc])
+    fixed = np.concatenate([hm.work_fixed, n + hm.tool_fixed])
+    T, step = thermal_step(x_all, tri, np.concatenate([nodes.T, run.T_tool]), dt, k, None, P,
+                           edges=np.concatenate([free, tedges + n]), loss=hm.loss, fixed=fixed,
+                           T_fixed=hm.T_fixed, conductance=G, mc=mc)
+    nodes.T, run.T_tool = T[:n], T[n:]
+    L = run.ledger
+    L["plastic"] += float(q_p.sum())
+    L["friction"] += float(q_f.sum())
+    L["friction_to_tool"] += float((1.0 - hm.chip_fraction) * q_f[touching].sum())
+    L["stored"] += step.stored
+    L["lost"] += step.lost
+    L["removed"] += step.removed
+
+
+def _tool_edges(hm: CutHeat) -> np.ndarray:
+    """The tool mesh's boundary edges (its free faces; the held ones lose nothing, they are at fixed temperature)."""
+    edges = boundary_edges(hm.tool_tri)
+    return edges[~np.isin(edges, hm.tool_fixed).all(axis=1)]
+
+
+def run_pfem_cut(cut: PFEMCut, progress=None, max_steps: int | None = None) -> dict:
+    """Algorithm 1 to t_end (module text): :class:`CutRun` stepped to the end (or ``max_steps``); its
+    :meth:`CutRun.result`. ``progress(step, nodes, F_tool, step_result)`` after each step."""
+    run = CutRun(cut)
+    while not run.done and (max_steps is None or run.steps < max_steps):
+        r = run.step()
         if progress:
-            progress(step, nodes, F_tool, r)
-    hist["reaction"] = {k: np.asarray(v) for k, v in reaction.items()}
-    metrics = thermal_cutting_metrics(hist, info, cut.t_end)
-    return dict(nodes=nodes, mesh=mesh, history=hist, metrics=metrics, newton_iterations=iters, retries=retries,
-                wall_time_s=time.perf_counter() - t0, steps=step, remeshes=remeshes)
+            progress(run.steps, run.nodes, run.reaction["tool"][-1], r)
+    return run.result()

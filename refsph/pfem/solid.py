@@ -455,11 +455,21 @@ def transfer_history(old: Mesh, hist: History, new: Mesh, nodes: Nodes) -> Histo
     return out
 
 
-def settle_nodes(nodes: Nodes, mesh: Mesh, step: StepResult, strength) -> None:
+def plastic_heat(mesh: Mesh, step: StepResult, strength, n: int) -> np.ndarray:
+    """The plastic heat of a step per node [J/m]: chi dW_p A of each triangle (Eq. (5) over the step), a third to
+    each of its nodes; zeros for a law that does not heat."""
+    if not getattr(strength, "heating", False):
+        return np.zeros(n)
+    q = strength.chi * step.d_w_p * np.abs(step.area)
+    return np.bincount(mesh.tri.ravel(), np.repeat(q / 3.0, 3), minlength=n)
+
+
+def settle_nodes(nodes: Nodes, mesh: Mesh, step: StepResult, strength, heat: bool = True) -> None:
     """After a converged step (in place): the plastic heat chi dW_p A of each triangle, a third to each of its
-    nodes, over m_i c_p (adiabatic; none for a law that does not heat), and the triangles' new history projected to
-    the nodes (:func:`project_to_nodes`), ready for a remeshing."""
-    if getattr(strength, "heating", False):
+    nodes, over m_i c_p (adiabatic; none for a law that does not heat; ``heat=False``: none, for a run whose heat
+    step takes it as a source), and the triangles' new history projected to the nodes (:func:`project_to_nodes`),
+    ready for a remeshing."""
+    if heat and getattr(strength, "heating", False):
         q = strength.chi * step.d_w_p * np.abs(step.area)
         nodes.T = nodes.T + np.bincount(mesh.tri.ravel(), np.repeat(q / 3.0, 3), minlength=nodes.n) / (nodes.m
                                                                                                        * strength.cp)

@@ -1,0 +1,226 @@
+"""``refsph run thermal_cutting --method pfem``: a PFEM cut (:mod:`refsph.pfem.cutting`) written as a run folder like
+an SPH run's, so that ``refsph compare``, ``refsph export --vtk``, the restart and the plots take it unchanged.
+
+The folder (:mod:`refsph.io` documents the common files):
+
+    summary.json              scene, method 'pfem', dim 2, dp (the finest spacing dx), n_particles (nodes),
+                              n_steps, t_end, status, metrics (the SPH scene's keys), scene_info, heat_balance,
+                              newton (iterations, halved steps, remeshings), run_args, wall_time_s, provenance
+    snapshots/snap_NNNNN.npz  the nodes as particles (t, id, x, v, m, rho, p, S, S_zz, sigma_vm, eps_p, eps_dot_p,
+                              W_p, T, body) plus the mesh: ``triangles`` (M, 3) and ``boundary_edges`` (K, 2), rows
+                              of the node arrays (int64); ``tool_x`` (P, 2) and ``tool_T`` (P,): the tool's nodes
+                              where the heat step meshes it
+    snapshots/units.json      the unit of each array
+    snapshots/restart.npz     the checkpoint of the last snapshot (``refsph run --restart`` continues from it)
+    reaction_forces.csv       the force on the tool, every step
+
+``rho`` of a node is rho0 / J with J its area-weighted volume ratio; ``p`` is the nodal pressure of the mixed
+element (the mean stress, positive in compression like the SPH snapshots' pressure).
+
+Scene options (``--option NAME=VALUE``): case, n_tu, travel, length, penalty, courant, alpha, friction, conduction,
+chip_fraction (:func:`refsph.pfem.cutting.pfem_cut`); ``--quick``: case 1's short cut at dx = t_u / 5 (4 t_u of a
+workpiece 1.2 mm long, the SPH scene's quick cut).
+"""
+from __future__ import annotations
+
+import inspect
+import json
+import os
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+from .io import claim_run_folder, save_reactions, save_units, write_json
+from .material import von_mises
+from .pfem.cutting import CutRun, pfem_cut
+from .pfem.mesh import signed_areas
+from .scenes.base import parse_bool
+from .simulate import SimulationError, provenance
+
+__all__ = ["run_pfem", "restart_pfem", "is_pfem_run", "PFEM_SCENES", "QUICK", "N_SNAPSHOTS",
+           "PFEMRunResult"]
+
+PFEM_SCENES = ("thermal_cutting",)
+QUICK = dict(case=1, n_tu=5.0, travel=4.0, length=1.2e-3)          # the SPH scene's quick cut
+N_SNAPSHOTS = 8                                                      # as the SPH scene: t = 0 and 8 more
+UNITS = dict(t="s", id="1 (node id)", x="m", v="m/s", m="kg/m", rho="kg/m^3", p="Pa", S="Pa", S_zz="Pa",
+             sigma_vm="Pa", eps_p="1", eps_dot_p="1/s", W_p="J/m^3", T="K", body="1",
+             triangles="1 (node rows)", boundary_edges="1 (node rows)", tool_x="m", tool_T="K")
+CHECKPOINT, PREVIOUS = "restart.npz", "restart_prev.npz"
+
+
+class PFEMRunResult:
+    """What :func:`run_pfem` returns: ``summary`` (summary.json's content) and ``result`` (:meth:`CutRun.result`)."""
+
+    def __init__(self, summary: dict, result: dict):
+        self.summary, self.result = summary, result
+
+
+def _options(options: dict, quick: bool) -> dict:
+    """The keyword arguments of :func:`pfem_cut` from the scene options (strings from the command line converted);
+    ValueError naming an unknown option."""
+    known = inspect.signature(pfem_cut).parameters
+    out = dict(QUICK) if quick else {}
+    for name, value in (options or {}).items():
+        if name not in known:
+            raise ValueError(f"option {name!r} is not an option of the PFEM cut; its options: {', '.join(known)}")
+        default = known[name].default
+        try:
+            if name in ("friction", "conduction"):
+                out[name] = parse_bool(value, f"option {name}")
+            elif name == "case":
+                out[name] = int(float(value))
+            elif name == "length" and value in (None, "none"):
+                out[name] = None
+            else:
+                out[name] = float(value)
+        except (TypeError, ValueError) as e:
+            raise ValueError(f"option {name} must be a number (default {default!r}), got {value!r}") from e
+    if "case" not in out:
+        out["case"] = 1
+    return out
+
+
+def _snapshot(path: Path, run: CutRun) -> None:
+    """The nodes as particles, the mesh and (with the heat step) the tool's nodes (module text), atomically."""
+    n, mesh, law = run.nodes, run.mesh, run.cut.law
+    area = np.abs(np.repeat(signed_areas(n.x, mesh.tri), 3))
+    w = np.bincount(mesh.tri.ravel(), area, minlength=n.n)
+    J = np.where(w > 0, n.J, 1.0)
+    arrays = dict(t=np.float64(n.t), id=np.arange(n.n, dtype=np.int64), x=n.x, v=n.v, m=n.m, rho=law.rho0 / J,
+                  p=-n.p, S=n.S, S_zz=n.S_zz, sigma_vm=von_mises(n.S, n.S_zz), eps_p=n.eps_p, eps_dot_p=n.eps_dot,
+                  W_p=n.W_p, T=n.T, body=np.zeros(n.n, dtype=np.int32), triangles=mesh.tri.astype(np.int64),
+                  boundary_edges=mesh.edges.astype(np.int64))
+    if run.T_tool is not None:
+        arrays.update(tool_x=run.tool_x(n.t), tool_T=run.T_tool)
+    save_units(path.parent, {k: UNITS[k] for k in arrays})
+    tmp = path.with_name(path.name + ".tmp.npz")
+    np.savez(tmp, **arrays)
+    os.replace(tmp, path)
+
+
+def _checkpoint(folder: Path, run: CutRun, snapshots: list, next_snap: int) -> None:
+    """restart.npz (the previous one kept as restart_prev.npz), atomically."""
+    arrays = run.checkpoint()
+    arrays["run"] = np.array(json.dumps(dict(snapshots=snapshots, next_snap=next_snap)))
+    path = folder / CHECKPOINT
+    if path.exists():
+        os.replace(path, folder / PREVIOUS)
+    tmp = folder / (CHECKPOINT + ".tmp.npz")
+    np.savez(tmp, **arrays)
+    os.replace(tmp, path)
+
+
+def _restore(folder: Path, cut):
+    for name in (CHECKPOINT, PREVIOUS):
+        path = folder / name
+        if path.exists():
+            with np.load(path) as z:
+                arrays = {k: z[k] for k in z.files}
+            rec = json.loads(str(arrays.pop("run")))
+            return CutRun.restore(cut, arrays), rec["snapshots"], rec["next_snap"]
+    raise ValueError(f"{folder}: nothing to restart from (no {CHECKPOINT} or {PREVIOUS})")
+
+
+def run_pfem(scene_name: str = "thermal_cutting", *, out=None, options: dict | None = None, quick: bool = False,
+             progress: bool = True, restart: bool = False, overwrite: bool = False,
+             max_steps: int | None = None) -> PFEMRunResult:
+    """Run the PFEM version of a scene into the run folder ``out`` (default runs/SCENE-pfem-2d; module text);
+    ``restart``: continue the run there from its last checkpoint. ``max_steps``: stop after that many steps of
+    this call (the folder can be continued with ``restart``). Returns a :class:`PFEMRunResult`."""
+    if scene_name not in PFEM_SCENES:
+        raise ValueError(f"scene {scene_name!r} has no PFEM version; PFEM scenes: {', '.join(PFEM_SCENES)}")
+    kwargs = _options(options, quick)
+    cut = pfem_cut(**kwargs)
+    out = Path(out or f"runs/{scene_name}-pfem-2d")
+    snaps_dir = out / "snapshots"
+    if restart:
+        run, snapshots, next_snap = _restore(snaps_dir, cut)
+    else:
+        claim_run_folder(out, scene_name, "pfem", overwrite)
+        snaps_dir.mkdir(parents=True, exist_ok=True)
+        run, snapshots, next_snap = CutRun(cut), [], 0
+        _snapshot(snaps_dir / "snap_00000.npz", run)
+        snapshots.append("snap_00000.npz")
+        next_snap = 1
+        _checkpoint(snaps_dir, run, snapshots, next_snap)
+    times = np.linspace(0.0, cut.t_end, N_SNAPSHOTS + 1)
+    args = dict(scene_name=scene_name, method="pfem", options=dict(options or {}), quick=bool(quick))
+    status, error, t_start, steps0 = "ok", None, time.perf_counter(), run.steps
+    last_print = 0.0
+    try:
+        while not run.done and (max_steps is None or run.steps - steps0 < max_steps):
+            run.step()
+            if not np.all(np.isfinite(run.nodes.x)) or not np.all(np.isfinite(run.nodes.T)):
+                raise FloatingPointError(f"non-finite nodes after step {run.steps} (t = {run.nodes.t:.6e} s)")
+            if next_snap <= N_SNAPSHOTS and run.nodes.t >= times[next_snap] * (1 - 1e-9):
+                name = f"snap_{len(snapshots):05d}.npz"             # one snapshot however many times a step passed
+                _snapshot(snaps_dir / name, run)
+                snapshots.append(name)
+                while next_snap <= N_SNAPSHOTS and run.nodes.t >= times[next_snap] * (1 - 1e-9):
+                    next_snap += 1
+                _checkpoint(snaps_dir, run, snapshots, next_snap)
+            now = time.perf_counter()
+            if progress and now - last_print > 2.0:
+                last_print = now
+                F = run.reaction["tool"][-1]
+                print(f"[{scene_name} pfem 2D] step {run.steps:6d}  t = {run.nodes.t:.3e} s "
+                      f"({100 * run.nodes.t / cut.t_end:5.1f} %)  Fc = {F[0] / 1e3:7.1f} N/mm  "
+                      f"Newton {run.iterations[-1]:3d}  elapsed {now - t_start:7.1f} s", file=sys.stderr, flush=True)
+    except Exception as e:                                  # a failed Newton, a non-finite state: kept, not lost
+        status, error = "failed", f"{type(e).__name__}: {e}"
+        _snapshot(snaps_dir / "last_good.npz", run)
+    res = run.result()
+    summary = _summary(scene_name, run, res, kwargs, args, snapshots, out, status, error)
+    write_json(out / "summary.json", summary)
+    if status != "ok":
+        raise SimulationError(f"PFEM {scene_name}: {error}; the last state is in {snaps_dir / 'last_good.npz'}")
+    return PFEMRunResult(summary, res)
+
+
+def _summary(scene_name: str, run: CutRun, res: dict, kwargs: dict, args: dict, snapshots: list, out: Path,
+             status: str, error: str | None) -> dict:
+    """summary.json's content (module text), and reaction_forces.csv written."""
+    cut = run.cut
+    reaction = {k: np.asarray(v, dtype=float) for k, v in run.reaction.items()}
+    if len(reaction["t"]):
+        save_reactions(out / "reaction_forces.csv", dict(t=reaction["t"], dt=reaction["dt"],
+                                                         tool=reaction["tool"].reshape(-1, 2)), 2)
+    it = np.asarray(run.iterations)
+    summary = dict(scene=scene_name, method="pfem", dim=2, dp=cut.info["dx"], h=None, n_particles=run.nodes.n,
+                   t_end=cut.t_end, t_final=run.nodes.t, n_steps=run.steps,
+                   status=status if status != "ok" or run.done else "partial", metrics=res["metrics"],
+                   scene_info=dict(cut.info), heat_balance=res["heat_balance"],
+                   newton=dict(iterations=int(it.sum()), max_per_step=int(it.max()) if len(it) else 0,
+                               halved_steps=run.retries, remeshes=run.remeshes, max_move=cut.max_move,
+                               max_iter=cut.max_iter),
+                   options=kwargs, run_args=args, wall_time_s=run.wall, snapshots=snapshots,
+                   particle_steps_per_s=run.nodes.n * run.steps / run.wall if run.wall > 0 else 0.0,
+                   reaction_forces_file="reaction_forces.csv", provenance=provenance(1))
+    if error:
+        summary["error"] = error
+    return summary
+
+
+def restart_pfem(run_dir, progress: bool = True) -> PFEMRunResult:
+    """Continue the PFEM run in ``run_dir`` from its last checkpoint, with the arguments it was started with
+    (``summary.json``'s ``run_args``)."""
+    path = Path(run_dir) / "summary.json"
+    try:
+        args = json.loads(path.read_text())["run_args"]
+        return run_pfem(args["scene_name"], out=run_dir, options=args.get("options"), quick=bool(args.get("quick")),
+                        progress=progress, restart=True)
+    except FileNotFoundError:
+        raise ValueError(f"{path} does not exist: {run_dir} is not a refsph run folder") from None
+    except (KeyError, TypeError, ValueError) as e:
+        raise ValueError(f"{path}: not a PFEM run folder that can be continued ({type(e).__name__}: {e})") from None
+
+
+def is_pfem_run(run_dir) -> bool:
+    """True if ``run_dir``'s summary.json says method 'pfem'."""
+    try:
+        return json.loads((Path(run_dir) / "summary.json").read_text()).get("method") == "pfem"
+    except (OSError, ValueError, AttributeError):
+        return False

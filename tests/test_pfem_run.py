@@ -1,0 +1,98 @@
+"""``refsph run thermal_cutting --method pfem`` (refsph.pfem_run): the run folder has the SPH runs' layout (summary,
+snapshots of numbers with their units, the triangles, the reaction CSV, the restart checkpoint); a restarted run
+gives the numbers of an uninterrupted one to the bit; the heat ledger closes; ParaView gets the triangles; the CLI
+refuses what the PFEM cannot take. A short cut: the quick scene with 0.3 t_u of travel (8 steps, ~20 s)."""
+import json
+
+import numpy as np
+import pytest
+
+from refsph.cli import main
+from refsph.io import load_reactions, load_snapshot
+from refsph.pfem_run import restart_pfem, run_pfem
+
+SHORT = dict(travel="0.3")
+
+
+@pytest.fixture(scope="module")
+def short_run(tmp_path_factory):
+    out = tmp_path_factory.mktemp("pfem") / "run"
+    res = run_pfem("thermal_cutting", out=out, options=SHORT, quick=True, progress=False)
+    return out, res
+
+
+def test_run_folder_has_the_sph_layout(short_run):
+    out, res = short_run
+    s = json.loads((out / "summary.json").read_text())
+    assert s["method"] == "pfem" and s["scene"] == "thermal_cutting" and s["status"] == "ok"
+    assert s["n_steps"] >= 6 and s["t_final"] == pytest.approx(s["t_end"], rel=1e-12)
+    for key in ("cutting_force_N_per_m", "passive_force_N_per_m", "force_ratio", "rake_face_temperature_K",
+                "chip_thickness_mm", "contact_length_mm", "measured"):
+        assert key in s["metrics"]
+    assert s["metrics"]["cutting_force_N_per_m"] > 0
+    assert s["run_args"] == dict(scene_name="thermal_cutting", method="pfem", options=SHORT, quick=True)
+    snaps = [load_snapshot(out / "snapshots" / name) for name in s["snapshots"]]
+    assert len(snaps) >= 4 and snaps[0]["t"] == 0.0 and snaps[-1]["t"] == pytest.approx(s["t_end"], rel=1e-12)
+    z = snaps[-1]
+    n = len(z["x"])
+    assert n == s["n_particles"]
+    assert z["triangles"].dtype == np.int64 and z["triangles"].min() >= 0 and z["triangles"].max() < n
+    assert z["units"]["triangles"].startswith("1") and z["units"]["p"] == "Pa" and z["units"]["tool_T"] == "K"
+    for k, a in z.items():                                     # numbers only
+        if isinstance(a, np.ndarray):
+            assert a.dtype.kind in "fi", k
+    x, tri = z["x"], z["triangles"]
+    area = 0.5 * ((x[tri[:, 1], 0] - x[tri[:, 0], 0]) * (x[tri[:, 2], 1] - x[tri[:, 0], 1])
+                  - (x[tri[:, 1], 1] - x[tri[:, 0], 1]) * (x[tri[:, 2], 0] - x[tri[:, 0], 0]))
+    assert np.all(area > 0)                                    # counter-clockwise, none inverted
+    np.testing.assert_array_equal(z["m"], snaps[0]["m"])       # the nodes carry fixed masses
+    r = load_reactions(out / "reaction_forces.csv")
+    assert len(r["t"]) == s["n_steps"] and np.all(np.diff(r["t"]) > 0)
+    hb = s["heat_balance"]
+    assert hb["plastic_J"] > 0 and abs(hb["residual_rel"]) < 1e-12     # the ledger closes to round-off
+    assert np.max(z["T"]) > 300.0 and np.max(z["tool_T"]) > 293.0       # the chip and the tool heat
+
+
+def test_restart_gives_the_uninterrupted_numbers(short_run, tmp_path):
+    out, res = short_run
+    part = tmp_path / "split"
+    first = run_pfem("thermal_cutting", out=part, options=SHORT, quick=True, progress=False, max_steps=4)
+    assert first.summary["status"] == "partial" and first.summary["n_steps"] == 4
+    assert main(["run", "--restart", str(part), "--quiet"]) == 0          # the CLI dispatches to restart_pfem
+    second = restart_pfem(part, progress=False)                            # nothing left to do: the same summary
+    a, b = load_reactions(out / "reaction_forces.csv"), load_reactions(part / "reaction_forces.csv")
+    np.testing.assert_array_equal(a["tool"], b["tool"])
+    np.testing.assert_array_equal(a["t"], b["t"])
+    for key in ("cutting_force_N_per_m", "rake_face_temperature_K", "max_temperature_K"):
+        assert second.summary["metrics"][key] == res.summary["metrics"][key]
+    za = load_snapshot(out / "snapshots" / res.summary["snapshots"][-1])
+    zb = load_snapshot(part / "snapshots" / second.summary["snapshots"][-1])
+    for k in ("x", "T", "eps_p", "triangles", "tool_T"):
+        np.testing.assert_array_equal(za[k], zb[k])
+
+
+def test_export_gives_paraview_the_triangles(short_run):
+    meshio = pytest.importorskip("meshio")
+    from refsph.crosscheck.export import export_vtk
+    out, res = short_run
+    export_vtk(out)
+    last = res.summary["snapshots"][-1].replace(".npz", ".vtu")
+    m = meshio.read(out / "vtk" / last)
+    z = load_snapshot(out / "snapshots" / res.summary["snapshots"][-1])
+    assert m.cells[0].type == "triangle"
+    np.testing.assert_array_equal(m.cells[0].data, z["triangles"])
+    np.testing.assert_allclose(m.point_data["T"], z["T"])
+    assert "triangles" not in m.point_data and "tool_x" not in m.point_data
+
+
+@pytest.mark.parametrize("args, says", [
+    (("run", "taylor", "--method", "pfem"), "no PFEM version"),
+    (("run", "thermal_cutting", "--method", "pfem", "--dp", "1e-5"), "--dp"),
+    (("run", "thermal_cutting", "--method", "pfem", "--set", "beta1=1"), "--set"),
+    (("run", "thermal_cutting", "--method", "pfem", "--option", "mass_scale=10"), "not an option of the PFEM cut"),
+    (("run", "thermal_cutting", "--method", "pfem", "--option", "n_tu=abc"), "must be a number"),
+])
+def test_cli_refuses_what_the_pfem_cannot_take(args, says, tmp_path, capsys):
+    assert main(list(args) + ["--out", str(tmp_path / "o")]) == 2
+    assert says in capsys.readouterr().err
+    assert not (tmp_path / "o").exists()

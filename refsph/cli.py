@@ -170,9 +170,12 @@ def _main(argv=None) -> int:
             return 2
         return 0
     if args.cmd == "list":
+        from .pfem_run import PFEM_SCENES, pfem_options
         for name, sc in SCENES.items():
             print(f"{name:10s} {sc.description}")
             print(f"{'':10s} default: {sc.default_dim}D, methods {', '.join(sc.methods)}")
+            if name in PFEM_SCENES:
+                print(f"{'':10s} also --method pfem (2D; its options: {', '.join(pfem_options())})")
             for opt, (default, help_) in sc.options.items():
                 print(f"{'':10s} --option {opt}=VALUE  {help_} (default {default})")
         return 0

@@ -39,7 +39,7 @@ from .pfem.mesh import signed_areas
 from .scenes.base import parse_bool
 from .simulate import SimulationError, provenance
 
-__all__ = ["run_pfem", "restart_pfem", "is_pfem_run", "PFEM_SCENES", "QUICK", "N_SNAPSHOTS",
+__all__ = ["run_pfem", "restart_pfem", "is_pfem_run", "pfem_options", "PFEM_SCENES", "QUICK", "N_SNAPSHOTS",
            "PFEMRunResult"]
 
 PFEM_SCENES = ("thermal_cutting",)
@@ -56,6 +56,11 @@ class PFEMRunResult:
 
     def __init__(self, summary: dict, result: dict):
         self.summary, self.result = summary, result
+
+
+def pfem_options() -> list[str]:
+    """The scene options the PFEM cut takes (the parameters of :func:`refsph.pfem.cutting.pfem_cut`)."""
+    return list(inspect.signature(pfem_cut).parameters)
 
 
 def _options(options: dict, quick: bool) -> dict:

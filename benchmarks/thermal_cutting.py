@@ -82,7 +82,7 @@ def _s(case: int) -> float:
     return mass_scale_for(MATERIALS[row["material"]], row["vc_m_per_min"] / 60.0, INERTIA)
 
 
-STUDY_NAMES = ("cases", "coarse", "pfem", "scaling", "scatter", "resolution", "tool", "contact")
+STUDY_NAMES = ("cases", "coarse", "pfem", "detector", "scaling", "scatter", "resolution", "tool", "contact")
 COARSE = " n_tu 5"                         # the key suffix of the 'coarse' study: all 18 cases at dx = t_u / 5
 PFEM = " pfem n_tu 5"                      # the key suffix of the 'pfem' study: the 18 cases with the PFEM at t_u / 5
 PFEM_OPTIONS = ("case", "n_tu", "travel", "length")     # the sweep's options the PFEM cut takes (its tool is TOOL)
@@ -105,6 +105,8 @@ def jobs(studies=STUDY_NAMES, only=None) -> dict:
         if n == 1 or n == 10:
             add("resolution", f"case {n}{COARSE}", converged(n, n_tu=5.0))
         add("coarse", f"case {n}{COARSE}", converged(n, n_tu=5.0))
+    for n in (1, 10):                                        # the paper's future work: alpha-shape vs SPH detector
+        add("detector", f"case {n}{COARSE} alpha detector", converged(n, n_tu=5.0, detector="alpha"))
     for n in [1, 10] + [k for k in range(2, 19) if k != 10]:   # the PFEM: cases 1 and 10 first
         add("pfem", f"case {n}{PFEM}", converged(n, n_tu=5.0), dict(method="pfem"))
     add("scaling", "case 1 s/2", converged(1, mass_scale=_s(1) / 2))
@@ -356,7 +358,7 @@ def _values(r: dict) -> dict:
         out[f"{name}_drift_pct"] = 100.0 * drift.get(key, math.nan) / m.get(key, math.nan)
     for key, name in (("rake_face_temperature_K", "TRF"), ("free_chip_surface_temperature_K", "TFCS")):
         out[f"{name}_drift"] = drift.get(key, math.nan)
-    for key in ("plastic_J", "friction_J", "dissipation_J", "removed_J"):
+    for key in ("plastic_J", "friction_J", "dissipation_J", "removed_J", "lost_J"):
         out[f"{key[:-2]}_of_work"] = 100.0 * hb.get(key, math.nan) / work
     out["made_of_work"] = 100.0 * out["made"] / work
     return out
@@ -394,6 +396,10 @@ STUDIES = (
       "case 1 n_tu 5", "case 1 tool 5x3, 4 t_u uncut", "case 1"),
      BASIC + (("removed at held faces [% of work]", "removed_of_work", ".1f"), ("Fc drift [%]", "Fc_drift_pct", ".1f"),
               ("T_RF drift [K]", "TRF_drift", ".0f"))),
+    ("Free-surface detector of the heat losses (the paper's future work: the alpha-shape instead of the SPH "
+     "detector; t_u/5)",
+     ("case 1 n_tu 5", "case 1 n_tu 5 alpha detector", "case 10 n_tu 5", "case 10 n_tu 5 alpha detector"),
+     BASIC + (("lost at the surface [% of work]", "lost_of_work", ".3f"),)),
     ("Contact and heat split (case 1: penalty contact, half the frictional heat into the chip)",
      ("case 1", "case 1 pinball", "case 1 all friction heat to the chip"),
      BASIC + (("friction heat [% of work]", "friction_of_work", ".1f"),

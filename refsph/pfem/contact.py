@@ -128,19 +128,25 @@ class StepContact:
 
 
 def solve_with_active_set(nodes, mesh, hist, law, dt, loads, max_outer: int = 8, dynamic=True, max_iter: int = 25,
-                          max_move: float | None = None):
-    """Newton-Raphson with the contact and slip sets frozen (:meth:`StepContact.freeze`): set at the step's start
-    (each solve starts from du = 0: the trapezoidal rule's velocities ring at an impact, and the predictor dt v
-    would drive the contact nodes deep into the tool), solved, set again from the solution, until the sets stop
-    changing (the active-set strategy, Wriggers 2006, Section 6.3); then a last solve with the sets free checks
-    that the solution satisfies the contact law itself."""
+                          max_move: float | None = None, du0=None):
+    """Newton-Raphson with the contact and slip sets frozen (:meth:`StepContact.freeze`): set at the step's start (the
+    first solve starts from du = 0, not from the predictor dt v: the trapezoidal rule's velocities ring at an
+    impact, and the predictor would drive the contact nodes deep into the tool), solved, set again from the
+    solution, until the sets stop changing (the active-set strategy, Wriggers 2006, Section 6.3); then a last solve
+    with the sets free checks that the solution satisfies the contact law itself. Each solve after the first starts
+    from the one before (``du0``: the first one's start, default zeros). The result's ``iterations`` counts those of
+    every solve."""
     c = loads.contact
     c.freeze(nodes.x)
+    total = 0
     for _ in range(max_outer):
         r = newton_step(nodes, mesh, hist, law, dt, loads, dynamic=dynamic, predictor=False, max_iter=max_iter,
-                        max_move=max_move)
+                        max_move=max_move, du0=du0)
+        du0, total = r.du, total + r.iterations
         if not c.freeze(nodes.x + r.du):
             c.active = c.slip = None
-            return newton_step(nodes, mesh, hist, law, dt, loads, dynamic=dynamic, predictor=False,
-                               max_iter=max_iter, max_move=max_move)              # the sets free
+            last = newton_step(nodes, mesh, hist, law, dt, loads, dynamic=dynamic, predictor=False,
+                               max_iter=max_iter, max_move=max_move, du0=r.du)   # the sets free
+            last.solves_iterations = total + last.iterations
+            return last
     raise NewtonFailed(f"the contact's active set kept changing over {max_outer} solves", [])

@@ -165,10 +165,13 @@ class StepResult:
     area: np.ndarray
     residuals: list = field(default_factory=list)
     contact_force: np.ndarray | None = None
+    solves_iterations: int | None = None
 
     @property
     def iterations(self) -> int:
-        return len(self.residuals) - 1
+        """The Newton iterations of the step: of every solve it took (the active-set strategy's several) where
+        ``solves_iterations`` is set, else of this solve."""
+        return len(self.residuals) - 1 if self.solves_iterations is None else self.solves_iterations
 
 
 @dataclass(frozen=True)
@@ -315,7 +318,7 @@ def assemble(nodes: Nodes, mesh: Mesh, hist: History, law: SolidLaw, du: np.ndar
 
 def newton_step(nodes: Nodes, mesh: Mesh, hist: History, law: SolidLaw, dt: float, loads: Loads,
                 dynamic: bool = True, tol: float = 1e-10, max_iter: int = 25, predictor: bool = True,
-                max_move: float | None = None) -> StepResult:
+                max_move: float | None = None, du0: np.ndarray | None = None) -> StepResult:
     """Solve Eqs. (19)-(20) for the step's du and p by Newton-Raphson. Converged when the residual of the free
     displacement rows and that of the pressure rows are below ``tol`` times their scales (:func:`assemble`), or
     below 100 tol and no longer falling (the round-off floor of a large system: the sums of many forces).
@@ -323,7 +326,8 @@ def newton_step(nodes: Nodes, mesh: Mesh, hist: History, law: SolidLaw, dt: floa
     node by more than this fraction of its local size sqrt(mean area of its triangles) (the whole correction scaled
     down, before the line search; None: no limit). Where elements flow plastically the tangent is soft, and a node
     on the tool (sliding, or frictionless) can get a correction of ten spacings from a residual that a few tenths
-    of one remove; the line search alone then crawls (chapter 12). Raises :class:`NewtonFailed`."""
+    of one remove; the line search alone then crawls (chapter 12). ``du0``: the first guess of du where the
+    predictor is off (default zeros). Raises :class:`NewtonFailed`."""
     n = nodes.n
     if max_move is not None:
         a = np.repeat(np.abs(signed_areas(nodes.x, mesh.tri)), 3)
@@ -335,6 +339,8 @@ def newton_step(nodes: Nodes, mesh: Mesh, hist: History, law: SolidLaw, dt: floa
     if not dynamic:
         fixed[~meshed] = True
     du = dt * nodes.v + 0.5 * dt * dt * nodes.a if dynamic and predictor else np.zeros((n, 2))
+    if du0 is not None and not predictor:
+        du = np.asarray(du0, dtype=float).copy()
     target = np.where(fixed, np.where(meshed[:, None] | bool(dynamic), loads.du_fixed, 0.0), du).ravel()
     p = nodes.p.copy()
     p[~meshed] = 0.0

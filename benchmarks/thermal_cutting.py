@@ -109,6 +109,10 @@ def jobs(studies=STUDY_NAMES, only=None) -> dict:
         add("detector", f"case {n}{COARSE} alpha detector", converged(n, n_tu=5.0, detector="alpha"))
     for n in [1, 10] + [k for k in range(2, 19) if k != 10]:   # the PFEM: cases 1 and 10 first
         add("pfem", f"case {n}{PFEM}", converged(n, n_tu=5.0), dict(method="pfem"))
+        if n == 10:                                          # the PFEM's resolution, on the short cut of --quick
+            for k in (5, 10):
+                add("pfem", f"case 1 pfem short n_tu {k}", converged(1, n_tu=float(k), travel=4.0, length=1.2e-3),
+                    dict(method="pfem"))
     add("scaling", "case 1 s/2", converged(1, mass_scale=_s(1) / 2))
     add("cases", "case 10", converged(10))
     add("scaling", "case 10 s/2", converged(10, mass_scale=_s(10) / 2))
@@ -400,6 +404,10 @@ STUDIES = (
      "detector; t_u/5)",
      ("case 1 n_tu 5", "case 1 n_tu 5 alpha detector", "case 10 n_tu 5", "case 10 n_tu 5 alpha detector"),
      BASIC + (("lost at the surface [% of work]", "lost_of_work", ".3f"),)),
+    ("The PFEM's resolution (case 1, the short cut of --quick: 4 t_u on a workpiece 1.2 mm long)",
+     ("case 1 pfem short n_tu 5", "case 1 pfem short n_tu 10"),
+     (("across t_u", "across", ".0f"), ("dx [um]", "dx_um", ".1f"), ("nodes", "n_particles", "d")) + BASIC
+     + (("steps", "n_steps", "d"), ("wall [s]", "wall", ".0f"))),
     ("Contact and heat split (case 1: penalty contact, half the frictional heat into the chip)",
      ("case 1", "case 1 pinball", "case 1 all friction heat to the chip"),
      BASIC + (("friction heat [% of work]", "friction_of_work", ".1f"),

@@ -293,3 +293,23 @@ def test_newmark_trapezoidal_keeps_and_damped_rule_takes_the_energy_of_an_oscill
                           4.0 / 0.25 * (np.ones(2) - 0.5) - 1.0)
     with pytest.raises(ValueError, match="unconditionally stable"):
         solid.Newmark(0.25, 0.7)
+
+
+@pytest.mark.parametrize("n_tu", [5.0, 7.0, 10.0])
+def test_graded_workpiece_is_held_along_its_bottom_and_left(n_tu):
+    """The cut's workpiece has a row at y = 0 and a column at x = 0, all held, at any number of nodes across t_u
+    (with 5, the coarse rows once stopped at y = dx: nothing held the bottom, and the workpiece bent as a cantilever
+    under the tool, 0.5 mm down at 4 t_u of cut)."""
+    from refsph.pfem.cutting import graded_workpiece, pfem_cut
+    tu = 1e-4
+    dx = tu / n_tu
+    x, h = graded_workpiece(2.0e-3, tu, dx)
+    assert x[:, 1].min() == 0.0 and np.isclose(x[:, 1].max(), 3 * tu)
+    bottom = x[:, 1] == 0.0
+    assert bottom.sum() >= round(2.0e-3 / (2 * dx))
+    ys = np.unique(np.round(x[:, 1] / dx, 9))
+    assert np.all(np.diff(ys) <= 2.0 + 1e-9) and np.all(np.diff(ys) >= 1.0 - 1e-9)   # no gap over 2 dx, none under dx
+    cut = pfem_cut(1, n_tu=n_tu, travel=4.0, length=1.2e-3, conduction=False)
+    held = cut.fixed.all(axis=1)
+    assert np.all(held[cut.nodes.x[:, 1] == 0.0]) and np.all(held[cut.nodes.x[:, 0] == 0.0])
+    assert held[cut.nodes.x[:, 1] == 0.0].sum() > 10

@@ -123,13 +123,13 @@ class PFEMCut:
 
 def graded_workpiece(length: float, tu: float, dx: float) -> tuple[np.ndarray, np.ndarray]:
     """(x (N, 2), h (N,)): rows dx apart (columns dx apart) in the top 2 tu of a workpiece 3 tu high and ``length``
-    long, rows and columns 2 dx apart below (module text)."""
+    long, rows and columns 2 dx apart below, from y = 0 (the held bottom row) up to at least dx under the fine band
+    (module text)."""
     H = 3.0 * tu
     nx, nf = round(length / dx), round(2.0 * tu / dx)
     ny = round(H / dx)
     fine = [(i * dx, (ny - j) * dx) for j in range(nf + 1) for i in range(nx + 1)]
-    coarse = [(i * 2 * dx, (ny - nf) * dx - j * 2 * dx) for j in range(1, (ny - nf) // 2 + 1)
-              for i in range(nx // 2 + 1)]
+    coarse = [(i * 2 * dx, y) for y in np.arange(0.0, (ny - nf - 0.5) * dx, 2 * dx) for i in range(nx // 2 + 1)]
     x = np.array(fine + coarse)
     h = np.concatenate([np.full(len(fine), dx), np.full(len(coarse), 2 * dx)])
     return x, h

@@ -128,8 +128,9 @@ for ax, (a, m) in zip(axes, meshes.items()):
         ax.plot(pts[[i, j], 0], pts[[i, j], 1], color="C3", lw=1.5)
     t = topo[a]
     ax.set(aspect="equal", title=f"alpha = {a}: {t['bodies']} bodies, {t['holes']} holes", xticks=[], yticks=[])
-ch.save(fig, "12_alpha_shape.png")
-plt.show()
+ch.show(fig, "12_alpha_shape.png", caption="Two bodies three spacings apart, meshed by Delaunay (alpha = None) "
+        "and by the alpha-shape at alpha = 2.0, 1.4 and 0.8: boundary edges in red. Only 1.4 keeps the bodies "
+        "apart without opening holes.")
 
 # %% [markdown]
 # Without α (plain Delaunay) the notch is filled and the two bodies are one; α = 2 still bridges the gap; α = 1.4
@@ -341,8 +342,8 @@ for ax, (p_plot, title) in zip(axes, ((p_ex, "exact: linear bending field"), (pc
     ax.set(aspect="equal", title=f"pressure, 4 elements deep, nu = 0.4999 — {title}", ylabel="y [m]")
 fig.colorbar(tp, ax=axes, label="p [MPa]")
 axes[-1].set_xlabel("x [m]")
-ch.save(fig, "12_cantilever_pressure.png")
-plt.show()
+ch.show(fig, "12_cantilever_pressure.png", caption="Pressure in the bent cantilever at ν = 0.4999: the exact "
+        "linear field, the stabilised element close to it, the bare element a checkerboard.")
 
 # %% [markdown]
 # With the projection term the nearly incompressible bar converges to Timoshenko's deflection (no locking) and its
@@ -431,8 +432,8 @@ for name, nr in norms.items():
     ax.semilogy(np.arange(1, len(nr) + 1), nr, "o-", ms=4, label=name)
 ax.set(xlabel="Newton iteration", ylabel="scaled residual norm", title="one plastic step, AISI 1045")
 ax.legend()
-ch.save(fig, "12_newton.png")
-plt.show()
+ch.show(fig, "12_newton.png", caption="Scaled residual per Newton iteration in one plastic step: quadratic "
+        "with refsph's tangent, linear with the elastic one.")
 
 # %% [markdown]
 # With refsph's tangent the residual falls as $r_{k+1} \approx C r_k^2$: the digits double each iteration. With
@@ -582,8 +583,9 @@ for name, out in creep.items():
     ax.plot(np.arange(1, 11), out, "o-", label=name)
 ax.set(xlabel="quasi-static step (constant tip load)", ylabel="tip deflection / Timoshenko")
 ax.legend()
-ch.save(fig, "12_remeshing_creep.png")
-plt.show()
+ch.show(fig, "12_remeshing_creep.png", caption="Tip deflection of a held cantilever over ten quasi-static "
+        "steps: constant without remeshing, creeping when every triangle's history is averaged, nearly constant "
+        "when kept triangles keep theirs.")
 
 # %% [markdown]
 # Under a constant load and with nothing else changing, the bar whose every triangle is averaged **creeps**: each
@@ -598,65 +600,49 @@ plt.show()
 
 # %%
 from refsph.pfem.cutting import pfem_cut
-from refsph.scenes.thermal_cutting import EDGE_RADIUS
 
 cut = pfem_cut(1)                                 # builds the scene (nodes, tool, contact); runs nothing
-print(f"case 1: t_u = {cut.info['tu_m'] * 1e3:.2f} mm, finest spacing {cut.info['dx'] * 1e6:.0f} um, tool edge "
-      f"radius {EDGE_RADIUS * 1e6:.0f} um, {cut.nodes.n} nodes, {cut.t_end / cut.dt:.0f} steps (remeshings) of "
-      f"{cut.dt * 1e9:.0f} ns")
-assert EDGE_RADIUS <= cut.info["dx"] * (1 + 1e-9)
+print(f"case 1: finest spacing {cut.info['dx'] * 1e6:.0f} um, edge radius {cut.info['edge_radius_m'] * 1e6:.0f} um, "
+      f"{cut.nodes.n} nodes, {cut.t_end / cut.dt:.0f} steps of {cut.dt * 1e9:.0f} ns")
 
 # %% [markdown]
 # **The first tool contact.** `refsph.pfem.cutting` builds the paper's cut (Figure 5: graded nodes, the rounded
-# tool of the SPH scene as an exact shape, a penalty contact with Coulomb friction inside the Newton iterations,
-# `refsph.pfem.contact`). Newton stalled at the first contact, twice over. First the start: the trapezoidal rule's
-# velocities ring at an impact, so the usual predictor du = dt v drove the contact nodes deep into the tool; each
-# step now starts from du = 0, with the contact and slip sets frozen within a Newton solve (the active-set
-# strategy, `solve_with_active_set`). Then the size of a correction: a directional-difference check shows the
-# tangent exact, yet a node on the tool, held only by flowing (soft) elements, got a correction of about 12
-# spacings from a residual that a few tenths of one remove, and the line search crawled (the scaled residual
-# stuck at 0.3 for 40 iterations). `newton_step(..., max_move=0.05)` scales every correction so that no node moves
-# by more than 0.05 of its local size. The quick cut's first 15 steps took 140 s with 10 halved steps at a limit
-# of 0.25, and 43 s with one at 0.05; the whole quick cut (case 1, t_u/5, 4 t_u, 733 nodes) now runs in about
-# four minutes, heat step included.
-
-# %% [markdown]
-# **The cut, side by side.** `refsph run thermal_cutting --method pfem` runs it into a run folder like an SPH
-# run's (the triangles in each snapshot); `python benchmarks/thermal_cutting.py --study pfem` runs the 18 cases
-# (too slow for this chapter: it reads what that sweep recorded). Below: refsph's PFEM and SPH at the same
-# spacing (t_u/5), the measurement, and the paper's PFEM.
+# tool as an exact shape, a penalty contact with Coulomb friction inside the Newton iterations). Newton stalled at
+# the first contact, twice over. The start: the trapezoidal rule's velocities ring at an impact, so the predictor
+# du = dt v drove contact nodes deep into the tool; each step now starts from du = 0, with the contact and slip
+# sets frozen within a solve (`solve_with_active_set`). The size of a correction: the tangent is exact, yet a node
+# on the tool, held by flowing (soft) elements, got a correction of about 12 spacings that a few tenths of one
+# would do, and the line search crawled. `max_move=0.05` scales each correction so that no node moves by more
+# than 0.05 of its local size: the quick cut's first 15 steps took 140 s with 10 halved steps at 0.25, 43 s with
+# one at 0.05; the whole quick cut (case 1, t_u/5, 4 t_u) now runs in about two minutes, heat included.
+#
+# **The cut, side by side.** `refsph run thermal_cutting --method pfem` writes a run folder like an SPH run's
+# (with the triangles); `python benchmarks/thermal_cutting.py --study pfem` runs the 18 cases, too slow for this
+# chapter, which reads what that sweep recorded: refsph's PFEM and SPH at t_u/5, the measurement, the paper's PFEM.
 
 # %%
 import json
-
 from refsph.teaching.notebook import repository_root
 
-runs = json.loads((repository_root() / "benchmarks" / "thermal_cutting.json").read_text())["runs"]
-print(f"{'case':>4} {'method':>10} {'Fc [N/mm]':>10} {'Fp/Fc':>6} {'T_RF [K]':>9} {'T_FCS [K]':>9} "
-      f"{'chip [mm]':>9} {'nodes':>6} {'wall [s]':>8}")
+records = json.loads((repository_root() / "benchmarks" / "thermal_cutting.json").read_text())["runs"]
+print("case     method  Fc [N/mm]  Fp/Fc  T_RF [K]  T_FCS [K]  chip [mm]  nodes  wall [s]")
 for case in (1, 10):
-    row = rla_cutting_case(case)
+    c = rla_cutting_case(case)
     for name, key in (("PFEM", f"case {case} pfem n_tu 5"), ("SPH", f"case {case} n_tu 5")):
-        r = runs.get(key)
-        if r is None or r["status"] != "ok":
-            print(f"{case:4d} {name:>10} {'(not recorded: ' + key + ')':>40}")
-            continue
-        m = r["metrics"]
-        print(f"{case:4d} {name:>10} {m['cutting_force_N_per_m'] / 1e3:10.1f} {m['force_ratio']:6.2f} "
-              f"{m['rake_face_temperature_K']:9.0f} {m['free_chip_surface_temperature_K']:9.0f} "
-              f"{m['chip_thickness_mm']:9.3f} {r['n_particles']:6d} {r['wall_time_s']:8.0f}")
-    print(f"{case:4d} {'measured':>10} {'':>10} {row['Fp_exp_N'] / row['Fc_exp_N']:6.2f} {row['TRF_exp_K']:9.0f} "
-          f"{row['TFCS_exp_K']:9.0f}")
-    print(f"{case:4d} {'paper PFEM':>10} {'':>10} {row['Fp_pfem_N'] / row['Fc_pfem_N']:6.2f} "
-          f"{row['TRF_pfem_K']:9.0f} {row['TFCS_pfem_K']:9.0f}")
+        r = records.get(key, {})
+        m = r.get("metrics", {}) if r.get("status") == "ok" else None
+        print(f"{case:4d} {name:>10} " + (f"(not recorded: {key})" if m is None else
+              f"{m['cutting_force_N_per_m'] / 1e3:10.1f} {m['force_ratio']:6.2f} {m['rake_face_temperature_K']:9.0f} "
+              f"{m['free_chip_surface_temperature_K']:10.0f} {m['chip_thickness_mm']:10.3f} {r['n_particles']:6d} "
+              f"{r['wall_time_s']:9.0f}"))
+    for name, tag in (("measured", "exp"), ("paper PFEM", "pfem")):
+        print(f"{case:4d} {name:>10} {'':10} {c[f'Fp_{tag}_N'] / c[f'Fc_{tag}_N']:6.2f} {c[f'TRF_{tag}_K']:9.0f} "
+              f"{c[f'TFCS_{tag}_K']:10.0f}")
 
 # %% [markdown]
-# **Where it stands, plainly.** Read the table with chapter 11's run-to-run scatter in mind (at t_u/5 the SPH
-# cut's Fc scatters by about 17 %). The PFEM's mesh is coarse here (5 nodes across t_u near the tool, 10 below):
-# its chip comes out thinner and its forces lower than the SPH cut's, and the remeshing's averaging relaxes the
-# stress of every triangle it changes (exercise 3). The paper's PFEM uses 10 to 20 nodes across t_u; that
-# resolution, node insertion where triangles grow, and the Newton cost per step (each step needs tens of
-# iterations with a finite-difference tangent) are what is still to be done.
+# **Where it stands, plainly.** Read the table with chapter 11's run-to-run scatter in mind (Fc about 17 % at
+# t_u/5). The PFEM's mesh is coarse here (5 nodes across t_u), each remeshing relaxes the triangles it changes
+# (exercise 3), and node insertion and the paper's 10-20 nodes across t_u are still to come.
 
 # %% [markdown]
 # ## Your turn

@@ -214,8 +214,9 @@ for ax, ylabel in zip(axes, (r"$h^2\,W$ [-]", r"$h^3\,\partial W/\partial r$ [-]
 axes[0].set_title("kernel (2D normalisation)")
 axes[1].set_title("radial slope; support ends at q = 2")
 fig.tight_layout()
-ch.save(fig, "01_kernels.png")
-plt.show()
+ch.show(fig, "01_kernels.png", caption="The cubic B-spline and the Wendland C2 kernel (left, 2D normalisation) and "
+                                       "their radial slopes (right) against q = r/h; both fade out smoothly at the "
+                                       "end of the support, q = 2, and the dots mark the steepest slope.")
 print(f"|f'(q)| is largest at q = {q_peak['cubic']:.3f} (cubic) and q = {q_peak['wendland']:.3f} (Wendland)")
 assert abs(q_peak["cubic"] - 2 / 3) < 1e-3 and abs(q_peak["wendland"] - 0.5) < 1e-3
 
@@ -400,8 +401,10 @@ for ax in axes:
     ax.set_xlabel(r"$x/\Delta p$ [-]")
     ax.set_ylabel(r"$y/\Delta p$ [-]")
 fig.tight_layout()
-ch.save(fig, "01_partition_of_unity.png")
-plt.show()
+ch.show(fig, "01_partition_of_unity.png", caption="A block of particles with h/Δp = 1.5: the kernel sum Σ V W (left) "
+                                                  "is one inside and falls off in the outer two or three layers; the "
+                                                  "gradient of a constant (right) is zero inside and of order 1/h at "
+                                                  "the surface, pointing into the block.")
 
 # %% [markdown]
 # At a straight edge half of the support lies outside the material, at a right-angled corner three quarters,
@@ -468,6 +471,8 @@ for name, K in KERNELS.items():
 # %% [markdown]
 # ## Your turn
 #
+# Predict first, run, then open *What you should see*. The last exercise asks for code, graded against the package.
+#
 # ### Exercise 1 — More neighbours, same surface
 #
 # Predict: if you raise $h/\Delta p$ from 1.5 to 3, the interior particle gets about four times as many
@@ -481,10 +486,15 @@ print(f"h/dp = {HDP}: interior sum V W - 1 = {s_w_in - 1:+.1e} with {n_in} neigh
       f"edge {s_w_b[edge]:.3f}, corner {s_w_b[corner]:.3f}")
 
 # %% [markdown]
-# What you should see: the neighbour count grows like $(h/\Delta p)^2$, but the edge and corner sums get
-# *worse*, moving towards the continuum values $\frac12$ and $\frac14$: a wider kernel has more of its support
-# outside the material, and more surface layers are affected. More neighbours do not cure a free surface.
+# <details><summary>What you should see</summary>
 #
+# The neighbour count grows like $(h/\Delta p)^2$, but the edge and corner sums get *worse*, falling towards the
+# continuum values $\frac12$ and $\frac14$ of a kernel cut in half or in four (the surface row's excess, its volume
+# reaching $\Delta p/2$ outside, shrinks like $\Delta p/h$), and more layers lie within $2h$ of the surface. More
+# neighbours do not cure a free surface.
+# </details>
+
+# %% [markdown]
 # ### Exercise 2 — Switch the kernel to Wendland
 #
 # Predict: Wendland is the "stable" kernel. Does it also reproduce a constant better inside the lattice, at
@@ -498,7 +508,52 @@ for hdp in (1.2, 1.5, 2.0, 3.0):
 print(f"smallest Fourier transform (2D): {fourier_radial(get_kernel(KERNEL), 2, kh).min():+.1e}")
 
 # %% [markdown]
-# What you should see: the cubic spline's error is small but jumps up and down with $h/\Delta p$ (it depends on
-# how the lattice shells fall on the kernel); its Fourier transform has a negative minimum. Wendland's error is
-# larger at every $h/\Delta p$ here, much larger at small ones, and falls steadily as $h/\Delta p$ grows; its
-# transform stays positive. It is the kernel you *can* give many neighbours, and the one that needs them.
+# <details><summary>What you should see</summary>
+#
+# The cubic spline's error is small but jumps up and down with $h/\Delta p$ (it depends on how the lattice shells
+# fall on the kernel); its Fourier transform has a negative minimum. Wendland's error is larger at every
+# $h/\Delta p$ here, much larger at small ones, and falls steadily as $h/\Delta p$ grows; its transform stays
+# positive. It is the kernel you *can* give many neighbours, and the one that needs them.
+# </details>
+
+# %% [markdown]
+# ### Exercise 3 — Write the kernel yourself
+#
+# Write $W$ and $\nabla_i W$ of the cubic spline, Eq. (9), for many pairs at once: `xij` holds one
+# $\mathbf x_{ij}$ per row (shape (M, dim), dim = 2 or 3), `h` is in metres; return `W`, shape (M,), and `gradW`,
+# shape (M, dim). Whole arrays, no loop (`np.linalg.norm`, `np.where`). The grader compares your function with
+# `refsph.kernels` on five cases, among them pairs exactly at the joints $q = 1$ and $q = 2$, pairs beyond the
+# support, and a particle paired with itself ($r = 0$).
+#
+# Predict: which case will a first attempt most likely fail, and why?
+
+# %% tags=["exercise"]
+from refsph.teaching.grader import case, check
+
+
+def my_cubic(xij, h, dim):
+    """W(|x_ij|, h) and grad_i W(x_ij) of Eq. (9) for each row of xij: arrays of shape (M,) and (M, dim)."""
+    raise NotImplementedError("write W and grad W of Eq. (9) here")      # <- replace this line by your code
+
+
+def pkg_cubic(xij, h, dim):                                              # the package's answer
+    return cubic.w(np.linalg.norm(xij, axis=1), h, dim), cubic.grad(xij, h, dim)
+
+
+h_ex = 1.5e-5                                                            # h = 1.5 dp with dp = 10 um [m]
+cases_ex3 = [case(rng.uniform(-2.2, 2.2, (60, 2)) * h_ex, h_ex, 2, label="2D, random pairs"),
+             case(rng.uniform(-2.2, 2.2, (60, 3)) * h_ex, h_ex, 3, label="3D, random pairs"),
+             case(np.array([[h_ex, 0.0], [0.0, -2 * h_ex], [0.6 * h_ex, 0.8 * h_ex]]), h_ex, 2, label="q = 1 and 2"),
+             case(np.array([[2.5 * h_ex, 0.0], [0.0, 4.0 * h_ex]]), h_ex, 2, label="beyond the support, q > 2"),
+             case(np.zeros((1, 2)), h_ex, 2, label="r = 0: a particle paired with itself")]
+report = check(my_cubic, pkg_cubic, cases_ex3, names=("W", "grad W"))
+
+# %% [markdown]
+# <details><summary>What you should see</summary>
+#
+# As handed out: `FAIL ... not written yet`. Then, typically, a failure at $r = 0$: $\nabla W =
+# \frac{\partial W}{\partial r}\frac{\mathbf x_{ij}}{r}$ gives $0/0$ = `nan` there. Use the finite limit of this
+# chapter's section on the gradient: $\frac1r\frac{\partial W}{\partial r} = \frac{\alpha_d}{h^2}\frac{f'(q)}{q}$, and
+# $f'(q)/q = -3 + \frac94 q$ on the inner piece has no division at all. Beyond the support the outer piece
+# $\frac14(2-q)^3$ turns negative: it needs its own zero. When all five cases agree: `PASS`.
+# </details>

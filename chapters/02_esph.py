@@ -241,8 +241,10 @@ colorbar(fig, sc, ax, "log10 of relative error of l [-]")
 ax.set_xlabel("x [mm]")
 ax.set_ylabel("y [mm]")
 ax.set_title("ESPH velocity gradient of v = A x")
-ch.save(fig, "02_velocity_gradient_patch.png")
-plt.show()
+ch.show(fig, "02_velocity_gradient_patch.png", caption="The error (log10) of the ESPH velocity gradient of the linear "
+                                                       "field v = A x on a square block: small inside, tens of per "
+                                                       "cent within 2h of the free surface, where the kernel's "
+                                                       "support is cut off.")
 
 # %% [markdown]
 # Inside, the error is the small lattice-sum error of the cubic spline. Within $2h$ of the surface it grows to
@@ -414,8 +416,10 @@ axes[1].set_xlabel("x [mm]")
 axes[1].set_ylabel("y [mm]")
 axes[1].set_title(f"ESPH, gamma = 0, at the end: {len(Ic)} clumped pairs (black)")
 fig.tight_layout()
-ch.save(fig, "02_tensile_instability.png")
-plt.show()
+ch.show(fig, "02_tensile_instability.png", caption="The tensile instability: the smallest pair distance in an "
+                                                   "expanding block over time (left) for ESPH with γ = 0 and γ = 0.3 "
+                                                   "and for TLSPH, and the ESPH block with γ = 0 at the end (right), "
+                                                   "its clumped pairs in black.")
 
 # %% [markdown]
 # Without artificial pressure the closest pair keeps approaching for as long as the block is in tension, and
@@ -440,6 +444,8 @@ plt.show()
 # %% [markdown]
 # ## Your turn
 #
+# Predict first, run, then open *What you should see*. The last exercise asks for code, graded against the package.
+#
 # ### Exercise 1 — How much artificial pressure?
 #
 # Predict: the paper's $\gamma = 0.3$ keeps the particles of the expanding block apart. If $\gamma = 0.02$, is
@@ -452,11 +458,15 @@ print(f"gamma = {GAMMA}: smallest pair distance over the run = "
       f"{r.summary['metrics']['min_pair_distance_over_dp']:.3f} dp")
 
 # %% [markdown]
-# What you should see: a small $\gamma$ already helps — the closest pair stays further apart than without any
-# artificial pressure, though not as far as with $0.3$. A large $\gamma$ is *not* safer: the repulsion itself
-# becomes violent, and at $\gamma = 3$ particles are thrown onto each other within microseconds and the
-# smallest distance collapses towards zero. The remedy has a window that works, and it has to be found by trial.
+# <details><summary>What you should see</summary>
 #
+# A small $\gamma$ already helps — the closest pair stays further apart than without any artificial pressure,
+# though not as far as with $0.3$. A large $\gamma$ is *not* safer: the repulsion itself becomes violent, and at
+# $\gamma = 3$ particles are thrown onto each other within microseconds and the smallest distance collapses
+# towards zero. The remedy has a window that works, and it has to be found by trial.
+# </details>
+
+# %% [markdown]
 # ### Exercise 2 — Refine the bar
 #
 # Predict: the bar's wave-speed error comes from surface layers about $2h$ thick. If you halve the particle
@@ -469,6 +479,50 @@ m = r.summary["metrics"]                                        # one half perio
 print(f"dp = W/{NW}: c = {m['wave_speed_m_s']:.0f} m/s, error {100 * m['wave_speed_rel_error']:+.2f} %")
 
 # %% [markdown]
-# What you should see: the bar is still too slow, but the error is roughly halved — first-order convergence in
-# $\Delta p$, as expected of an error that lives in a surface layer whose thickness is proportional to
-# $\Delta p$. (The run costs about eight times more: four times the particles, twice the steps.)
+# <details><summary>What you should see</summary>
+#
+# The bar is still too slow, but the error is roughly halved — first-order convergence in $\Delta p$, as expected
+# of an error that lives in a surface layer whose thickness is proportional to $\Delta p$. (The run costs about
+# eight times more: four times the particles, twice the steps.)
+# </details>
+
+# %% [markdown]
+# ### Exercise 3 — Write the Jaumann rate yourself
+#
+# Write Eq. (20) for $n$ particles in 2D plane strain: `S` holds the in-plane deviatoric stresses, shape (n, 2, 2)
+# [Pa], `S_zz` the out-of-plane ones, shape (n,), `l` the velocity gradients $l_{ab} = \partial v_a/\partial x_b$,
+# shape (n, 2, 2) [1/s]; return $\dot{\mathbf s}$ and $\dot s_{zz}$ [Pa/s]. Whole arrays (`np.swapaxes`, `@`), no
+# loop. The grader compares with `refsph.material.jaumann_deviatoric_rate` on a stretch, a rigid spin of a
+# pre-stressed particle, a compression and 20 random particles.
+#
+# Predict: which two details of this chapter will the cases catch if you get them wrong?
+
+# %% tags=["exercise"]
+from refsph.teaching.grader import case, check
+
+
+def my_jaumann(S, S_zz, l, G):
+    """Eq. (20) in plane strain: (ds/dt of shape (n, 2, 2), ds_zz/dt of shape (n,))."""
+    raise NotImplementedError("write the Jaumann rate, Eq. (20), here")      # <- replace this line by your code
+
+
+rng_ex = np.random.default_rng(3)
+S_rand = rng_ex.normal(scale=2e8, size=(20, 2, 2))
+S_rand = S_rand + np.swapaxes(S_rand, 1, 2)                               # symmetric, ~300 MPa
+cases_ex3 = [case(np.zeros((1, 2, 2)), np.zeros(1), np.array([[[1e3, 0.0], [0.0, 0.0]]]), mat.G, label="a stretch"),
+             case(S0, Szz0, l_rot, mat.G, label="a rigid spin of a pre-stressed particle"),
+             case(S0, Szz0, np.array([[[-2e3, 0.0], [0.0, -1e3]]]), mat.G, label="a compression"),
+             case(S_rand, -np.trace(S_rand, axis1=1, axis2=2), rng_ex.normal(scale=1e3, size=(20, 2, 2)), mat.G,
+                  label="20 random particles")]
+report = check(my_jaumann, jaumann_deviatoric_rate, cases_ex3, names=("ds/dt", "ds_zz/dt"))
+
+# %% [markdown]
+# <details><summary>What you should see</summary>
+#
+# As handed out: `FAIL ... not written yet`. The two details: the order of the spin terms (with the printed
+# $\mathbf s\boldsymbol\omega - \boldsymbol\omega\mathbf s$ and this chapter's $l_{ab} = \partial v_a/\partial
+# x_b$ the rigid spin fails: the stress turns the wrong way), and plane strain (the deviator is that of the 3D
+# strain rate, $\mathrm{tr}\,\dot{\boldsymbol\epsilon}/3$ with $\dot\epsilon_{zz} = 0$, and $\dot s_{zz} =
+# -\tfrac23 G\,\mathrm{tr}\,\dot{\boldsymbol\epsilon}$ is not zero: the stretch fails without it). When all four
+# cases agree: `PASS`.
+# </details>

@@ -129,8 +129,8 @@ axes[2].plot(T_grid, f_T, "k")
 axes[2].set(xlabel="temperature T [K]", ylabel=r"$1 - T^{*m}$ [-]", title=f"thermal, m = {jc.m}")
 for ax in axes:
     ax.grid(alpha=0.3)
-ch.save(fig, "04_johnson_cook_factors.png")
-plt.show()
+ch.show(fig, "04_johnson_cook_factors.png", caption="The factors of the Johnson–Cook yield stress of 4340, Eq. (25): "
+                                                    "strain hardening, rate (printed and clamped), thermal.")
 
 # %% [markdown]
 # The rate factor of 4340 is weak (small $C$); the thermal factor falls almost linearly to zero at $T_m$.
@@ -328,8 +328,8 @@ for r_, ls in ((RATE_CH, "--"), (jc.eps_dot_0, ":")):
 ax.set(xlabel=r"equivalent strain $\gamma/\sqrt{3}$ [-]", ylabel=r"von Mises stress $\sigma_{vm}$ [MPa]",
        ylim=(jc.A / 1e6 - 80, None), xlim=(0.0, STRAIN_CH), title=f"simple shear at {RATE_CH:.0e} /s")
 ax.legend(fontsize=8, loc="lower right")
-ch.save(fig, "04_johnson_cook_rate_chatter.png")
-plt.show()
+ch.show(fig, "04_johnson_cook_rate_chatter.png", caption="Simple shear at 10⁴ /s: the previous step's plastic rate "
+                                                         "makes the return map chatter; the total rate does not.")
 
 # %% [markdown]
 # With the previous step's plastic rate the return map falls into a two-step cycle. After an elastic step the rate
@@ -428,8 +428,8 @@ for n, (ep_n, rel_n) in conv.items():
 axes[1].set(xlabel=r"plastic strain $\bar\epsilon_p$ [-]", ylabel=r"$|\sigma_{vm}/\sigma_y - 1|$ [-]",
             ylim=(1e-5, 1e-1), title="the one-step lag (shear): first order")
 axes[1].legend()
-ch.save(fig, "04_johnson_cook_material_point.png")
-plt.show()
+ch.show(fig, "04_johnson_cook_material_point.png", caption="A material point on Eq. (25) in tension and shear (left), "
+                                                           "and its first-order lag behind the yield stress (right).")
 
 # %% [markdown]
 # Both loadings give the same $\sigma_{vm}(\bar\epsilon_p)$ curve: von Mises plasticity with isotropic hardening does
@@ -495,8 +495,8 @@ axes[1].plot(adi["eps_p"], T_ode, "k--", label="ODE")
 axes[1].set(xlabel=r"plastic strain $\bar\epsilon_p$ [-]", ylabel="temperature T [K]",
             title="temperature of the adiabatic particle")
 axes[1].legend()
-ch.save(fig, "04_johnson_cook_adiabatic.png")
-plt.show()
+ch.show(fig, "04_johnson_cook_adiabatic.png", caption="Adiabatic shear softens past its maximum (left, the dot); the "
+                                                      "particle's temperature follows the ODE of Eq. (28) (right).")
 
 # %% [markdown]
 # Hardening wins at first, but the hardening rate $Bn\bar\epsilon_p^{\,n-1}$ falls while the heating
@@ -555,6 +555,8 @@ for T in (jc.T_melt - 50.0, jc.T_melt, jc.T_melt + 100.0):
 # %% [markdown]
 # ## Your turn
 #
+# Predict first, run, then open *What you should see*. The last exercise asks for code, graded against the package.
+#
 # ### Exercise 1 — Faster
 #
 # Predict: a bar of 4340 pulled at $10^5$ /s instead of $10^3$ /s. By what factor does its flow stress rise? And
@@ -568,16 +570,20 @@ s_02 = np.interp(0.2, o["eps_p"], o["sigma"][:, 0, 0])              # flow stres
 ratio = s_02 / yield_stress(jc, 0.2, jc.eps_dot_0, T0)
 print(f"{RATE:.0e} /s: flow stress at eps_p = 0.2 is {s_02 / 1e6:.0f} MPa, {ratio:.3f} x the one at 1 /s; "
       f"1 + C ln(rate / eps_dot_0) = {1 + jc.C * math.log(RATE / jc.eps_dot_0):.3f}")
-plt.plot(o["eps_p"], o["sigma"][:, 0, 0] / 1e6)
-plt.xlabel("plastic strain [-]")
-plt.ylabel("uniaxial stress [MPa]")
-plt.show()
+fig, ax = plt.subplots(figsize=(6.5, 4), constrained_layout=True)
+ax.plot(o["eps_p"], o["sigma"][:, 0, 0] / 1e6)
+ax.set(xlabel="plastic strain [-]", ylabel="uniaxial stress [MPa]", title=f"{RATE:.0e} /s")
+ch.show(fig, caption="Uniaxial stress against plastic strain of one 4340 particle pulled at the exercise's rate.")
 
 # %% [markdown]
-# What you should see: above the reference rate the whole curve is lifted by the factor $1 + C\ln\dot\epsilon^*$
-# (within the one-step lag), weakly, since $C$ is small for 4340. Below it the clamp makes the factor 1, while the
-# printed formula would give a number *below* 1.
+# <details><summary>What you should see</summary>
 #
+# Above the reference rate the whole curve is lifted by the factor $1 + C\ln\dot\epsilon^*$ (within the one-step
+# lag), weakly, since $C$ is small for 4340. Below it the clamp makes the factor 1, while the printed formula would
+# give a number *below* 1.
+# </details>
+
+# %% [markdown]
 # ### Exercise 2 — How much of the work becomes heat?
 #
 # Predict: in adiabatic shear, what happens to the peak of the stress–strain curve if only half the plastic work
@@ -589,16 +595,20 @@ o = shear(replace(jc, chi=CHI), RATE_AD, T0, n=500, strain=STRAIN_AD, heating=Tr
 k = int(np.argmax(o["sigma_vm"]))
 print(f"chi = {CHI}: peak stress {o['sigma_vm'][k] / 1e6:.0f} MPa at eps_p = {o['eps_p'][k]:.2f}; at the end "
       f"{o['sigma_vm'][-1] / 1e6:.0f} MPa, T = {o['T'][-1]:.0f} K")
-plt.plot(2 * o["strain"][:, 0, 1], o["S"][:, 0, 1] / 1e6)
-plt.xlabel("shear strain [-]")
-plt.ylabel("shear stress [MPa]")
-plt.show()
+fig, ax = plt.subplots(figsize=(6.5, 4), constrained_layout=True)
+ax.plot(2 * o["strain"][:, 0, 1], o["S"][:, 0, 1] / 1e6)
+ax.set(xlabel="shear strain [-]", ylabel="shear stress [MPa]", title=f"adiabatic shear, chi = {CHI}")
+ch.show(fig, caption="Shear stress against shear strain of one 4340 particle in adiabatic shear at 1e4 /s.")
 
 # %% [markdown]
-# What you should see: with less heating the particle gets less hot, the peak moves to a larger strain and the
-# softening after it is milder. With $\chi = 0$ the temperature stays at room temperature and there is no peak
-# at all: the curve hardens to the end, as the isothermal curve of Section 5.
+# <details><summary>What you should see</summary>
 #
+# With less heating the particle gets less hot, the peak moves to a larger strain and the softening after it is
+# milder. With $\chi = 0$ the temperature stays at room temperature and there is no peak at all: the curve hardens
+# to the end, as the isothermal curve of Section 5.
+# </details>
+
+# %% [markdown]
 # ### Exercise 3 — Which melting temperature?
 #
 # Predict: the same adiabatic shear with $T_m$ = 1793 K (the usual value for 4340) instead of Table 1's 1293 K.
@@ -610,12 +620,49 @@ o = shear(replace(jc, T_melt=T_MELT), RATE_AD, T0, n=500, strain=STRAIN_AD, heat
 k = int(np.argmax(o["sigma_vm"]))
 print(f"T_m = {T_MELT:.0f} K: peak at eps_p = {o['eps_p'][k]:.2f}; at the end sigma_vm = "
       f"{o['sigma_vm'][-1] / 1e6:.0f} MPa, T = {o['T'][-1]:.0f} K")
-plt.plot(o["eps_p"], o["sigma_vm"] / 1e6)
-plt.xlabel("plastic strain [-]")
-plt.ylabel("von Mises stress [MPa]")
-plt.show()
+fig, ax = plt.subplots(figsize=(6.5, 4), constrained_layout=True)
+ax.plot(o["eps_p"], o["sigma_vm"] / 1e6)
+ax.set(xlabel="plastic strain [-]", ylabel="von Mises stress [MPa]", title=f"T_m = {T_MELT:.0f} K")
+ch.show(fig, caption="Von Mises stress against plastic strain of one 4340 particle in adiabatic shear at 1e4 /s.")
 
 # %% [markdown]
-# What you should see: with the higher $T_m$ every kelvin softens less, so the steel stays stronger, the peak comes
-# later, and — because the stronger material does more plastic work per unit strain — the particle ends up
-# *hotter*, yet still stronger. The choice of $T_m$ changes a machining simulation's forces and temperatures alike.
+# <details><summary>What you should see</summary>
+#
+# With the higher $T_m$ every kelvin softens less, so the steel stays stronger, the peak comes later, and —
+# because the stronger material does more plastic work per unit strain — the particle ends up *hotter*, yet still
+# stronger. The choice of $T_m$ changes a machining simulation's forces and temperatures alike.
+# </details>
+
+# %% [markdown]
+# ### Exercise 4 — Write the return map yourself
+#
+# Write the return map of Section 1 for $n$ particles, whole arrays, no loop: from the trial deviatoric stress `S`
+# (n, d, d) [Pa] (and `S_zz` (n,) in 2D plane strain; zeros in 3D), the start-of-step `eps_p`, `T` [K], the density
+# `rho` and the rate `eps_dot` [1/s], return $\mathbf s_n$, $s_{zz,n}$, $\Delta\bar\epsilon_p$, $\Delta w_p$ and
+# $\Delta T$ (Eqs. 28–31), $\sigma_y$ from `yield_stress`. Predict: which case fails if $J_2$ leaves out $s_{zz}$?
+
+# %% tags=["exercise"]
+def my_return_map(S, S_zz, eps_p, T, rho, eps_dot, jc, G):
+    """Radial return and Eqs. (28)-(31): (S_n, S_zz_n, d_eps_p, d_w_p, d_T) from the trial stress."""
+    raise NotImplementedError("write the return map here")      # <- replace this line by your code
+
+
+from refsph.teaching.grader import case, check
+s_el = np.array([[[100e6, 50e6, 0.0], [50e6, -100e6, 0.0], [0.0, 0.0, 0.0]]])       # von Mises 194 MPa < A
+s_2d = np.array([[[1.2e9, 5e8], [5e8, -0.6e9]]])                                     # with s_zz = -0.6 GPa
+one = (np.array([0.1]), np.array([T0]), np.array([mat.rho0]), np.array([1e3]), jc, mat.G)   # eps_p, T, rho, rate
+cases_ex4 = [case(s_el, np.zeros(1), *one, label="elastic: inside the yield surface"),
+             case(10 * s_el, np.zeros(1), *one, label="3D, plastic, room temperature"),
+             case(s_2d, np.array([-0.6e9]), *one, label="2D plane strain: s_zz is part of J2"),
+             case(10 * s_el, np.zeros(1), one[0], one[1] + 1100.0, *one[2:], label="molten: sigma_y = 0")]
+for d in (3, 2):
+    cases_ex4.append(case(*random_trial_states(400, d, jc, seed=d), jc, mat.G, label=f"{d}D, 400 random states"))
+report = check(my_return_map, plastic_update, cases_ex4, names=("S_n", "S_zz_n", "d eps_p", "d w_p", "d T"))
+
+# %% [markdown]
+# <details><summary>What you should see</summary>
+#
+# As handed out: `FAIL ... not written yet`. $J_2 = \frac12\mathbf s:\mathbf s$ includes $s_{zz}$ in plane strain:
+# without it the 2D case returns to the wrong surface. Above $T_m$, $\sigma_y = 0$ and $c_f = 0$: the whole trial
+# deviator becomes plastic strain, with no work done. When all six cases agree: `PASS`.
+# </details>

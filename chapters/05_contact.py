@@ -118,8 +118,8 @@ ax.set_xlabel(r"penetration $p_d$ / $\Delta p$")
 ax.set_ylabel("force / $K_p$ [N/m]")
 ax.legend(loc="lower right")
 fig.tight_layout()
-ch.save(fig, "05_force_law.png")
-plt.show()
+ch.show(fig, "05_force_law.png", caption="The pinball forces per unit K_p: the Hertz force F² (Eq. (35)) grows with "
+                                         "penetration, the rate force F¹ (Eq. (34), dashed) does not.")
 
 # %% [markdown]
 # The force is the lower of the two curves. At impact speeds the Hertz spring governs until the pair has gone a
@@ -436,8 +436,8 @@ for a in ax:
     a.set_xlabel("t [µs]")
     a.legend()
 fig.tight_layout()
-ch.save(fig, "05_bounce_history.png")
-plt.show()
+ch.show(fig, "05_bounce_history.png", caption="A disc bouncing off a wall of tool particles, ESPH and TLSPH: force on "
+                                              "the wall (left), disc momentum (right); dashed: a kinematic wall.")
 
 # %% [markdown]
 # Both methods bounce the disc, and no disc particle crosses the wall face. Neither gives back all the momentum:
@@ -480,8 +480,8 @@ for a in ax:
 ax[0].set_ylabel("restitution (dashed: kinematic wall)")
 ax[1].set_ylabel(r"max penetration $p_d$ / $\Delta p$")
 fig.tight_layout()
-ch.save(fig, "05_kp_scan.png")
-plt.show()
+ch.show(fig, "05_kp_scan.png", caption="TLSPH bounces against the scaling factor K_p at several speeds: restitution "
+                                       "(left; dashed: a kinematic wall) and largest penetration (right).")
 
 # %% [markdown]
 # A small $K_p$ lets the disc sink deep into the wall and kills the rebound. At $K_p$ = 50 the restitution has
@@ -568,6 +568,8 @@ assert o["face"].min() < 0.0
 #
 # ## Your turn
 #
+# Predict first, run, then open *What you should see*. The last exercise asks for code, graded against the package.
+#
 # ### Exercise 1 — The scaling factor $K_p$
 #
 # Predict: with $K_p$ = 5 instead of 50, does the disc go deeper into the wall or less deep? Does it bounce back
@@ -580,10 +582,13 @@ print(f"K_p = {K_P:g}: restitution {o['restitution']:.3f}, max penetration {o['p
       f"energy after / before {o['energy']:.3f}")
 
 # %% [markdown]
-# What you should see: with $K_p$ = 5 the disc sinks several times deeper into the wall and comes back clearly
-# slower: the softer contact takes in energy on the way in and does not give it all back (nothing acts while the
-# pairs separate).
+# <details><summary>What you should see</summary>
 #
+# With $K_p$ = 5 the disc sinks several times deeper into the wall and comes back clearly slower: the softer
+# contact takes in energy on the way in and does not give it all back (nothing acts while the pairs separate).
+# </details>
+
+# %% [markdown]
 # ### Exercise 2 — The pinball radius factor $k$
 #
 # Predict: the pinball radius is $R = k h$, here $k$ = `K_FACTOR` $\times\,\Delta p/(2h)$. With `K_FACTOR` = 1.2,
@@ -596,10 +601,14 @@ print(f"k = {K_FACTOR:g} dp/(2h): contact starts at 2R = {K_FACTOR:g} dp; closes
       f"{o['closest']:.3f} dp, max penetration {o['pen']:.3f} dp, restitution {o['restitution']:.3f}")
 
 # %% [markdown]
-# What you should see: the disc stops about 0.2 spacings farther from the wall (the contact surface moved out with
-# $2R$), while the penetration and the restitution hardly change: $k$ sets *where* the wall is, not how stiff it
-# is. $k = \Delta p/(2h)$ puts the contact where the faces are.
+# <details><summary>What you should see</summary>
 #
+# The disc stops about 0.2 spacings farther from the wall (the contact surface moved out with $2R$), while the
+# penetration and the restitution hardly change: $k$ sets *where* the wall is, not how stiff it is.
+# $k = \Delta p/(2h)$ puts the contact where the faces are.
+# </details>
+
+# %% [markdown]
 # ### Exercise 3 — Friction and Coulomb's bound
 #
 # Predict: turn friction on with $\mu_0$ = 0.81 (AISI 1045) for the oblique throw at the fine wall. How much
@@ -618,6 +627,45 @@ print(f"mu0 = {MU0}: J_f / J_N = {J_f / J_N:.3f}, wall J_t / J_n = {o['Jt_over_J
 assert J_f <= MU0 * J_N * (1 + 1e-12)          # Coulomb's bound, summed over the run
 
 # %% [markdown]
-# What you should see: with $\mu_0$ = 0.81 the block loses a large part of its speed along the wall, $J_f/J_N$
-# comes out at (or just below, where pairs stuck) $\mu_0$, never above it, and the wall's $J_t/J_n$ is close to
-# $\mu_0$ (a little above it: the fine wall still has small bumps).
+# <details><summary>What you should see</summary>
+#
+# With $\mu_0$ = 0.81 the block loses a large part of its speed along the wall, $J_f/J_N$ comes out at (or just
+# below, where pairs stuck) $\mu_0$, never above it, and the wall's $J_t/J_n$ is close to $\mu_0$ (a little above
+# it: the fine wall still has small bumps).
+# </details>
+
+# %% [markdown]
+# ### Exercise 4 — Write the pinball force yourself
+#
+# Write Eqs. (32)–(36) for particles $a$ (positions `x_a` [m], velocities `v_a` [m/s], masses `m_a` [kg/m in 2D])
+# against rigid particles $b$ at rest (`x_b`): return the acceleration of each $a$ particle, shape (n, d). For a
+# rigid partner $m_{ij} = m_i$ and $\mu_{ij} = G$; in 2D divide the Hertz force by `thickness` = $\Delta p$ (3D: 1).
+# Whole arrays, no loop over particles. Predict: which case fails if $F^1$ is not zero for separating pairs?
+
+# %% tags=["exercise"]
+def my_pinball(x_a, v_a, m_a, x_b, R, G, dt, K_p, thickness):
+    """Eqs. (32)-(36): acceleration (n_a, d) of particles a from rigid particles b at rest, pinball radius R."""
+    raise NotImplementedError("write the pinball contact here")      # <- replace this line by your code
+
+
+def pkg_pinball(x_a, v_a, m_a, x_b, R, G, dt, K_p, thickness):
+    return pinball_contact(x_a, v_a, m_a, x_b, 0 * x_b, math.inf, R, G, math.inf, dt, PinballContact(1.0, K_p),
+                           thickness=thickness).a
+
+
+from refsph.teaching.grader import case, check
+rng_ex, at = np.random.default_rng(9), (R_BALL, mat.G, dt_test, NUM.contact_Kp)
+cases_ex4 = [case(*random_contact(rng_ex, 2, 12, True)[:4], *at, DP, label="2D block, random velocities"),
+             case(*random_contact(rng_ex, 3, 4, True)[:4], *at, 1.0, label="3D block, random velocities")]
+for v0, what in ((V_IMPACT, "the disc pressing into the wall"), (-V_IMPACT, "the disc leaving it")):
+    d_ex = disc_state(v0, -0.1 * DP)                                 # its face 0.1 dp inside the wall
+    cases_ex4.append(case(d_ex.x, d_ex.v, d_ex.m, wall_main.x, *at, DP, label=what))
+report = check(my_pinball, pkg_pinball, cases_ex4)
+
+# %% [markdown]
+# <details><summary>What you should see</summary>
+#
+# As handed out: `FAIL ... not written yet`. The random velocities and the disc leaving the wall catch an $F^1$ that
+# does not vanish while a pair separates ($\dot p_d \le 0$: no force, Eq. 34); the 2D cases a missing division by
+# the thickness. Pairs: `cKDTree(x_b).query_ball_point(x_a, 2 * R)`, or all distances at once by broadcasting.
+# </details>

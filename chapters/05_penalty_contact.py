@@ -113,8 +113,10 @@ ax[0].set(xlabel="t [µs]", ylabel="block velocity along the plane [m/s]")
 ax[1].set(xlabel="t [µs]", ylabel="$F_t/F_N$ on the plane (running mean)", ylim=(0, 1))
 ax[0].legend()
 fig.tight_layout()
-ch.save(fig, "05_incline.png")
-plt.show()
+ch.show(fig, "05_incline.png", caption="A block sliding down a tilted plane on the pinball and on the penalty "
+                                       "contact, for several friction coefficients μ and mass scales s: its velocity "
+                                       "against the closed form (left), and the ratio of tangential to normal force "
+                                       "on the plane, which should be μ (right).")
 
 # %% [markdown]
 # The penalty contact gives Coulomb's law: $F_t/F_N = \mu$ and the closed-form acceleration, at either mass scale.
@@ -225,6 +227,8 @@ print(f"heat of the slipping particle in this step: {2.0 * (5e-6 - 2e-6) * 1e6:.
 #
 # ## Your turn
 #
+# Predict first, run, then open *What you should see*. The last exercise asks for code, graded against the package.
+#
 # ### Exercise 1 — The penalty stiffness $\alpha$
 #
 # Predict: with $\alpha$ = 0.02 instead of 0.1 (`Numerics(penalty_alpha=...)`), does the block's face sink deeper
@@ -237,10 +241,13 @@ print(f"alpha = {ALPHA:g}: the face sinks {o['sink']:.4f} dp, F_t / F_N = {o['mu
       f"a / closed form = {o['a'] / A_EXACT:.3f}")
 
 # %% [markdown]
-# What you should see: about five times deeper (the spring is five times softer: $g \propto 1/\alpha$), still a
-# small fraction of a spacing, and the same $F_t/F_N = \mu$ and acceleration: $\alpha$ sets how far the surface
-# gives, not the friction.
+# <details><summary>What you should see</summary>
 #
+# About five times deeper (the spring is five times softer: $g \propto 1/\alpha$), still a small fraction of a
+# spacing, and the same $F_t/F_N = \mu$ and acceleration: $\alpha$ sets how far the surface gives, not the friction.
+# </details>
+
+# %% [markdown]
 # ### Exercise 2 — Below the friction angle
 #
 # Predict: keep the tilt ($\tan\theta$ = 0.6) and raise $\mu$ to 0.8. Does the block slide? What is $F_t/F_N$ on
@@ -253,6 +260,39 @@ print(f"mu = {MU_EX:g}: a = {o['a']:.3g} m/s^2 (closed form if it slides: "
       f"{G_P * (math.sin(THETA) - MU_EX * math.cos(THETA)):.3g}), F_t / F_N = {o['mu_eff']:.3f}")
 
 # %% [markdown]
-# What you should see: the block sticks ($a \approx 0$) and $F_t/F_N$ = 0.6 = $\tan\theta$, not 0.8: a stuck
-# contact carries the force that holds the block, anything inside the Coulomb cone. The return map keeps every
-# particle's spring inside it.
+# <details><summary>What you should see</summary>
+#
+# The block sticks ($a \approx 0$) and $F_t/F_N$ = 0.6 = $\tan\theta$, not 0.8: a stuck contact carries the force
+# that holds the block, anything inside the Coulomb cone. The return map keeps every particle's spring inside it.
+# </details>
+
+# %% [markdown]
+# ### Exercise 3 — Write the friction return map yourself
+#
+# Write Coulomb's return map of the section above for $n$ particles, whole arrays, no loop: from the trial
+# histories `xi_trial` (n, d) [m], the spring stiffnesses `k` (n,) [N/m] and the limits $\mu f_N$ `f_limit` (n,)
+# [N], return the friction forces $\mathbf f_t$ (n, d) and the new histories $\boldsymbol\xi$ (n, d). The grader
+# compares with `penalty.return_map_friction`. Predict: which output does a first attempt most often get wrong?
+
+# %% tags=["exercise"]
+def my_friction(xi_trial, k, f_limit):
+    """Coulomb's return map: stick if |k xi*| <= mu f_N, else slip back onto the cone; returns (f_t, xi)."""
+    raise NotImplementedError("write the return map of friction here")      # <- replace this line by your code
+
+
+from refsph.teaching.grader import case, check
+rng_ex = np.random.default_rng(7)
+cases_ex3 = [case(np.array([[1e-6, 0.0]]), np.array([1e6]), np.array([2.0]), label="sticks: 1 N inside a 2 N cone"),
+             case(np.array([[4e-6, 3e-6]]), np.array([1e6]), np.array([2.0]), label="slips: 5 N outside a 2 N cone"),
+             case(np.array([[4e-6, 3e-6]]), np.array([1e6]), np.array([0.0]), label="no normal force: no friction"),
+             *(case(rng_ex.normal(0, 2e-6, (100, d)), rng_ex.uniform(1e5, 1e7, 100), rng_ex.uniform(0, 5, 100),
+                    label=f"{d}D, 100 random particles, sticking and slipping") for d in (2, 3))]
+report = check(my_friction, penalty.return_map_friction, cases_ex3, names=("f_t", "xi"))
+
+# %% [markdown]
+# <details><summary>What you should see</summary>
+#
+# As handed out: `FAIL ... not written yet`. The force is usually right first; the history is not: on slip the
+# spring must be shortened to what the returned force stretches, $\boldsymbol\xi = -\mathbf f_t/k$, or the next step
+# starts from a spring still stretched beyond the cone. The grader names the output, `xi`. Then: `PASS`.
+# </details>

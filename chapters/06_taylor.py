@@ -149,8 +149,9 @@ for ax, pts, half, title in ((axes[0], x_show[x_show[:, 2] == x_show[0, 2]], 0.5
     ax.plot(1e3 * r_meas * np.cos(th), 1e3 * r_meas * np.sin(th), "C3--", label="measured: max r + half a spacing")
     ax.set(aspect="equal", xlim=(0, 4.6), ylim=(0, 4.6), xlabel="x [mm]", ylabel="y [mm]", title=title)
     ax.legend(loc="upper right")
-ch.save(fig, "06_rings.png")
-plt.show()
+ch.show(fig, "06_rings.png", caption="One cross-section of the 3D Taylor bar's particles, on rings (left) and on a "
+                                     "square lattice cut to the circle (right): the cylinder (green) and the radius "
+                                     "measured as the largest r plus half a spacing (red, dashed).")
 
 # %% [markdown]
 # On rings the measured diameter is exact at $t = 0$; the cut lattice starts too large by several percent, as
@@ -394,8 +395,9 @@ for ax, key, what in ((axes[0], "final_length_mm", "length"), (axes[1], "final_d
     ax.set(xlabel="t [µs]", ylabel=f"{what} [mm]", title=f"2D half slab: {what}")
     ax.grid(alpha=0.3)
     ax.legend()
-ch.save(fig, "06_2d_history.png")
-plt.show()
+ch.show(fig, "06_2d_history.png", caption="The 2D half slab of the Taylor test with ESPH and TLSPH: length (left) and "
+                                          "foot diameter (right) over time, with the experiment's final values for "
+                                          "the 3D bar (dotted).")
 
 # %% [markdown]
 # The length falls fast at first (the end moves at nearly the impact speed), then more slowly as the plastic
@@ -429,8 +431,9 @@ for row, (key, label, cmap) in enumerate((("eps_p", "effective plastic strain [-
     colorbar(fig, sc, list(axes[row]), label, fraction=0.04, pad=0.03)
 for ax in axes[1]:
     ax.set_xlabel("x [mm]")
-ch.save(fig, "06_2d_fields.png")
-plt.show()
+ch.show(fig, "06_2d_fields.png", caption="The 2D Taylor slab at the end of the run, mirrored to show the whole "
+                                         "section, ESPH (left) and TLSPH (right): effective plastic strain (top) and "
+                                         "temperature (bottom).")
 
 # %% [markdown]
 # The plastic strain, and with it the temperature ($\Delta T$ grows with the plastic work), is largest at the
@@ -495,8 +498,9 @@ for ax, m in zip(axes, METHODS):
     ax.set(aspect="equal", xlabel="r [mm] (mirrored)", title=f"3D {m.upper()}, t = {1e6 * s.t:.0f} µs")
 axes[0].set_ylabel("z [mm]")
 colorbar(fig, sc, list(axes), "effective plastic strain [-]", shrink=0.6)
-ch.save(fig, "06_3d_final.png")
-plt.show()
+ch.show(fig, "06_3d_final.png", caption="The 3D quarter cylinder at the end of the impact, ESPH (left) and TLSPH "
+                                        "(right), mirrored in r and coloured by effective plastic strain; dotted: the "
+                                        "experiment's final length and foot diameter.")
 
 # %% [markdown]
 # Every particle of the final state, plotted at its distance from the axis and its height: the silhouette of the
@@ -570,6 +574,7 @@ for m in METHODS:
 #
 # ## Your turn
 #
+# Predict first, run, then open *What you should see*. The last exercise asks for code, graded against the package.
 # The exercises use the 2D half slab at 1 mm with TLSPH (about a second per run). The reference run:
 
 # %%
@@ -592,10 +597,14 @@ print(f"v0 = {V_IMPACT:g} m/s: final length {mt['final_length_mm']:.2f} mm "
       f"max plastic strain {mt['max_plastic_strain']:.2f}, max T {mt['max_temperature_K']:.0f} K")
 
 # %% [markdown]
-# What you should see: at 250 m/s the bar ends clearly shorter and its foot wider, with more plastic strain and a
-# hotter foot; at 120 m/s the opposite. The kinetic energy, which grows as $v_0^2$, is what the plastic work has
-# to take up: this is how Taylor read the dynamic yield stress off the final length.
+# <details><summary>What you should see</summary>
 #
+# At 250 m/s the bar ends clearly shorter and its foot wider, with more plastic strain and a hotter foot; at
+# 120 m/s the opposite. The kinetic energy, which grows as $v_0^2$, is what the plastic work has to take up: this
+# is how Taylor read the dynamic yield stress off the final length.
+# </details>
+
+# %% [markdown]
 # ### Exercise 2 — The melting temperature
 #
 # Predict: with $T_m$ = 1793 K (the usual value for 4340) instead of the printed 1293 K, the metal softens less
@@ -611,10 +620,14 @@ print(f"T_m = {T_MELT:g} K: final length {mt['final_length_mm']:.3f} mm "
       f"multiplied by 1 - T*^m = {1 - T_star**jc.m:.3f}")
 
 # %% [markdown]
-# What you should see: with 1793 K the foot gets a little narrower and the bar is no shorter (a touch longer): the
-# hot metal is stronger. The change is small, because only a small volume at the centre of the foot gets hot. The benchmark
-# report shows the same in 3D at the paper's spacing.
+# <details><summary>What you should see</summary>
 #
+# With 1793 K the foot gets a little narrower and the bar is no shorter (a touch longer): the hot metal is
+# stronger. The change is small, because only a small volume at the centre of the foot gets hot. The benchmark
+# report shows the same in 3D at the paper's spacing.
+# </details>
+
+# %% [markdown]
 # ### Exercise 3 — The spacing
 #
 # Predict: halve the spacing to 0.5 mm. Does the foot get wider or narrower? Is the 1 mm answer converged?
@@ -627,6 +640,40 @@ print(f"dp = {1e3 * DP_EX:g} mm: final length {mt['final_length_mm']:.2f} mm "
       f"({mt['final_diameter_mm'] - ref['final_diameter_mm']:+.2f})")
 
 # %% [markdown]
-# What you should see: the finer slab has a clearly wider foot and a slightly shorter length; the 1 mm answer is
-# far from converged in the diameter (it moves by the order of a spacing). The 3D benchmark shows the same for TLSPH:
-# coarse spacings give narrow feet.
+# <details><summary>What you should see</summary>
+#
+# The finer slab has a clearly wider foot and a slightly shorter length; the 1 mm answer is far from converged in
+# the diameter (it moves by the order of a spacing). The 3D benchmark shows the same for TLSPH: coarse spacings
+# give narrow feet.
+# </details>
+
+# %% [markdown]
+# ### Exercise 4 — Measure the final length yourself
+#
+# The bar rings after it leaves the wall, so "the final length" needs a definition. The package's: the bar has come
+# to rest when the plastic work reaches 99.5 % of its final value; if the run went on for at least 30 µs after
+# that, the final length is the mean of the length over the last 30 µs of the run, otherwise the last length.
+# Write it, from a run's `run.history` ("t" [s], "length" [m], "plastic_work"), returning metres; the grader
+# compares with the run's `final_length_mm`. Predict: which case fails if you always take the mean?
+
+# %% tags=["exercise"]
+def my_final_length(run):
+    """The final length [m] of a Taylor run, from run.history, by the definition above."""
+    raise NotImplementedError("write the measurement here")      # <- replace this line by your code
+
+
+from refsph.teaching.grader import case, check
+cases_ex4 = [case(bar_2d(), label="2D TLSPH, 1 mm, the reference run"),                # runs done above
+             case(res2["esph"], label=f"2D ESPH, {1e3 * DP_2D} mm, {1e6 * T_END:.0f} us"),
+             case(res3["tlsph"], label=f"3D TLSPH, {1e3 * DP_3D} mm, {1e6 * T_END:.0f} us"),
+             case(rh, label=f"2D {rh.summary['method'].upper()}, 0.5 mm, stopped at {1e6 * SYM_T:.0f} us")]
+report = check(my_final_length, lambda run: 1e-3 * run.summary["metrics"]["final_length_mm"], cases_ex4)
+
+# %% [markdown]
+# <details><summary>What you should see</summary>
+#
+# As handed out: `FAIL ... not written yet`. Always the mean: the runs not long at rest fail — in quick mode the
+# 50 µs runs above came to rest at about 28 µs, too late for a 30 µs window, and the 12 µs run of the symmetry check
+# is still in the impact. Always the last value: the reference run fails by 0.02 mm — its free axial ringing
+# (period $2L/c_{\rm bar}$, about 13 µs), which the mean over two periods smooths out.
+# </details>

@@ -132,8 +132,9 @@ ax.annotate("200 m/s", xy=(1.15, 0.25), xytext=(1.3, 0.25), arrowprops=dict(arro
 ax.set(aspect="equal", xlim=(-0.05, 1.5), ylim=(-0.15, 0.65), xlabel="x [mm]", ylabel="y [mm]",
        title=f"The pressing test (cf. the paper's Fig. 6), dp = {1e3 * DP:.4f} mm")
 ax.legend(loc="upper left", ncol=2, fontsize=8)
-ch.save(fig, "07_pressing_setup.png")
-plt.show()
+ch.show(fig, "07_pressing_setup.png", caption="The pressing test: the AISI 4340 block (grey) with its clamped column "
+                                              "(black) and the row of particles at mid-height (green), and the rigid "
+                                              "tool (orange).")
 
 # %% [markdown]
 # ## The contact: ESPH neighbours, TLSPH pinballs
@@ -227,8 +228,9 @@ axes[1, 0].set_ylabel("y [mm]")
 for row, (pc, label) in enumerate(((pe, "effective plastic strain [-]"), (pT, "temperature [K]"))):
     y0, y1 = axes[row, 1].get_position().y0, axes[row, 1].get_position().y1
     colorbar(fig, pc, axes[row, :], label, extend="max", cax=fig.add_axes([0.87, y0, 0.015, y1 - y0]))
-ch.save(fig, "07_pressing_fields.png")
-plt.show()
+ch.show(fig, "07_pressing_fields.png", caption="The pressed block at the end of the run, ESPH (left) and TLSPH "
+                                               "(right): effective plastic strain (top, scale cut at 1), with two "
+                                               "shear bands crossing in an X, and temperature (bottom).")
 
 # %% [markdown]
 # How to read it:
@@ -266,8 +268,10 @@ ax.set(xlabel="current x [mm]", ylabel="effective plastic strain [-]",
        title="Plastic strain along the mid-height row, end of the run (cf. Fig. 8)")
 ax.grid(alpha=0.3)
 ax.legend()
-ch.save(fig, "07_pressing_strain_line.png")
-plt.show()
+ch.show(fig, "07_pressing_strain_line.png", caption="Effective plastic strain along the row of particles that started "
+                                                    "at mid-height, against their current x, at the end of the run "
+                                                    "(cf. the paper's Fig. 8): both methods peak where the row "
+                                                    "crosses the X of the shear bands.")
 
 # %% [markdown]
 # As in the paper, the strain grows from left to right (the right part of the block is "subjected to more plastic
@@ -336,8 +340,9 @@ ax.text(1e9 * LX / c_L + 5, 2.5, "$L / c_L$", color="0.4")
 ax.set(xlabel="t [ns]", ylabel="force [MN/m]", title="Forces of the block on tool and clamp (25 ns running mean)")
 ax.grid(alpha=0.3)
 ax.legend(fontsize=8, ncol=2)
-ch.save(fig, "07_pressing_forces.png")
-plt.show()
+ch.show(fig, "07_pressing_forces.png", caption="The forces of the block on the tool (solid) and on the clamp (dashed) "
+                                               "with ESPH and TLSPH, as 25 ns running means, and the elastic-plastic "
+                                               "impact estimate (dotted).")
 print(f"impact estimate {1e-6 * impact_force(V_TOOL):.2f} MN/m (elastic: rho c_L v H0 = "
       f"{1e-6 * mat.rho0 * c_L * V_TOOL * LY:.2f} MN/m)")
 

@@ -137,8 +137,8 @@ ax.annotate("", xy=(3.1, 1.3), xytext=(3.5, 1.3), arrowprops=dict(arrowstyle="->
 cb = colorbar(fig, sc, ax, "particle", ticks=[0, 1, 2])
 cb.ax.set_yticklabels(["workpiece", "cut layer", "held"])
 ax.set(xlabel="x [mm]", ylabel="y [mm]", title=f"Set-up, feed {1e3 * FEEDS[0]:.1f} mm, dp = {1e3 * DP:.3f} mm")
-ch.save(fig, "08_setup.png")
-plt.show()
+ch.show(fig, "08_setup.png", caption="The cutting set-up at this chapter's coarse spacing: the workpiece, the layer "
+                                     "to be cut and the held particles, and the tool (grey).")
 
 # %% [markdown]
 # ## The measurements
@@ -353,8 +353,9 @@ for col, (m, r) in enumerate(res.items()):
         ax.set(title=f"{m.upper()}, {1e3 * V_TOOL * s.t:.2f} mm of cut", xlabel="x [mm]", ylabel="y [mm]")
 colorbar(fig, a, axs[0, 1], "plastic strain [-] (scale cut at 2)", extend="max")
 colorbar(fig, b, axs[1, 1], "temperature [K]")
-ch.save(fig, "08_chip_end.png")
-plt.show()
+ch.show(fig, "08_chip_end.png", caption="The chip at the end of the cut, ESPH (left) and TLSPH (right): effective "
+                                        "plastic strain (top) and temperature (bottom); the tool's surface layers in "
+                                        "grey.")
 
 # %% [markdown]
 # The plastic strain gathers in a **primary shear zone** running from the cutting edge up to the free surface
@@ -396,8 +397,9 @@ for ax, label in zip(axs, ("cutting force $F_c$", "thrust force $F_t$")):
     ax.grid(alpha=0.3)
 axs[0].set_ylabel("force on the tool [MN/m]")
 axs[1].legend(fontsize=8)
-ch.save(fig, "08_forces.png")
-plt.show()
+ch.show(fig, "08_forces.png", caption="Cutting force (left) and thrust force (right) on the tool against the cut "
+                                      "length, ESPH and TLSPH at this chapter's spacing and (dashed) the benchmark's "
+                                      "runs at the paper's resolution.")
 
 # %% [markdown]
 # The force builds up while the edge enters and the chip forms, then levels off. Even at the coarse spacing the
@@ -460,8 +462,9 @@ for ax, (m, r) in zip(axs, res.items()):
     ax.set(xlabel="initial x of the material [mm]", ylabel="plastic strain, middle row [-]", title=m.upper(),
            ylim=(0, 1.25 * q[q[:, 0] < q[-1, 0] - 0.05, 1].max()))
     ax.legend(fontsize=8)
-ch.save(fig, "08_band_profiles.png")
-plt.show()
+ch.show(fig, "08_band_profiles.png", caption="Plastic strain along the chip's middle row against the material's "
+                                             "initial x, ESPH (left) and TLSPH (right): the bands of the "
+                                             "paper-resolution run against the broad humps at this chapter's spacing.")
 
 # %% [markdown]
 # At the paper's spacing the profile along the chip has sharp peaks (dotted: the bands counted). At the coarse
@@ -566,7 +569,8 @@ fig, ax = plt.subplots(figsize=(9, 3), constrained_layout=True)
 sc = particle_field(ax, Xd, ed, DP_DRAW, xlim=(1.8, 3.0), ylim=(0.6, 1.0), vmin=0, vmax=2)
 colorbar(fig, sc, ax, "plastic strain [-]")
 ax.set(xlabel="x [mm]", ylabel="y [mm]", title=f"drawn bands at dp = {1e3 * DP_DRAW:.3f} mm: {found['n']} found")
-plt.show()
+ch.show(fig, caption="Five shear bands drawn 0.15 mm apart, each 1.5 spacings wide, at the spacing chosen above, "
+                     "coloured by plastic strain; the title says how many the band measure finds.")
 
 # %% [markdown]
 # What you should see: at 0.025 mm all five are still found; at 0.05 mm each band is as wide as the gap between

@@ -120,8 +120,8 @@ for name, mat in (("AISI 1045", AISI1045_RLA), ("Ti6Al4V", TI6AL4V_RLA)):
     ax.plot(Ts, law.mu(Ts), label=f"{name}: mu0 = {mat['mu0']}, q = {mat['q_friction']}")
 ax.set(xlabel="temperature at the contact [K]", ylabel="mu(T)")
 ax.legend()
-ch.save(fig, "11_friction_law.png")
-plt.show()
+ch.show(fig, "11_friction_law.png", caption="The friction coefficient μ(T) of the two materials against the "
+                                            "temperature at the contact: it falls from μ0 to zero at melting.")
 
 # %% [markdown]
 # At 900 K steel keeps 0.67 of its room-temperature coefficient, titanium 0.99: titanium's friction only collapses
@@ -156,8 +156,9 @@ fig, axes = plt.subplots(1, 2, figsize=(12, 3.6), constrained_layout=True)
 for ax, (name, on) in zip(axes, marks.items()):
     particle_field(ax, s.x, on.astype(float), res.setup.dp, vmin=0, vmax=1, fill=None)
     ax.set(title=f"{name}: {np.count_nonzero(on)} surface particles", aspect="equal", xlabel="x [mm]")
-ch.save(fig, "11_surface_detectors.png")
-plt.show()
+ch.show(fig, "11_surface_detectors.png", caption="The free surface of one cut as two detectors find it (surface "
+                                                 "particles in yellow): the SPH detector (left), about two particles "
+                                                 "deep, and the α-shape (right), one particle deep.")
 
 # %% [markdown]
 # The SPH detector marks a layer about two particles deep (the support is cut there too); the α-shape marks one.
@@ -199,8 +200,8 @@ for key, lab in (("cutting_force_history", "Fc"), ("passive_force_history", "Fp"
     axes[1].plot(hst[:, 0] * 1e6, hst[:, 1] * 1e-3, label=lab)
 axes[1].set(xlabel="t [us]", ylabel="force on the tool [N/mm]")
 axes[1].legend()
-ch.save(fig, "11_cut.png")
-plt.show()
+ch.show(fig, "11_cut.png", caption="One measured cut: the temperature at the end (left) and the cutting and thrust "
+                                   "forces Fc and Fp on the tool over time (right).")
 meas = m["measured"]
 print(f"T_RF  {m['rake_face_temperature_K']:.0f} K (measured {meas['T_RF_K']:.0f}),  T_FCS "
       f"{m['free_chip_surface_temperature_K']:.0f} K (measured {meas['T_FCS_K']:.0f})")

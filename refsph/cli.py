@@ -1,5 +1,5 @@
 """Command line: ``refsph list``, ``refsph run SCENE [--method {esph,tlsph,both}] ...``, ``refsph book``,
-``refsph oracle DIR``, ``refsph compare REF TEST`` and ``refsph export RUN_DIR --vtk``.
+``refsph oracle DIR``, ``refsph compare REF TEST``, ``refsph export RUN_DIR --vtk`` and ``refsph handout DIR``.
 
 Exit codes (:data:`EXIT_CODES`): 0 done, 1 a comparison found a difference (or the book failed), 2 bad input (a
 message names the parameter or the file), 3 the run failed, 4 an internal error (a bug), 130 interrupted. Every
@@ -36,6 +36,12 @@ def _parser() -> argparse.ArgumentParser:
     b.add_argument("--rerun", action="store_true", help="execute every chapter again (default: reuse the "
                    "executed notebooks in build/executed/ that are newer than their chapter)")
     b.add_argument("--jobs", type=int, default=2, help="chapters executed at a time (default 2)")
+    hd = sub.add_parser("handout", help="write the chapters as notebooks into DIR: the students' copies, or with "
+                                        "--instructor the lecturer's (each exercise followed by its worked solution)")
+    hd.add_argument("dir")
+    hd.add_argument("--instructor", action="store_true", help="the lecturer's copy, with chapters/solutions/ merged in")
+    hd.add_argument("--only", nargs="+", default=None, metavar="NN", help="these chapters only (e.g. 01 05)")
+    hd.add_argument("--force", action="store_true", help="replace notebooks already in DIR (default: keep them)")
     o = sub.add_parser("oracle", help="write the golden cases (inputs, refsph's outputs, tolerances) into DIR, "
                                       "computed with NumPy's, OpenBLAS's and glibc's CPU-independent code paths "
                                       "(refsph.crosscheck.golden; every case: a few minutes)")
@@ -150,6 +156,11 @@ def _main(argv=None) -> int:
         ap.error(f"unrecognized arguments: {' '.join(extra)}")
     if args.cmd == "book":
         return _book(args)
+    if args.cmd == "handout":
+        from .teaching.handout import write_handout
+        written = write_handout(args.dir, instructor=args.instructor, only=args.only, force=args.force)
+        print(f"{len(written)} {'lecturer' if args.instructor else 'student'} notebooks in {args.dir}")
+        return 0
     if args.cmd == "oracle":
         from .crosscheck.golden import write_golden_cases
         try:

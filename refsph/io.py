@@ -52,9 +52,9 @@ import numpy as np
 from .material import eos_pressure, von_mises
 from .state import FIELD_UNITS, PLASTIC_FIELDS, State
 
-__all__ = ["run_files", "claim_run_folder", "save_snapshot", "save_units", "load_snapshot", "state_from_snapshot",
-           "state_from_particles", "load_run", "write_json", "json_ready", "save_reactions", "load_reactions",
-           "analyse_cutting_run", "SNAPSHOT_UNITS", "UNITS_FILE"]
+__all__ = ["run_files", "claim_run_folder", "save_snapshot", "write_snapshot", "save_units", "load_snapshot",
+           "state_from_snapshot", "state_from_particles", "load_run", "write_json", "json_ready", "save_reactions",
+           "load_reactions", "analyse_cutting_run", "SNAPSHOT_UNITS", "UNITS_FILE"]
 
 SNAPSHOT_UNITS = dict(FIELD_UNITS, p="Pa", sigma_vm="Pa", F="1", id="1 (particle id)")
 UNITS_FILE = "units.json"       # snapshots/units.json: the unit of every snapshot array (module text)
@@ -78,7 +78,14 @@ def save_snapshot(path, state: State, material, F: np.ndarray | None = None, ids
         arrays.update(eps_p=state.eps_p, eps_dot_p=state.eps_dot_p, W_p=state.W_p, T=state.T)
     if state.body is not None:
         arrays["body"] = state.body
-    save_units(path.parent, {k: SNAPSHOT_UNITS[k] for k in arrays})
+    write_snapshot(path, arrays, SNAPSHOT_UNITS)
+
+
+def write_snapshot(path, arrays: dict, units: dict) -> None:
+    """Write ``arrays`` (numbers only) as the snapshot ``path`` and their units (``units``: {array: unit}, a
+    superset) in ``units.json`` beside it, both atomically: a crash never leaves a half-written file."""
+    path = Path(path)
+    save_units(path.parent, {k: units[k] for k in arrays})
     tmp = path.with_name(path.name + ".tmp.npz")
     np.savez(tmp, **arrays)
     os.replace(tmp, path)

@@ -32,10 +32,9 @@ from pathlib import Path
 
 import numpy as np
 
-from .io import claim_run_folder, save_reactions, save_units, write_json
+from .io import claim_run_folder, read_npz, save_reactions, write_json, write_snapshot
 from .material import von_mises
 from .pfem.cutting import CutRun, pfem_cut
-from .pfem.mesh import signed_areas
 from .scenes.base import parse_bool
 from .simulate import SimulationError, provenance
 
@@ -91,19 +90,14 @@ def _options(options: dict, quick: bool) -> dict:
 def _snapshot(path: Path, run: CutRun) -> None:
     """The nodes as particles, the mesh and (with the heat step) the tool's nodes (module text), atomically."""
     n, mesh, law = run.nodes, run.mesh, run.cut.law
-    area = np.abs(np.repeat(signed_areas(n.x, mesh.tri), 3))
-    w = np.bincount(mesh.tri.ravel(), area, minlength=n.n)
-    J = np.where(w > 0, n.J, 1.0)
+    J = np.where(mesh.meshed, n.J, 1.0)                     # a node without a triangle: at its reference density
     arrays = dict(t=np.float64(n.t), id=np.arange(n.n, dtype=np.int64), x=n.x, v=n.v, m=n.m, rho=law.rho0 / J,
                   p=-n.p, S=n.S, S_zz=n.S_zz, sigma_vm=von_mises(n.S, n.S_zz), eps_p=n.eps_p, eps_dot_p=n.eps_dot,
                   W_p=n.W_p, T=n.T, body=np.zeros(n.n, dtype=np.int32), triangles=mesh.tri.astype(np.int64),
                   boundary_edges=mesh.edges.astype(np.int64))
     if run.T_tool is not None:
         arrays.update(tool_x=run.tool_x(n.t), tool_T=run.T_tool)
-    save_units(path.parent, {k: UNITS[k] for k in arrays})
-    tmp = path.with_name(path.name + ".tmp.npz")
-    np.savez(tmp, **arrays)
-    os.replace(tmp, path)
+    write_snapshot(path, arrays, UNITS)
 
 
 def _checkpoint(folder: Path, run: CutRun, snapshots: list, next_snap: int) -> None:
@@ -119,14 +113,17 @@ def _checkpoint(folder: Path, run: CutRun, snapshots: list, next_snap: int) -> N
 
 
 def _restore(folder: Path, cut):
+    """The run of the last readable checkpoint (restart.npz, else restart_prev.npz): (CutRun, snapshots, next
+    snapshot); ValueError naming what could not be read."""
+    failures = []
     for name in (CHECKPOINT, PREVIOUS):
-        path = folder / name
-        if path.exists():
-            with np.load(path) as z:
-                arrays = {k: z[k] for k in z.files}
+        try:
+            arrays = read_npz(folder / name, "PFEM checkpoint")
             rec = json.loads(str(arrays.pop("run")))
             return CutRun.restore(cut, arrays), rec["snapshots"], rec["next_snap"]
-    raise ValueError(f"{folder}: nothing to restart from (no {CHECKPOINT} or {PREVIOUS})")
+        except (ValueError, KeyError) as e:
+            failures.append(f"{type(e).__name__}: {e}")
+    raise ValueError(f"{folder}: nothing to restart from ({'; '.join(failures)})")
 
 
 def run_pfem(scene_name: str = "thermal_cutting", *, out=None, options: dict | None = None, quick: bool = False,
@@ -178,21 +175,21 @@ def run_pfem(scene_name: str = "thermal_cutting", *, out=None, options: dict | N
         status, error = "failed", f"{type(e).__name__}: {e}"
         _snapshot(snaps_dir / "last_good.npz", run)
     res = run.result()
-    summary = _summary(scene_name, run, res, kwargs, args, snapshots, out, status, error)
+    reaction = {k: np.asarray(v, dtype=float) for k, v in run.reaction.items()}
+    if len(reaction["t"]):
+        save_reactions(out / "reaction_forces.csv", dict(t=reaction["t"], dt=reaction["dt"],
+                                                         tool=reaction["tool"].reshape(-1, 2)), 2)
+    summary = _summary(scene_name, run, res, kwargs, args, snapshots, status, error)
     write_json(out / "summary.json", summary)
     if status != "ok":
         raise SimulationError(f"PFEM {scene_name}: {error}; the last state is in {snaps_dir / 'last_good.npz'}")
     return PFEMRunResult(summary, res)
 
 
-def _summary(scene_name: str, run: CutRun, res: dict, kwargs: dict, args: dict, snapshots: list, out: Path,
-             status: str, error: str | None) -> dict:
-    """summary.json's content (module text), and reaction_forces.csv written."""
+def _summary(scene_name: str, run: CutRun, res: dict, kwargs: dict, args: dict, snapshots: list, status: str,
+             error: str | None) -> dict:
+    """summary.json's content (module text)."""
     cut = run.cut
-    reaction = {k: np.asarray(v, dtype=float) for k, v in run.reaction.items()}
-    if len(reaction["t"]):
-        save_reactions(out / "reaction_forces.csv", dict(t=reaction["t"], dt=reaction["dt"],
-                                                         tool=reaction["tool"].reshape(-1, 2)), 2)
     it = np.asarray(run.iterations)
     summary = dict(scene=scene_name, method="pfem", dim=2, dp=cut.info["dx"], h=None, n_particles=run.nodes.n,
                    t_end=cut.t_end, t_final=run.nodes.t, n_steps=run.steps,

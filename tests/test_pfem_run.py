@@ -96,3 +96,17 @@ def test_cli_refuses_what_the_pfem_cannot_take(args, says, tmp_path, capsys):
     assert main(list(args) + ["--out", str(tmp_path / "o")]) == 2
     assert says in capsys.readouterr().err
     assert not (tmp_path / "o").exists()
+
+
+def test_a_spoilt_checkpoint_is_a_clear_error(tmp_path, capsys):
+    """A truncated restart.npz falls back on restart_prev.npz; with both spoilt, refsph run --restart says which
+    files it could not read (exit 2), no zipfile traceback."""
+    out = tmp_path / "run"
+    run_pfem("thermal_cutting", out=out, options=SHORT, quick=True, progress=False, max_steps=1)
+    snaps = out / "snapshots"
+    for name in ("restart.npz", "restart_prev.npz"):
+        if (snaps / name).exists():
+            (snaps / name).write_bytes(b"not a zip")
+    assert main(["run", "--restart", str(out), "--quiet"]) == 2
+    err = capsys.readouterr().err
+    assert "nothing to restart from" in err and "restart.npz" in err and "Traceback" not in err

@@ -54,7 +54,7 @@ from ..scenes.thermal_cutting import (CLEARANCE_DEG, EDGE_RADIUS, RAKE_DEG, chip
                                       tool_particles, tool_shape)
 from ..thermal import SurfaceLoss
 from .contact import StepContact, ToolContact, boundary_lengths, solve_with_active_set
-from .mesh import Mesh, alpha_shape_mesh, boundary_edges, remesh_needed, signed_areas
+from .mesh import Mesh, alpha_shape_mesh, remesh_needed, signed_areas
 from .solid import (TRAPEZOIDAL, History, Loads, Newmark, NewtonFailed, Nodes, SolidLaw, commit, history_from_nodes,
                     make_nodes, plastic_heat, settle_nodes, transfer_history)
 from .thermal import contact_conductance, thermal_step
@@ -71,6 +71,7 @@ class CutHeat:
     """The cut's heat model (module text): the workpiece's k [W/(m K)] and c_p [J/(kg K)]; the tool's nodes ``x_tool``
     (P, 2) at t = 0, its triangles ``tool_tri`` (Q, 3), its k, and m c_p of each tool node ``tool_mc`` (P,) [J/(m K)];
     ``tool_fixed`` (tool node indices held at ``T_fixed``), the workpiece's ``work_fixed`` (node indices) likewise;
+    ``tool_edges`` (K, 2) the tool mesh's free boundary edges (the held faces lose nothing: fixed temperature);
     ``h_int`` [W/(m^2 K)] the contact conductance; ``loss`` the losses of Eq. (6); ``chip_fraction`` of the frictional
     heat into the workpiece; ``eta`` the fraction of the frictional work that becomes heat. No defaults."""
 
@@ -81,6 +82,7 @@ class CutHeat:
     k_tool: float
     tool_mc: np.ndarray
     tool_fixed: np.ndarray
+    tool_edges: np.ndarray
     work_fixed: np.ndarray
     T_fixed: float
     h_int: float
@@ -182,7 +184,9 @@ def pfem_cut(case: int, n_tu: float = 10.0, travel: float = 16.0, length: float 
         tool_mc = tool["rho"] * tool["cp_J_kgK"] * np.bincount(tmesh.tri.ravel(), area, minlength=len(xt))
         k_w, k_t = mat["k_W_mK"], tool["k_W_mK"]
         heat = CutHeat(k_work=k_w, cp_work=mat["cp_J_kgK"], x_tool=xt, tool_tri=tmesh.tri, k_tool=k_t,
-                       tool_mc=tool_mc, tool_fixed=np.flatnonzero(tool_held), work_fixed=np.flatnonzero(fixed[:, 0]),
+                       tool_mc=tool_mc, tool_fixed=np.flatnonzero(tool_held),
+                       tool_edges=tmesh.edges[~np.isin(tmesh.edges, np.flatnonzero(tool_held)).all(axis=1)],
+                       work_fixed=np.flatnonzero(fixed[:, 0]),
                        T_fixed=T0, h_int=2.0 * k_w * k_t / (k_w + k_t) / dx,
                        loss=SurfaceLoss(**RLA_SURFACE_LOSS, T_ambient=T0), chip_fraction=float(chip_fraction),
                        eta=CONTACT_RLA["friction_work_to_heat"])
@@ -345,14 +349,13 @@ def heat_step(run: "CutRun", nodes: Nodes, mesh: Mesh, r, contact: StepContact, 
     length = boundary_lengths(nodes.x, mesh.edges, n)[touching]
     G = contact_conductance(np.stack([touching, n + nearest], axis=1), length, hm.h_int, n + len(xt))
     free = mesh.edges[~np.isin(mesh.edges, touching).any(axis=1)]
-    tedges = _tool_edges(hm)
     x_all = np.concatenate([nodes.x, xt])
     tri = np.concatenate([mesh.tri, hm.tool_tri + n])
     k = np.concatenate([np.full(len(mesh.tri), hm.k_work), np.full(len(hm.tool_tri), hm.k_tool)])
     mc = np.concatenate([nodes.m * hm.cp_work, hm.tool_mc])
     fixed = np.concatenate([hm.work_fixed, n + hm.tool_fixed])
     T, step = thermal_step(x_all, tri, np.concatenate([nodes.T, run.T_tool]), dt, k, None, P,
-                           edges=np.concatenate([free, tedges + n]), loss=hm.loss, fixed=fixed,
+                           edges=np.concatenate([free, hm.tool_edges + n]), loss=hm.loss, fixed=fixed,
                            T_fixed=hm.T_fixed, conductance=G, mc=mc)
     nodes.T, run.T_tool = T[:n], T[n:]
     L = run.ledger
@@ -362,12 +365,6 @@ def heat_step(run: "CutRun", nodes: Nodes, mesh: Mesh, r, contact: StepContact, 
     L["stored"] += step.stored
     L["lost"] += step.lost
     L["removed"] += step.removed
-
-
-def _tool_edges(hm: CutHeat) -> np.ndarray:
-    """The tool mesh's boundary edges (its free faces; the held ones lose nothing, they are at fixed temperature)."""
-    edges = boundary_edges(hm.tool_tri)
-    return edges[~np.isin(edges, hm.tool_fixed).all(axis=1)]
 
 
 def run_pfem_cut(cut: PFEMCut, progress=None, max_steps: int | None = None) -> dict:

@@ -476,9 +476,7 @@ def settle_nodes(nodes: Nodes, mesh: Mesh, step: StepResult, strength, heat: boo
     step takes it as a source), and the triangles' new history projected to the nodes (:func:`project_to_nodes`),
     ready for a remeshing."""
     if heat and getattr(strength, "heating", False):
-        q = strength.chi * step.d_w_p * np.abs(step.area)
-        nodes.T = nodes.T + np.bincount(mesh.tri.ravel(), np.repeat(q / 3.0, 3), minlength=nodes.n) / (nodes.m
-                                                                                                       * strength.cp)
+        nodes.T = nodes.T + plastic_heat(mesh, step, strength, nodes.n) / (nodes.m * strength.cp)
     for name in ("S", "S_zz", "eps_p", "W_p", "J", "eps_dot"):
         value = getattr(step.history, name)
         if value is not None:

@@ -72,7 +72,7 @@ def _options(options: dict, quick: bool) -> dict:
             raise ValueError(f"option {name!r} is not an option of the PFEM cut; its options: {', '.join(known)}")
         default = known[name].default
         try:
-            if name in ("friction", "conduction"):
+            if name in ("friction", "conduction", "refine"):
                 out[name] = parse_bool(value, f"option {name}")
             elif name == "case":
                 out[name] = int(float(value))
@@ -91,7 +91,7 @@ def _snapshot(path: Path, run: CutRun) -> None:
     """The nodes as particles, the mesh and (with the heat step) the tool's nodes (module text), atomically."""
     n, mesh, law = run.nodes, run.mesh, run.cut.law
     J = np.where(mesh.meshed, n.J, 1.0)                     # a node without a triangle: at its reference density
-    arrays = dict(t=np.float64(n.t), id=np.arange(n.n, dtype=np.int64), x=n.x, v=n.v, m=n.m, rho=law.rho0 / J,
+    arrays = dict(t=np.float64(n.t), id=run.ids, x=n.x, v=n.v, m=n.m, rho=law.rho0 / J,
                   p=-n.p, S=n.S, S_zz=n.S_zz, sigma_vm=von_mises(n.S, n.S_zz), eps_p=n.eps_p, eps_dot_p=n.eps_dot,
                   W_p=n.W_p, T=n.T, body=np.zeros(n.n, dtype=np.int32), triangles=mesh.tri.astype(np.int64),
                   boundary_edges=mesh.edges.astype(np.int64))

@@ -10,7 +10,9 @@ is mass-scaled (the SPH runs scale the density by s; here s = 1).
 Each step (Algorithm 1): the tool moves by -v_c dt; Newton-Raphson solves the mechanical step with the contact
 inside it (:func:`refsph.pfem.solid.newton_step`); the nodes move; the plastic work heats the nodes (chi dW_p of
 each triangle, a third to each node, over m_i c_p: adiabatic, or the source of the heat step when conduction is
-on); the history goes to the nodes and the nodes are meshed again (remeshing every step). A step whose Newton fails
+on); the history goes to the nodes, nodes closer than half a spacing are merged and triangles larger than 2.5
+lattice triangles get a node (:mod:`refsph.pfem.refine`: mass, momentum and heat kept exactly), and the nodes are
+meshed again (remeshing every step). A step whose Newton fails
 is retried at half the step (up to four times). dt = ``courant`` dx / v_c: the tool moves a fraction of the finest
 spacing per step (the mesh, not stability, limits it).
 
@@ -55,6 +57,7 @@ from ..scenes.thermal_cutting import (CLEARANCE_DEG, EDGE_RADIUS, RAKE_DEG, chip
 from ..thermal import SurfaceLoss
 from .contact import StepContact, ToolContact, boundary_lengths, solve_with_active_set
 from .mesh import Mesh, alpha_shape_mesh, remesh_needed, signed_areas
+from .refine import NodeRule, refine_nodes, renumber_mesh
 from .solid import (TRAPEZOIDAL, History, Loads, Newmark, NewtonFailed, Nodes, SolidLaw, commit, history_from_nodes,
                     make_nodes, plastic_heat, settle_nodes, transfer_history)
 from .thermal import contact_conductance, thermal_step
@@ -70,7 +73,7 @@ LEDGER = ("plastic", "friction", "friction_to_tool", "stored", "lost", "removed"
 class CutHeat:
     """The cut's heat model (module text): the workpiece's k [W/(m K)] and c_p [J/(kg K)]; the tool's nodes ``x_tool``
     (P, 2) at t = 0, its triangles ``tool_tri`` (Q, 3), its k, and m c_p of each tool node ``tool_mc`` (P,) [J/(m K)];
-    ``tool_fixed`` (tool node indices held at ``T_fixed``), the workpiece's ``work_fixed`` (node indices) likewise;
+    ``tool_fixed`` (tool node indices held at ``T_fixed``; the workpiece's held nodes are held at it too);
     ``tool_edges`` (K, 2) the tool mesh's free boundary edges (the held faces lose nothing: fixed temperature);
     ``h_int`` [W/(m^2 K)] the contact conductance; ``loss`` the losses of Eq. (6); ``chip_fraction`` of the frictional
     heat into the workpiece; ``eta`` the fraction of the frictional work that becomes heat. No defaults."""
@@ -83,7 +86,6 @@ class CutHeat:
     tool_mc: np.ndarray
     tool_fixed: np.ndarray
     tool_edges: np.ndarray
-    work_fixed: np.ndarray
     T_fixed: float
     h_int: float
     loss: SurfaceLoss
@@ -100,7 +102,8 @@ class PFEMCut:
     heat model (:class:`CutHeat`; None: adiabatic); a remeshing every ``remesh_every`` steps and whenever a
     triangle's quality drops below ``remesh_quality``; ``newmark`` the time rule (the paper's trapezoidal rule by
     default); ``max_iter`` Newton iterations per solve; ``max_move`` the largest Newton correction of a node, in its
-    local sizes (:func:`refsph.pfem.solid.newton_step`)."""
+    local sizes (:func:`refsph.pfem.solid.newton_step`); ``node_rule`` the node insertion and removal at each
+    remeshing (:class:`refsph.pfem.refine.NodeRule`; None: the nodes stay as they are)."""
 
     nodes: object
     h: np.ndarray
@@ -121,6 +124,7 @@ class PFEMCut:
     newmark: Newmark = TRAPEZOIDAL
     max_iter: int = 80
     max_move: float | None = 0.05
+    node_rule: NodeRule | None = None
 
 
 def graded_workpiece(length: float, tu: float, dx: float) -> tuple[np.ndarray, np.ndarray]:
@@ -139,11 +143,13 @@ def graded_workpiece(length: float, tu: float, dx: float) -> tuple[np.ndarray, n
 
 def pfem_cut(case: int, n_tu: float = 10.0, travel: float = 16.0, length: float | None = None,
              courant: float = 0.25, alpha: float = 1.4, penalty: float = 20.0, friction: bool = True,
-             conduction: bool = True, chip_fraction: float = 0.5) -> PFEMCut:
+             conduction: bool = True, chip_fraction: float = 0.5, refine: bool = True, r_min: float = 0.5,
+             a_max: float = 2.5) -> PFEMCut:
     """The cut of row ``case`` of the paper's Appendix B: dx = t_u / n_tu, ``travel`` t_u of cut on a workpiece
     ``length`` [m] long (default (travel + 12) t_u), dt = courant dx / v_c, contact penalties ``penalty`` G / dx;
     ``conduction``: the heat step (module text; False: adiabatic), ``chip_fraction`` of the frictional heat into
-    the chip."""
+    the chip; ``refine``: node removal and insertion at each remeshing with ``r_min`` and ``a_max``
+    (:class:`refsph.pfem.refine.NodeRule`; False: the nodes stay as they are)."""
     row = rla_cutting_case(int(case))
     mat = MATERIALS[row["material"]]
     vc, tu = row["vc_m_per_min"] / 60.0, row["tu_mm"] * 1e-3
@@ -186,7 +192,6 @@ def pfem_cut(case: int, n_tu: float = 10.0, travel: float = 16.0, length: float 
         heat = CutHeat(k_work=k_w, cp_work=mat["cp_J_kgK"], x_tool=xt, tool_tri=tmesh.tri, k_tool=k_t,
                        tool_mc=tool_mc, tool_fixed=np.flatnonzero(tool_held),
                        tool_edges=tmesh.edges[~np.isin(tmesh.edges, np.flatnonzero(tool_held)).all(axis=1)],
-                       work_fixed=np.flatnonzero(fixed[:, 0]),
                        T_fixed=T0, h_int=2.0 * k_w * k_t / (k_w + k_t) / dx,
                        loss=SurfaceLoss(**RLA_SURFACE_LOSS, T_ambient=T0), chip_fraction=float(chip_fraction),
                        eta=CONTACT_RLA["friction_work_to_heat"])
@@ -195,10 +200,10 @@ def pfem_cut(case: int, n_tu: float = 10.0, travel: float = 16.0, length: float 
                 inertia_ratio=mat["rho"] * vc * vc / mat["A_Pa"], rake_deg=RAKE_DEG, clearance_deg=CLEARANCE_DEG,
                 edge_radius_m=EDGE_RADIUS, apex0=apex.tolist(), measured=row, method="pfem", alpha=alpha,
                 courant=courant, penalty=penalty, conduction=bool(conduction), chip_fraction=float(chip_fraction),
-                h_int=None if heat is None else heat.h_int)
+                h_int=None if heat is None else heat.h_int, refine=bool(refine), r_min=r_min, a_max=a_max)
     return PFEMCut(nodes=nodes, h=h, fixed=fixed, law=law, shape=shape, shift0=centroid, v_tool=np.array([-vc, 0.0]),
                    contact=contact, alpha=alpha, dt=courant * dx / vc, t_end=travel * tu / vc, X0=x.copy(), info=info,
-                   heat=heat)
+                   heat=heat, node_rule=NodeRule(r_min=r_min, a_max=a_max) if refine else None)
 
 
 class CutRun:
@@ -210,13 +215,16 @@ class CutRun:
     def __init__(self, cut: PFEMCut):
         self.cut = cut
         self.nodes = cut.nodes
-        self.mesh = alpha_shape_mesh(self.nodes.x, cut.alpha, cut.h)
+        self.h, self.fixed, self.X0 = cut.h.copy(), cut.fixed.copy(), cut.X0.copy()   # per node: they change
+        self.ids = np.arange(self.nodes.n, dtype=np.int64)                               # with the node rule
+        self.mesh = alpha_shape_mesh(self.nodes.x, cut.alpha, self.h)
         self.hist_e = history_from_nodes(self.nodes, self.mesh)
         self.f_T = np.zeros(self.nodes.n)
         self.T_tool = None if cut.heat is None else np.full(len(cut.heat.x_tool), cut.heat.T_fixed)
         self.hist = {k: [] for k in HISTORY_KEYS}
         self.reaction = dict(t=[], dt=[], tool=[])
         self.iterations, self.retries, self.steps, self.remeshes, self.wall = [], 0, 0, 0, 0.0
+        self.inserted = self.removed = 0
         self.ledger = {k: 0.0 for k in LEDGER}
 
     @property
@@ -236,7 +244,7 @@ class CutRun:
                                   self.f_T, nodes.T, boundary_lengths(nodes.x, mesh.edges, nodes.n),
                                   np.flatnonzero(mesh.boundary))
             try:
-                r = solve_with_active_set(nodes, mesh, self.hist_e, cut.law, dt, Loads(cut.fixed, zero,
+                r = solve_with_active_set(nodes, mesh, self.hist_e, cut.law, dt, Loads(self.fixed, zero,
                                                                                          contact=contact),
                                           dynamic=cut.newmark, max_iter=cut.max_iter, max_move=cut.max_move)
                 break
@@ -255,8 +263,11 @@ class CutRun:
         if cut.heat is not None:
             heat_step(self, nodes, mesh, r, contact, dt)
         if remesh_needed(nodes.x, mesh, cut.remesh_quality) or self.steps % cut.remesh_every == cut.remesh_every - 1:
-            new = alpha_shape_mesh(nodes.x, cut.alpha, cut.h)              # Algorithm 1: "if remeshing is needed"
-            self.hist_e, self.mesh = transfer_history(mesh, r.history, new, nodes), new
+            old, hist = mesh, r.history                                 # Algorithm 1: "if remeshing is needed"
+            if cut.node_rule is not None:
+                nodes, old, hist = self.refine(nodes, mesh, hist)
+            new = alpha_shape_mesh(nodes.x, cut.alpha, self.h)
+            self.hist_e, self.mesh = transfer_history(old, hist, new, nodes), new
             self.remeshes += 1
         else:
             self.hist_e = r.history
@@ -264,12 +275,29 @@ class CutRun:
         self.reaction["t"].append(nodes.t - 0.5 * dt)                     # the step's midpoint, as the SPH runs
         self.reaction["dt"].append(dt)
         self.reaction["tool"].append(F_tool)
-        m = chip_measures(nodes.x, cut.X0, nodes.T, nodes.t, cut.info)
+        m = chip_measures(nodes.x, self.X0, nodes.T, nodes.t, cut.info)
         for k, v in dict(t=nodes.t, max_T=float(nodes.T.max()), max_eps_p=float(nodes.eps_p.max()), **m).items():
             self.hist[k].append(v)
         self.steps += 1
         self.wall += time.perf_counter() - t0
         return r
+
+    def refine(self, nodes: Nodes, mesh: Mesh, hist: History):
+        """The node rule of the cut (:func:`refsph.pfem.refine.refine_nodes`; no node inserted within half a spacing
+        of the tool): (nodes, the old mesh renumbered, its history); the run's per-node arrays (h, fixed, X0, ids,
+        f_T) follow."""
+        cut = self.cut
+        shift = cut.shift0 + cut.v_tool * nodes.t
+        nodes, h, fixed, extra, change = refine_nodes(
+            nodes, mesh, hist, self.h, self.fixed, cut.node_rule,
+            extra=dict(id=(self.ids, "keep"), X0=(self.X0, "keep"), f_T=(self.f_T, "sum")),
+            forbidden=lambda x: cut.shape.gap(x, shift)[0] > -0.5 * cut.info["dx"])
+        if not change.changed:
+            return nodes, mesh, hist
+        self.h, self.fixed, self.ids, self.X0, self.f_T = h, fixed, extra["id"], extra["X0"], extra["f_T"]
+        self.inserted += len(change.parents)
+        self.removed += len(change.merged)
+        return (nodes, *renumber_mesh(mesh, hist, change))
 
     def tool_x(self, t: float) -> np.ndarray:
         """The tool's nodes at time t (moved rigidly)."""
@@ -293,6 +321,7 @@ class CutRun:
         metrics = thermal_cutting_metrics(hist, self.cut.info, self.cut.t_end) if self.steps else {}
         return dict(nodes=self.nodes, mesh=self.mesh, history=hist, metrics=metrics, newton_iterations=self.iterations,
                     retries=self.retries, wall_time_s=self.wall, steps=self.steps, remeshes=self.remeshes,
+                    nodes_inserted=self.inserted, nodes_removed=self.removed,
                     heat_balance=self.heat_balance(), T_tool=self.T_tool)
 
     def checkpoint(self) -> dict:
@@ -301,13 +330,13 @@ class CutRun:
         out.update({f"mesh/{k}": getattr(self.mesh, k) for k in ("tri", "edges", "boundary")})
         out.update({f"hist/{f.name}": getattr(self.hist_e, f.name) for f in fields(History)
                     if getattr(self.hist_e, f.name) is not None})
-        out["f_T"] = self.f_T
+        out.update(f_T=self.f_T, h=self.h, fixed=self.fixed, X0=self.X0, ids=self.ids)
         if self.T_tool is not None:
             out["T_tool"] = self.T_tool
         out["record"] = np.array(json.dumps(dict(
             hist=self.hist, reaction={k: np.asarray(v).tolist() for k, v in self.reaction.items()},
             iterations=self.iterations, retries=self.retries, steps=self.steps, remeshes=self.remeshes, wall=self.wall,
-            ledger=self.ledger)))
+            ledger=self.ledger, inserted=self.inserted, removed=self.removed)))
         return out
 
     @classmethod
@@ -322,12 +351,15 @@ class CutRun:
                         alpha=cut.alpha)
         run.hist_e = History(**{f.name: arrays.get(f"hist/{f.name}") for f in fields(History)})
         run.f_T = arrays["f_T"]
+        run.h, run.fixed, run.X0 = (np.asarray(arrays.get(k, getattr(cut, k))).copy() for k in ("h", "fixed", "X0"))
+        run.ids = np.asarray(arrays.get("ids", np.arange(run.nodes.n)), dtype=np.int64)
         run.T_tool = arrays.get("T_tool")
         rec = json.loads(str(arrays["record"]))
         run.hist = rec["hist"]
         run.reaction = {k: [np.asarray(row) if k == "tool" else row for row in v] for k, v in rec["reaction"].items()}
         run.iterations, run.retries, run.steps = rec["iterations"], rec["retries"], rec["steps"]
         run.remeshes, run.wall, run.ledger = rec["remeshes"], rec["wall"], rec["ledger"]
+        run.inserted, run.removed = rec.get("inserted", 0), rec.get("removed", 0)
         return run
 
 
@@ -353,7 +385,7 @@ def heat_step(run: "CutRun", nodes: Nodes, mesh: Mesh, r, contact: StepContact, 
     tri = np.concatenate([mesh.tri, hm.tool_tri + n])
     k = np.concatenate([np.full(len(mesh.tri), hm.k_work), np.full(len(hm.tool_tri), hm.k_tool)])
     mc = np.concatenate([nodes.m * hm.cp_work, hm.tool_mc])
-    fixed = np.concatenate([hm.work_fixed, n + hm.tool_fixed])
+    fixed = np.concatenate([np.flatnonzero(run.fixed[:, 0]), n + hm.tool_fixed])
     T, step = thermal_step(x_all, tri, np.concatenate([nodes.T, run.T_tool]), dt, k, None, P,
                            edges=np.concatenate([free, hm.tool_edges + n]), loss=hm.loss, fixed=fixed,
                            T_fixed=hm.T_fixed, conductance=G, mc=mc)

@@ -1,0 +1,189 @@
+"""Node insertion and removal at a remeshing (issue 24; the paper's Section 2.3.4 and Figure 5 name it but give no
+rule, so refsph states its own, after Cremonesi et al. 2020, "A state of the art review of the Particle Finite
+Element Method", Arch. Comput. Methods Eng. 27, 1709, Section 3.3, and Rodriguez et al. 2016, Comput. Mech. 57,
+"The particle finite element method (PFEM) in thermo-mechanical problems"):
+
+    removal    two nodes closer than r_min min(h_i, h_j) (h the node's target spacing) are merged into one
+    insertion  a triangle larger than a_max h_e^2 / 2 (h_e the mean of its nodes' h; h^2 / 2 a triangle of the
+               initial lattice) gets a node at its centroid
+
+Without them the nodes of the chip pile up against the rake face (pairs a tenth of a spacing apart, sliver
+triangles between them: Newton-Raphson fails there) and the stretched regions open into holes.
+
+**What is conserved, exactly (to round-off).** A merge of j into i: m_i <- m_i + m_j, the momentum m v and the
+heat m c_p T summed (v and T the mass-weighted means; c_p is one constant per body), the nodal history (S, S_zz,
+eps_p, W_p, J, p, a) mass-weighted, the contact's tangential force f_T summed; i keeps its position (a boundary
+node stays on the boundary: i is the held node, else the boundary node, else the lower index). An insertion in
+triangle e (area A) takes from each of its nodes k the mass its tributary area loses when e is split in three:
+rho_k A / 9 with rho_k = m_k / a_k, a_k the node's tributary area (a third of each of its triangles); the new node
+gets the sum, with the momentum and heat that mass carried (the three keep their velocities and temperatures), and
+the triangle's own history (S, S_zz, eps_p, W_p, J, eps_dot of the element: what the centroid had). So total mass,
+momentum and heat content are unchanged; kinetic energy is not (a merge is an inelastic collision).
+
+Nodes are not inserted where ``forbidden`` says (inside or within half a spacing of the tool), and held nodes are
+never removed. Each node carries a persistent ``id`` (new nodes take the next free ones), so a snapshot's particles
+can be followed across node changes.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+from .mesh import Mesh, signed_areas
+from .solid import History, Nodes
+
+__all__ = ["NodeRule", "NodeChange", "refine_nodes", "renumber_mesh", "close_pairs", "tributary_areas"]
+
+NODAL = ("S", "S_zz", "eps_p", "W_p", "J", "p", "a", "eps_dot")     # mass-weighted in a merge
+ELEMENT = ("S", "S_zz", "eps_p", "W_p", "J", "eps_dot")              # an inserted node takes its triangle's
+
+
+@dataclass(frozen=True)
+class NodeRule:
+    """The rule of the module text: merge nodes closer than ``r_min`` times the smaller target spacing; insert a
+    node in a triangle of area above ``a_max`` h_e^2 / 2. No defaults (the cut's are in
+    :func:`refsph.pfem.cutting.pfem_cut`)."""
+
+    r_min: float
+    a_max: float
+
+    def __post_init__(self):
+        if not (0.0 < self.r_min < 1.0 and self.a_max > 1.0):
+            raise ValueError(f"NodeRule: need 0 < r_min < 1 (a fraction of the spacing) and a_max > 1 (a multiple of "
+                             f"a lattice triangle's area); got r_min = {self.r_min!r}, a_max = {self.a_max!r}")
+
+
+@dataclass
+class NodeChange:
+    """What :func:`refine_nodes` did: ``old_to_new`` (N_old,) the new index of each old node (-1: merged away),
+    ``parents`` (K, 3) the old nodes of each inserted node's triangle (the new nodes are the last K), ``merged``
+    (R, 2) the (kept, removed) old index pairs."""
+
+    old_to_new: np.ndarray
+    parents: np.ndarray
+    merged: np.ndarray
+
+    @property
+    def changed(self) -> bool:
+        return len(self.parents) > 0 or len(self.merged) > 0
+
+
+def close_pairs(x: np.ndarray, h: np.ndarray, r_min: float) -> np.ndarray:
+    """(P, 2) node pairs closer than r_min min(h_i, h_j), the closest first."""
+    i, j = cKDTree(x).query_pairs(r_min * float(h.max()), output_type="ndarray").T
+    d = np.linalg.norm(x[i] - x[j], axis=1)
+    near = d < r_min * np.minimum(h[i], h[j])
+    order = np.argsort(d[near], kind="stable")
+    return np.stack([i[near][order], j[near][order]], axis=1)
+
+
+def tributary_areas(x: np.ndarray, tri: np.ndarray, n: int) -> np.ndarray:
+    """a_k: a third of the area of each triangle of node k."""
+    return np.bincount(tri.ravel(), np.repeat(np.abs(signed_areas(x, tri)) / 3.0, 3), minlength=n)
+
+
+def refine_nodes(nodes: Nodes, mesh: Mesh, hist: History, h: np.ndarray, fixed: np.ndarray, rule: NodeRule,
+                 extra: dict | None = None, forbidden=None, boundary: np.ndarray | None = None):
+    """The nodes after the removals and insertions of ``rule`` (module text) on the mesh ``mesh`` with the
+    triangles' history ``hist``. ``h`` (N,) the target spacings, ``fixed`` (N, 2) the held components; ``extra``: more
+    per-node arrays to carry (name -> (array, how): how 'sum' (a force), 'keep' (the kept node's: an id, an initial
+    position) or 'mean'; a new node's 'sum' is 0, its 'keep' and 'mean' the parents' mass-weighted mean, except the
+    key 'id', which counts on from the largest); ``forbidden(x) -> bool (K,)``: where no node may be inserted.
+    Returns (nodes, h, fixed, extra, :class:`NodeChange`); the inputs are not changed."""
+    n = nodes.n
+    extra = dict(extra or {})
+    boundary = mesh.boundary if boundary is None else boundary
+    held = np.asarray(fixed, bool).any(axis=1)
+    # removals: greedy over the closest pairs, each node in one merge at most
+    used = np.zeros(n, bool)
+    merged = []
+    for i, j in close_pairs(nodes.x, h, rule.r_min):
+        if used[i] or used[j] or (held[i] and held[j]):
+            continue
+        rank_i, rank_j = (held[i], boundary[i], -i), (held[j], boundary[j], -j)
+        keep, drop = (i, j) if rank_i >= rank_j else (j, i)
+        used[[i, j]] = True
+        merged.append((keep, drop))
+    merged = np.array(merged, dtype=np.int64).reshape(-1, 2)
+    # insertions: triangles too large, none of whose nodes is merged, not where forbidden
+    A = np.abs(signed_areas(nodes.x, mesh.tri))
+    h_e = h[mesh.tri].mean(axis=1)
+    big = (A > rule.a_max * 0.5 * h_e**2) & ~used[mesh.tri].any(axis=1)
+    centroid = nodes.x[mesh.tri].mean(axis=1)
+    if forbidden is not None and big.any():
+        big[big] &= ~np.asarray(forbidden(centroid[big]), bool)
+    ins = np.flatnonzero(big)
+    parents = mesh.tri[ins]
+    # the new nodes' masses, from the parents' tributary areas (module text)
+    a = tributary_areas(nodes.x, mesh.tri, n)
+    rho = np.where(a > 0, nodes.m / np.where(a > 0, a, 1.0), 0.0)
+    share = rho[parents] * (A[ins] / 9.0)[:, None]                         # (K, 3) mass given by each parent
+    m = nodes.m.copy()
+    np.subtract.at(m, parents.ravel(), share.ravel())
+    m_new = share.sum(axis=1)
+    w_new = share / np.where(m_new > 0, m_new, 1.0)[:, None]               # each parent's part of the new mass
+
+    def new_mean(values):
+        v = values[parents]
+        return np.einsum("kp,kp...->k...", w_new, v)
+
+    keep, drop = merged[:, 0], merged[:, 1]
+    mk, md = nodes.m[keep], nodes.m[drop]
+    wk, wd = mk / (mk + md), md / (mk + md)
+
+    def merge_mean(values):
+        out = values.copy()
+        shape = (-1,) + (1,) * (values.ndim - 1)
+        out[keep] = wk.reshape(shape) * values[keep] + wd.reshape(shape) * values[drop]
+        return out
+
+    alive = np.ones(n, bool)
+    alive[drop] = False
+    old_to_new = np.full(n, -1, dtype=np.int64)
+    old_to_new[alive] = np.arange(int(alive.sum()))
+    m_merged = m.copy()
+    m_merged[keep] = m[keep] + m[drop]
+
+    def assemble(kept_values, new_values):
+        return np.concatenate([kept_values[alive], new_values])
+
+    fields = {}
+    for name in ("v", "T") + NODAL:
+        values = getattr(nodes, name)
+        element = getattr(hist, name, None) if name in ELEMENT else None
+        fields[name] = assemble(merge_mean(values), element[ins] if element is not None else new_mean(values))
+    out = replace(nodes, x=assemble(nodes.x, centroid[ins]), m=assemble(m_merged, m_new), **fields)
+    h_kept = h.copy()
+    np.minimum.at(h_kept, keep, h[drop])
+    fixed_kept = np.asarray(fixed, bool).copy()
+    fixed_kept[keep] |= fixed_kept[drop]
+    h_out = assemble(h_kept, h_e[ins])
+    fixed_out = assemble(fixed_kept, np.zeros((len(ins), 2), bool))
+    extra_out = {}
+    for key, (values, how) in extra.items():
+        values = np.asarray(values)
+        if how == "sum":
+            v = values.copy()
+            np.add.at(v, keep, values[drop])
+            new = np.zeros((len(ins),) + values.shape[1:], values.dtype)
+        elif how == "mean":
+            v, new = merge_mean(values), new_mean(values)
+        elif how == "keep":
+            v = values
+            new = (values.max() + 1 + np.arange(len(ins))).astype(values.dtype) if key == "id" else new_mean(values)
+        else:
+            raise ValueError(f"refine_nodes: extra[{key!r}]: how must be 'sum', 'mean' or 'keep', got {how!r}")
+        extra_out[key] = assemble(v, new)
+    return out, h_out, fixed_out, extra_out, NodeChange(old_to_new=old_to_new, parents=parents, merged=merged)
+
+
+def renumber_mesh(mesh: Mesh, hist: History, change: NodeChange) -> tuple[Mesh, History]:
+    """The old mesh in the new node numbering, without the triangles that lost a node, with their history (so that
+    :func:`refsph.pfem.solid.transfer_history` keeps the history of every triangle that survives)."""
+    tri = change.old_to_new[mesh.tri]
+    ok = (tri >= 0).all(axis=1)
+    h = History(**{k: (None if getattr(hist, k) is None else getattr(hist, k)[ok])
+                   for k in ("S", "S_zz", "eps_p", "W_p", "J", "eps_dot")})
+    return Mesh(tri=tri[ok], edges=np.zeros((0, 2), np.int64), boundary=np.zeros(0, bool), alpha=mesh.alpha), h

@@ -62,7 +62,7 @@ from .solid import (TRAPEZOIDAL, History, Loads, Newmark, NewtonFailed, Nodes, S
                     make_nodes, plastic_heat, settle_nodes, transfer_history)
 from .thermal import contact_conductance, thermal_step
 
-__all__ = ["PFEMCut", "CutHeat", "CutRun", "graded_workpiece", "pfem_cut", "heat_step", "run_pfem_cut"]
+__all__ = ["PFEMCut", "CutHeat", "CutRun", "graded_workpiece", "pfem_cut", "heat_step", "refine_run", "run_pfem_cut"]
 
 MATERIALS = {"AISI1045": AISI1045_RLA, "Ti6Al4V": TI6AL4V_RLA}
 HISTORY_KEYS = ("t", "T_RF", "T_RF_max", "T_FCS", "chip_mm", "contact_mm", "max_T", "max_eps_p")
@@ -265,7 +265,7 @@ class CutRun:
         if remesh_needed(nodes.x, mesh, cut.remesh_quality) or self.steps % cut.remesh_every == cut.remesh_every - 1:
             old, hist = mesh, r.history                                 # Algorithm 1: "if remeshing is needed"
             if cut.node_rule is not None:
-                nodes, old, hist = self.refine(nodes, mesh, hist)
+                nodes, old, hist = refine_run(self, nodes, mesh, hist)
             new = alpha_shape_mesh(nodes.x, cut.alpha, self.h)
             self.hist_e, self.mesh = transfer_history(old, hist, new, nodes), new
             self.remeshes += 1
@@ -281,23 +281,6 @@ class CutRun:
         self.steps += 1
         self.wall += time.perf_counter() - t0
         return r
-
-    def refine(self, nodes: Nodes, mesh: Mesh, hist: History):
-        """The node rule of the cut (:func:`refsph.pfem.refine.refine_nodes`; no node inserted within half a spacing
-        of the tool): (nodes, the old mesh renumbered, its history); the run's per-node arrays (h, fixed, X0, ids,
-        f_T) follow."""
-        cut = self.cut
-        shift = cut.shift0 + cut.v_tool * nodes.t
-        nodes, h, fixed, extra, change = refine_nodes(
-            nodes, mesh, hist, self.h, self.fixed, cut.node_rule,
-            extra=dict(id=(self.ids, "keep"), X0=(self.X0, "keep"), f_T=(self.f_T, "sum")),
-            forbidden=lambda x: cut.shape.gap(x, shift)[0] > -0.5 * cut.info["dx"])
-        if not change.changed:
-            return nodes, mesh, hist
-        self.h, self.fixed, self.ids, self.X0, self.f_T = h, fixed, extra["id"], extra["X0"], extra["f_T"]
-        self.inserted += len(change.parents)
-        self.removed += len(change.merged)
-        return (nodes, *renumber_mesh(mesh, hist, change))
 
     def tool_x(self, t: float) -> np.ndarray:
         """The tool's nodes at time t (moved rigidly)."""
@@ -361,6 +344,24 @@ class CutRun:
         run.remeshes, run.wall, run.ledger = rec["remeshes"], rec["wall"], rec["ledger"]
         run.inserted, run.removed = rec.get("inserted", 0), rec.get("removed", 0)
         return run
+
+
+def refine_run(run: "CutRun", nodes: Nodes, mesh: Mesh, hist: History):
+    """The node rule of the cut (:func:`refsph.pfem.refine.refine_nodes`; no node inserted within half a spacing
+    of the tool): (nodes, the old mesh renumbered, its history); ``run``'s per-node arrays (h, fixed, X0, ids,
+    f_T) follow."""
+    cut = run.cut
+    shift = cut.shift0 + cut.v_tool * nodes.t
+    nodes, h, fixed, extra, change = refine_nodes(
+        nodes, mesh, hist, run.h, run.fixed, cut.node_rule,
+        extra=dict(id=(run.ids, "keep"), X0=(run.X0, "keep"), f_T=(run.f_T, "sum")),
+        forbidden=lambda x: cut.shape.gap(x, shift)[0] > -0.5 * cut.info["dx"])
+    if not change.changed:
+        return nodes, mesh, hist
+    run.h, run.fixed, run.ids, run.X0, run.f_T = h, fixed, extra["id"], extra["X0"], extra["f_T"]
+    run.inserted += len(change.parents)
+    run.removed += len(change.merged)
+    return (nodes, *renumber_mesh(mesh, hist, change))
 
 
 def heat_step(run: "CutRun", nodes: Nodes, mesh: Mesh, r, contact: StepContact, dt: float) -> None:

@@ -34,7 +34,8 @@ from scipy.spatial import cKDTree
 from .mesh import Mesh, signed_areas
 from .solid import History, Nodes
 
-__all__ = ["NodeRule", "NodeChange", "refine_nodes", "renumber_mesh", "close_pairs", "tributary_areas"]
+__all__ = ["NodeRule", "NodeChange", "refine_nodes", "renumber_mesh", "close_pairs", "pick_merges", "pick_insertions",
+           "tributary_areas"]
 
 NODAL = ("S", "S_zz", "eps_p", "W_p", "J", "p", "a", "eps_dot")     # mass-weighted in a merge
 ELEMENT = ("S", "S_zz", "eps_p", "W_p", "J", "eps_dot")              # an inserted node takes its triangle's
@@ -79,6 +80,36 @@ def close_pairs(x: np.ndarray, h: np.ndarray, r_min: float) -> np.ndarray:
     return np.stack([i[near][order], j[near][order]], axis=1)
 
 
+def pick_merges(x, h, held, boundary, r_min):
+    """(the (kept, removed) pairs (R, 2), the nodes in a merge (N,) bool): greedy over the closest pairs
+    (:func:`close_pairs`), each node in one merge at most, two held nodes never; the kept node is the held one, else
+    the boundary one, else the lower index."""
+    used = np.zeros(len(x), bool)
+    merged = []
+    for i, j in close_pairs(x, h, r_min):
+        if used[i] or used[j] or (held[i] and held[j]):
+            continue
+        rank_i, rank_j = (held[i], boundary[i], -i), (held[j], boundary[j], -j)
+        merged.append((i, j) if rank_i >= rank_j else (j, i))
+        used[[i, j]] = True
+    return np.array(merged, dtype=np.int64).reshape(-1, 2), used
+
+
+def pick_insertions(nodes: Nodes, mesh: Mesh, h: np.ndarray, used: np.ndarray, a_max: float, forbidden=None):
+    """(the triangles that get a node (K,), the mass each of their nodes gives it (K, 3)): triangles of area above
+    a_max h_e^2 / 2 none of whose nodes is in a merge (``used``), whose centroid is not ``forbidden``; the masses
+    rho_k A / 9 (module text)."""
+    A = np.abs(signed_areas(nodes.x, mesh.tri))
+    h_e = h[mesh.tri].mean(axis=1)
+    big = (A > a_max * 0.5 * h_e**2) & ~used[mesh.tri].any(axis=1)
+    if forbidden is not None and big.any():
+        big[big] &= ~np.asarray(forbidden(nodes.x[mesh.tri[big]].mean(axis=1)), bool)
+    ins = np.flatnonzero(big)
+    a = tributary_areas(nodes.x, mesh.tri, nodes.n)
+    rho = np.where(a > 0, nodes.m / np.where(a > 0, a, 1.0), 0.0)
+    return ins, rho[mesh.tri[ins]] * (A[ins] / 9.0)[:, None]
+
+
 def tributary_areas(x: np.ndarray, tri: np.ndarray, n: int) -> np.ndarray:
     """a_k: a third of the area of each triangle of node k."""
     return np.bincount(tri.ravel(), np.repeat(np.abs(signed_areas(x, tri)) / 3.0, 3), minlength=n)
@@ -96,30 +127,9 @@ def refine_nodes(nodes: Nodes, mesh: Mesh, hist: History, h: np.ndarray, fixed: 
     extra = dict(extra or {})
     boundary = mesh.boundary if boundary is None else boundary
     held = np.asarray(fixed, bool).any(axis=1)
-    # removals: greedy over the closest pairs, each node in one merge at most
-    used = np.zeros(n, bool)
-    merged = []
-    for i, j in close_pairs(nodes.x, h, rule.r_min):
-        if used[i] or used[j] or (held[i] and held[j]):
-            continue
-        rank_i, rank_j = (held[i], boundary[i], -i), (held[j], boundary[j], -j)
-        keep, drop = (i, j) if rank_i >= rank_j else (j, i)
-        used[[i, j]] = True
-        merged.append((keep, drop))
-    merged = np.array(merged, dtype=np.int64).reshape(-1, 2)
-    # insertions: triangles too large, none of whose nodes is merged, not where forbidden
-    A = np.abs(signed_areas(nodes.x, mesh.tri))
-    h_e = h[mesh.tri].mean(axis=1)
-    big = (A > rule.a_max * 0.5 * h_e**2) & ~used[mesh.tri].any(axis=1)
-    centroid = nodes.x[mesh.tri].mean(axis=1)
-    if forbidden is not None and big.any():
-        big[big] &= ~np.asarray(forbidden(centroid[big]), bool)
-    ins = np.flatnonzero(big)
+    merged, used = pick_merges(nodes.x, h, held, boundary, rule.r_min)
+    ins, share = pick_insertions(nodes, mesh, h, used, rule.a_max, forbidden)
     parents = mesh.tri[ins]
-    # the new nodes' masses, from the parents' tributary areas (module text)
-    a = tributary_areas(nodes.x, mesh.tri, n)
-    rho = np.where(a > 0, nodes.m / np.where(a > 0, a, 1.0), 0.0)
-    share = rho[parents] * (A[ins] / 9.0)[:, None]                         # (K, 3) mass given by each parent
     m = nodes.m.copy()
     np.subtract.at(m, parents.ravel(), share.ravel())
     m_new = share.sum(axis=1)
@@ -154,12 +164,12 @@ def refine_nodes(nodes: Nodes, mesh: Mesh, hist: History, h: np.ndarray, fixed: 
         values = getattr(nodes, name)
         element = getattr(hist, name, None) if name in ELEMENT else None
         fields[name] = assemble(merge_mean(values), element[ins] if element is not None else new_mean(values))
-    out = replace(nodes, x=assemble(nodes.x, centroid[ins]), m=assemble(m_merged, m_new), **fields)
+    out = replace(nodes, x=assemble(nodes.x, nodes.x[parents].mean(axis=1)), m=assemble(m_merged, m_new), **fields)
     h_kept = h.copy()
     np.minimum.at(h_kept, keep, h[drop])
     fixed_kept = np.asarray(fixed, bool).copy()
     fixed_kept[keep] |= fixed_kept[drop]
-    h_out = assemble(h_kept, h_e[ins])
+    h_out = assemble(h_kept, h[parents].mean(axis=1))
     fixed_out = assemble(fixed_kept, np.zeros((len(ins), 2), bool))
     extra_out = {}
     for key, (values, how) in extra.items():

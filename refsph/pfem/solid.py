@@ -377,8 +377,7 @@ def newton_step(nodes: Nodes, mesh: Mesh, hist: History, law: SolidLaw, dt: floa
             break
         keep = sp.diags((~fix).astype(float))
         Kf = (keep @ Kg @ keep + sp.diags(fix.astype(float))).tocsc()
-        if order is None:
-            order = band_order(Kf)
+        order = band_order(Kf) if order is None else order
         step = sparse_solve(Kf, -(R_free + keep @ (Kg @ lift)), order) + lift
         if not np.all(np.isfinite(step)):
             break

@@ -138,21 +138,12 @@ def figure(res: dict) -> None:
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    fig, axes = plt.subplots(1, 2, figsize=(12, 4.8), constrained_layout=True)
-    for ax, method in zip(axes, VARIANTS):
-        vs = list(VARIANTS[method])
-        grid = np.full((len(vs), len(CASES)), np.nan)
-        for i, v in enumerate(vs):
-            for j, c in enumerate(CASES):
-                r = res["runs"].get(f"{c}|{method}|{v}")
-                if r is not None and STORE.good(r):
-                    grid[i, j] = 1.0 if r["survived"] else 0.0
-                    ax.text(j, i, "yes" if r["survived"] else "NO", ha="center", va="center", fontsize=9)
-        ax.imshow(grid, cmap="RdYlGn", vmin=-0.3, vmax=1.3, aspect="auto")
-        ax.set_xticks(range(len(CASES)), CASES, rotation=20)
-        ax.set_yticks(range(len(vs)), vs)
-        ax.set_title(f"{method.upper()}: survived?")
-    study.save_figure(fig, FIGURE, dpi=110)
+
+    from refsph.teaching.plots import slide_style, stability_map
+    with plt.rc_context(slide_style()):                     # the figure chapter 10 shows, drawn by the same code
+        fig, axes = plt.subplots(2, 1, figsize=(8.5, 6.4), sharex=True, constrained_layout=True)
+        stability_map(axes, res["runs"], CASES, {m: list(v) for m, v in VARIANTS.items()})
+        study.save_figure(fig, FIGURE, dpi=110)
 
 
 def main(argv=None) -> int:

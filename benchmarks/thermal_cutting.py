@@ -455,24 +455,14 @@ def figures(res: dict) -> None:
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+
+    from refsph.teaching.plots import measured_cuts, slide_style
     rows = comparison(res)
-    fig, axes = plt.subplots(1, 3, figsize=(15, 4.6), constrained_layout=True)
-    for ax, (q, name) in zip(axes, (("TRF", "rake-face temperature [K]"), ("TFCS", "free chip surface [K]"),
-                                    ("ratio", "Fp / Fc"))):
-        for src, mk, lab in (("", "o", "refsph"), ("_sph", "s", "paper SPH"), ("_pfem", "^", "paper PFEM")):
-            for mat, col in (("AISI1045", "C0"), ("Ti6Al4V", "C3")):
-                pts = [(r[f"{q}_exp"], r[f"{q}{src}"]) for r in rows if r["material"] == mat
-                       and r[f"{q}{src}"] is not None]
-                if pts:
-                    p = np.array(pts, dtype=float)
-                    ax.plot(p[:, 0], p[:, 1], mk, color=col, mfc="none" if src else col,
-                            label=f"{lab}, {mat}")
-        lo, hi = ax.get_xlim()
-        ax.plot([lo, hi], [lo, hi], "k:", lw=1)
-        ax.set_xlabel(f"measured {name}")
-        ax.set_ylabel(f"predicted {name}")
-    axes[0].legend(fontsize=7)
-    fig.savefig(FIG / "11_thermal_cutting_vs_measured.png", dpi=100)
+    with plt.rc_context(slide_style()):                     # the figure chapter 11 shows, drawn by the same code
+        fig, axes = plt.subplots(3, 1, figsize=(10, 6.5), sharex=True, constrained_layout=True)
+        measured_cuts(axes, res["runs"])
+        fig.legend(loc="outside right upper")
+        fig.savefig(FIG / "11_thermal_cutting_vs_measured.png", dpi=100)
     plt.close(fig)
     fig, axes = plt.subplots(1, 2, figsize=(11, 4.2), constrained_layout=True)
     for ax, mat in zip(axes, ("AISI1045", "Ti6Al4V")):

@@ -387,16 +387,16 @@ assert np.linalg.norm(s_g[edge]) * h > 0.1 and s_g[edge][1] > 0            # O(1
 # constant is zero inside and of order $1/h$ at the surface, pointing into the block.
 
 # %%
-fig, axes = plt.subplots(1, 2, figsize=(12, 4))
-lims = dict(xlim=(-1, nx), ylim=(-1, ny))                 # in units of dp (scale = 1 / dp)
+fig, axes = plt.subplots(1, 2, figsize=(10, 3.8))
+lims = dict(xlim=(-1, nx), ylim=(-1, ny), spread=1.0, fill=None)     # in units of dp (scale = 1 / dp)
 sc = particle_field(axes[0], x_blk, s_w, dp, scale=1 / dp, **lims)
 colorbar(fig, sc, axes[0], r"$\sum_j V_j W_{ij}$ [-]")
-axes[0].set_title("partition of unity, cubic, h/dp = 1.5")
+axes[0].set_title("kernel sum, h/Δp = 1.5")
 sc = particle_field(axes[1], x_blk, np.linalg.norm(s_g, axis=1) * h, dp, scale=1 / dp, **lims)
 sel = (depth <= 1) & ((ix + iy) % 2 == 0)          # arrows on the surface layers, every other particle
 axes[1].quiver(ix[sel], iy[sel], s_g[sel, 0], s_g[sel, 1], color="k", width=0.005)
 colorbar(fig, sc, axes[1], r"$h\,|\sum_j V_j \nabla_i W_{ij}|$ [-]")
-axes[1].set_title("gradient of a constant (arrows: direction)")
+axes[1].set_title("gradient of a constant")
 for ax in axes:
     ax.set_xlabel(r"$x/\Delta p$ [-]")
     ax.set_ylabel(r"$y/\Delta p$ [-]")
@@ -404,7 +404,7 @@ fig.tight_layout()
 ch.show(fig, "01_partition_of_unity.png", caption="A block of particles with h/Δp = 1.5: the kernel sum Σ V W (left) "
                                                   "is one inside and falls off in the outer two or three layers; the "
                                                   "gradient of a constant (right) is zero inside and of order 1/h at "
-                                                  "the surface, pointing into the block.")
+                                                  "the surface, pointing into the block (arrows).")
 
 # %% [markdown]
 # At a straight edge half of the support lies outside the material, at a right-angled corner three quarters,

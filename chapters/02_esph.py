@@ -389,15 +389,15 @@ assert rmin["ESPH, gamma = 0.3"] > rmin["ESPH, gamma = 0"] + 0.08  # ... the art
 
 # %%
 CLUMP = 0.85                                                    # pairs closer than this (in dp) count as clumped
-fig, axes = plt.subplots(1, 2, figsize=(13, 4.8), gridspec_kw=dict(width_ratios=[1.1, 1]))
+fig, axes = plt.subplots(1, 2, figsize=(10, 4.4), gridspec_kw=dict(width_ratios=[1.1, 1]))
 for (label, r), color in zip(ten.items(), ("C3", "C0", "C1")):
     mh = r.summary["metrics"]["min_pair_distance_history"]
     axes[0].plot(mh[:, 0] * 1e6, mh[:, 1], color, label=label)
 axes[0].axhline(CLUMP, color="0.6", ls=":", lw=1)
-axes[0].set_xlabel("t [us]")
+axes[0].set_xlabel("t [µs]")
 axes[0].set_ylabel("smallest pair distance / dp [-]")
 axes[0].legend(loc="lower left", frameon=False)
-axes[0].set_title("expanding block: closest pair of particles")
+axes[0].set_title("closest pair of particles")
 st = ten["ESPH, gamma = 0"].state
 side = ten["ESPH, gamma = 0"].setup.info["side"] * 1e3
 dp_ten = ten["ESPH, gamma = 0"].setup.dp
@@ -411,15 +411,16 @@ sc = particle_field(axes[1], st.x, nearest, dp_ten, spread=1.0,
 Ic, Jc = I_t[d_t < CLUMP], J_t[d_t < CLUMP]
 for a, b in zip(Ic, Jc):                                        # clumped pairs as black bars
     axes[1].plot(st.x[[a, b], 0] * 1e3, st.x[[a, b], 1] * 1e3, "k-", lw=2)
-colorbar(fig, sc, axes[1], "distance to the nearest neighbour / dp [-]")
+colorbar(fig, sc, axes[1], "nearest neighbour / dp [-]")
 axes[1].set_xlabel("x [mm]")
 axes[1].set_ylabel("y [mm]")
-axes[1].set_title(f"ESPH, gamma = 0, at the end: {len(Ic)} clumped pairs (black)")
+axes[1].set_title(f"ESPH, γ = 0: {len(Ic)} clumped pairs")
 fig.tight_layout()
 ch.show(fig, "02_tensile_instability.png", caption="The tensile instability: the smallest pair distance in an "
                                                    "expanding block over time (left) for ESPH with γ = 0 and γ = 0.3 "
                                                    "and for TLSPH, and the ESPH block with γ = 0 at the end (right), "
-                                                   "its clumped pairs in black.")
+                                                   "coloured by the distance to its nearest neighbour, its clumped "
+                                                   "pairs in black.")
 
 # %% [markdown]
 # Without artificial pressure the closest pair keeps approaching for as long as the block is in tension, and

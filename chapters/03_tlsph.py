@@ -250,7 +250,7 @@ print(f"patch test x = A X + b, max |F - A|: corrected {e_cor.max():.0e}, printe
 assert e_cor.max() < 1e-12 and e_raw[surface].max() > 0.1
 
 # %%
-fig, axes = plt.subplots(1, 2, figsize=(12, 3.8), constrained_layout=True)
+fig, axes = plt.subplots(1, 2, figsize=(10, 3.6), constrained_layout=True)
 for ax, err, title in ((axes[0], err_raw, "Eq. (18) as printed"), (axes[1], err_cor, "with the correction")):
     sc = particle_field(ax, X_fs, np.log10(np.maximum(err, 1e-17)), dp_fs, vmin=-17, vmax=0)
     ax.set(xlabel="X [mm]", ylabel="Y [mm]", title=f"{title}: body at rest")
@@ -537,7 +537,7 @@ ij_fs = np.round(X_fs / dp_fs - 0.5).astype(int)
 zero = np.zeros(len(X_fs))
 modes = {"every second row up/down": np.stack([zero, 0.2 * dp_fs * (-1.0) ** ij_fs[:, 1]], 1),
          "checkerboard along x": np.stack([0.2 * dp_fs * (-1.0) ** ij_fs.sum(1), zero], 1)}
-fig, axes = plt.subplots(1, 2, figsize=(12, 3.8), constrained_layout=True)
+fig, axes = plt.subplots(1, 2, figsize=(10, 3.6), constrained_layout=True)
 for ax, (name, u) in zip(axes, modes.items()):
     e = fnorm(op_cor.deformation_gradient(X_fs + u) - I_n)
     print(f"{name}: every particle moved by 0.2 dp; max |F - I| interior {e[interior].max():.0e}, "

@@ -116,15 +116,15 @@ assert np.allclose(f_hard, jc.A + jc.B * eps_grid**jc.n, rtol=1e-14)
 assert np.all(f_rate[rate_grid <= 1.0] == 1.0) and np.allclose(f_rate[rate_grid > 1], f_rate_printed[rate_grid > 1])
 assert np.all(f_T[T_grid <= T0] == 1.0) and np.all(f_T[T_grid >= jc.T_melt] == 0.0)
 
-fig, axes = plt.subplots(1, 3, figsize=(14, 3.8), constrained_layout=True)
+fig, axes = plt.subplots(1, 3, figsize=(10, 3.8), constrained_layout=True)
 axes[0].plot(eps_grid, f_hard / 1e6, "k")
 axes[0].set(xlabel=r"plastic strain $\bar\epsilon_p$ [-]", ylabel=r"$A + B\bar\epsilon_p^n$ [MPa]",
             title="strain hardening")
 axes[1].semilogx(rate_grid, f_rate_printed, "C3--", label="as printed")
-axes[1].semilogx(rate_grid, f_rate, "k", label=r"refsph: $\ln\max(\dot\epsilon^*, 1)$")
+axes[1].semilogx(rate_grid, f_rate, "k", label=r"$\ln\max(\dot\epsilon^*, 1)$")
 axes[1].set(xlabel=r"$\dot\epsilon^* = \dot{\bar\epsilon}/\dot\epsilon_0$ [-]", ylabel="rate factor [-]",
             title=f"rate, C = {jc.C}")
-axes[1].legend()
+axes[1].legend(loc="upper left")
 axes[2].plot(T_grid, f_T, "k")
 axes[2].set(xlabel="temperature T [K]", ylabel=r"$1 - T^{*m}$ [-]", title=f"thermal, m = {jc.m}")
 for ax in axes:
@@ -314,20 +314,20 @@ for dt in (1e-8, 1e-9):
     assert jump_pla > 10 * jump_tot and gap < -0.03
     assert np.all(above_rate_free > -0.01) and np.all(above_rate_free < 0.01 + 1.5 * step / jc.A)
 
-fig, ax = plt.subplots(figsize=(7.5, 4.4), constrained_layout=True)
+fig, ax = plt.subplots(figsize=(10, 4.6), layout="constrained")
 for dt, c in zip((1e-7, 1e-8, 1e-9), ("C2", "C0", "C3")):
     ax.plot(chatter[dt, "plastic"]["strain"], chatter[dt, "plastic"]["svm"] / 1e6, c, lw=0.7,
-            label=f"previous plastic rate, dt = {dt:.0e} s")
+            label=f"plastic rate, dt = {dt:.0e} s")
 ax.plot(chatter[1e-9, "total"]["strain"], chatter[1e-9, "total"]["svm"] / 1e6, "k", lw=2,
-        label="total rate (refsph), any dt")
+        label="total rate (refsph)")
 ep_line = np.linspace(0.0, STRAIN_CH, 200)
 for r_, ls in ((RATE_CH, "--"), (jc.eps_dot_0, ":")):
     sy_line = yield_stress(jc, ep_line, r_, T0)
     ax.plot(ep_line + sy_line / (3 * mat.G), sy_line / 1e6, "k" + ls, lw=1,
-            label=f"Eq. (25) at {r_:.0e} /s")
+            label=f"Eq. (25), {r_:.0e} /s")
 ax.set(xlabel=r"equivalent strain $\gamma/\sqrt{3}$ [-]", ylabel=r"von Mises stress $\sigma_{vm}$ [MPa]",
        ylim=(jc.A / 1e6 - 80, None), xlim=(0.0, STRAIN_CH), title=f"simple shear at {RATE_CH:.0e} /s")
-ax.legend(fontsize=8, loc="lower right")
+fig.legend(loc="outside right center")
 ch.show(fig, "04_johnson_cook_rate_chatter.png", caption="Simple shear at 10⁴ /s: the previous step's plastic rate "
                                                          "makes the return map chatter; the total rate does not.")
 
@@ -415,7 +415,7 @@ orders = np.log2(errs[:-1] / errs[1:]) / np.log2(np.array(N_CONV[1:]) / np.array
 print("observed order of the lag:", np.round(orders, 2))
 assert np.all((orders > 0.85) & (orders < 1.15))
 
-fig, axes = plt.subplots(1, 2, figsize=(12, 4.2), constrained_layout=True)
+fig, axes = plt.subplots(1, 2, figsize=(10, 4), constrained_layout=True)
 ep_an = np.linspace(0.0, ep_curve.max(), 300)
 axes[0].plot(ep_curve, s_xx / 1e6, "C0", lw=3, label=r"uniaxial $\sigma_{xx}$")
 axes[0].plot(shr["eps_p"], shr["sigma_vm"] / 1e6, "C1", label=r"shear $\sigma_{vm}$")
@@ -483,7 +483,7 @@ assert err_s_ode < 2 * step_change + 2e-4 and np.abs(adi["T"] - T_ode)[m].max() 
 k_peak = int(np.argmax(adi["sigma_vm"]))
 assert adi["sigma_vm"][-1] < iso["sigma_vm"][-1] and 0 < k_peak < N_AD
 
-fig, axes = plt.subplots(1, 2, figsize=(12, 4.2), constrained_layout=True)
+fig, axes = plt.subplots(1, 2, figsize=(10, 4), constrained_layout=True)
 axes[0].plot(2 * iso["strain"][:, 0, 1], iso["S"][:, 0, 1] / 1e6, "k", label="isothermal (heating off)")
 axes[0].plot(2 * adi["strain"][:, 0, 1], adi["S"][:, 0, 1] / 1e6, "C3", label="adiabatic (Eq. 28)")
 axes[0].plot(2 * adi["strain"][k_peak, 0, 1], adi["S"][k_peak, 0, 1] / 1e6, "C3o")

@@ -425,7 +425,7 @@ kin = bounce(V_IMPACT, kinematic=True)         # starts closer: shift its clock 
 t_kin = kin["t"] + (GAP_ESPH - GAP_TLSPH) / V_IMPACT
 print(f"kinematic wall: restitution {kin['restitution']:.3f}")
 
-fig, ax = plt.subplots(1, 2, figsize=(12, 4.2))
+fig, ax = plt.subplots(1, 2, figsize=(10, 4))
 for method, o in main.items():
     ax[0].plot(o["t_F"] * 1e6, -o["F"][:, 0] / 1e6, color=COL[method], lw=0.7, label=method.upper())
     ax[1].plot(o["t"] * 1e6, o["Px"], color=COL[method], label=method.upper())
@@ -468,7 +468,7 @@ for v0 in SPEEDS:
     assert bounce(v0, 50.0)["energy_max"] <= 1.0 + 1e-3              # the default makes no energy
 assert max(bounce(v0, 1000.0)["energy"] for v0 in SPEEDS) > 1.0      # K_p = 1000 does
 
-fig, ax = plt.subplots(1, 2, figsize=(12, 4.2))
+fig, ax = plt.subplots(1, 2, figsize=(10, 4))
 for v0, c in zip(SPEEDS, ("C3", "C0", "C2")):
     ax[0].semilogx(KPS, [bounce(v0, Kp)["restitution"] for Kp in KPS], "o-", color=c, label=f"{v0:.0f} m/s")
     ax[0].axhline(bounce(v0, kinematic=True)["restitution"], color=c, ls="--", lw=1)

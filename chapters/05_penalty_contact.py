@@ -102,7 +102,7 @@ assert all(abs(runs["penalty", s, MU_P]["a"] / A_EXACT - 1) < 0.02 for s in (1.0
 assert runs["pinball", 1.0, MU_P]["a"] < 0.2 * A_EXACT                # the pinball's block hardly moves
 assert runs["pinball", 1.0, 0.0]["mu_eff"] > 0.1                        # and resists without friction
 
-fig, ax = plt.subplots(1, 2, figsize=(12, 4.2))
+fig, ax = plt.subplots(1, 2, figsize=(10, 5.2), layout="constrained")
 for (c, s, mu), o in runs.items():
     style = dict(color="C3" if c == "pinball" else "C0", ls="-" if s == 1.0 else "--", alpha=1.0 if mu else 0.5)
     ax[0].plot(o["t"] * 1e6, o["vx"], **style, label=f"{c}, $\\mu$ = {mu:g}, s = {s:g}")
@@ -111,8 +111,7 @@ for (c, s, mu), o in runs.items():
 ax[0].plot(o["t"] * 1e6, A_EXACT * o["t"], "k:", label="closed form")
 ax[0].set(xlabel="t [µs]", ylabel="block velocity along the plane [m/s]")
 ax[1].set(xlabel="t [µs]", ylabel="$F_t/F_N$ on the plane (running mean)", ylim=(0, 1))
-ax[0].legend()
-fig.tight_layout()
+fig.legend(loc="outside lower center", ncol=3)
 ch.show(fig, "05_incline.png", caption="A block sliding down a tilted plane on the pinball and on the penalty "
                                        "contact, for several friction coefficients μ and mass scales s: its velocity "
                                        "against the closed form (left), and the ratio of tangential to normal force "

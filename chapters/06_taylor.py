@@ -366,13 +366,19 @@ RUNS = {}                                              # runs done once: a cell 
 
 
 def bar_2d(method="tlsph", dp=1e-3, v0=V0, t_end=None, out=None, **options):
-    """The 2D half slab hitting the wall at speed v0 [m/s]; options: T_melt, symmetry (the scene's options)."""
+    """The 2D half slab hitting the wall at speed v0 [m/s]; options: T_melt, symmetry (the scene's options). The
+    result also keeps 26 frames (t, x, eps_p) of the run, for the animation."""
     key = (method, dp, v0, t_end, out, tuple(sorted(options.items())))
     if key not in RUNS:
-        setup = scene.setup(2, dp, True, **options)
+        setup, frames = scene.setup(2, dp, True, **options), []
         setup.state.v[:, -1] = -v0
         setup.t_end = t_end or setup.t_end
-        RUNS[key] = simulate(setup, method, scene=scene, out=out, progress=False)
+
+        def keep(state, solver):                                # a frame every t_end / 25
+            if state.t >= len(frames) * setup.t_end / 25:
+                frames.append((state.t, state.x.copy(), state.eps_p.copy()))
+        RUNS[key] = simulate(setup, method, scene=scene, out=out, progress=False, hook=keep)
+        RUNS[key].frames = frames
     return RUNS[key]
 
 
@@ -385,7 +391,7 @@ for m in METHODS:
           f"{mt['final_diameter_mm']:.2f} mm  (experiment, a 3D bar: {L_EXP} mm and {D_EXP} mm)")
 
 # %%
-fig, axes = plt.subplots(1, 2, figsize=(12, 4.2), constrained_layout=True)
+fig, axes = plt.subplots(1, 2, figsize=(10, 4), constrained_layout=True)
 for m, colour in zip(METHODS, ("C0", "C3")):
     hist = res2[m].history
     for ax, key in zip(axes, ("length", "diameter")):
@@ -416,8 +422,8 @@ snap = {}
 for m in METHODS:
     _, paths = load_run(ch.tmp / f"2d_{m}")
     snap[m] = min((load_snapshot(p) for p in paths), key=lambda z: abs(z["t"] - 30e-6))
-fig, axes = plt.subplots(2, 2, figsize=(8.5, 9), sharex=True, sharey=True)
-fig.subplots_adjust(left=0.08, right=0.86, bottom=0.06, top=0.96, wspace=0.08, hspace=0.15)
+fig, axes = plt.subplots(2, 2, figsize=(6.4, 6.4), sharex=True, sharey=True)
+fig.subplots_adjust(left=0.11, right=0.8, bottom=0.08, top=0.95, wspace=0.08, hspace=0.18)
 for row, (key, label, cmap) in enumerate((("eps_p", "effective plastic strain [-]", "viridis"),
                                           ("T", "temperature [K]", "inferno"))):
     vmax = max(snap[m][key].max() for m in METHODS)
@@ -431,25 +437,51 @@ for row, (key, label, cmap) in enumerate((("eps_p", "effective plastic strain [-
     colorbar(fig, sc, list(axes[row]), label, fraction=0.04, pad=0.03)
 for ax in axes[1]:
     ax.set_xlabel("x [mm]")
-ch.show(fig, "06_2d_fields.png", caption="The 2D Taylor slab at the end of the run, mirrored to show the whole "
+ch.show(fig, "06_2d_fields.png", caption="The 2D Taylor slab at 30 µs, mirrored to show the whole "
                                          "section, ESPH (left) and TLSPH (right): effective plastic strain (top) and "
                                          "temperature (bottom).")
 
 # %% [markdown]
 # The plastic strain, and with it the temperature ($\Delta T$ grows with the plastic work), is largest at the
 # wall in the centre of the foot and falls off towards the rear. Look at the edge of the foot: the ESPH particles
-# are more disordered than the TLSPH ones (more on that under "Where it fails").
+# are more disordered than the TLSPH ones (more on that under "Where it fails"). The whole impact, 2 µs a frame:
+
+# %%
+fig, axes = plt.subplots(1, 2, figsize=(6.4, 6), sharey=True)
+fig.subplots_adjust(left=0.12, right=0.8, bottom=0.1, top=0.86, wspace=0.08)      # fixed: marker sizes
+frames = {m: res2[m].frames for m in METHODS}                                     # (t, x, eps_p) of each run
+mirror = lambda a, sign=(-1, 1): np.concatenate([a, a * sign])                      # noqa: E731
+dots = {m: particle_field(ax, mirror(frames[m][0][1]), mirror(frames[m][0][2], 1), DP_2D, xlim=(-8, 8), fill=None,
+                          ylim=(0, 1e3 * L0 + 0.5), vmin=0, vmax=max(frames[n][-1][2].max() for n in METHODS))
+        for ax, m in zip(axes, METHODS)}
+for ax, m in zip(axes, METHODS):
+    ax.set(title=f"2D {m.upper()}", xlabel="x [mm]", ylabel="z [mm]" if ax is axes[0] else "")
+colorbar(fig, dots["tlsph"], list(axes), "effective plastic strain [-]", fraction=0.05, pad=0.03)
+
+
+def draw(k):
+    for m in METHODS:
+        t, x, eps = frames[m][k]
+        order = np.argsort(mirror(eps, 1), kind="stable")                          # high values on top
+        dots[m].set_offsets(1e3 * mirror(x)[order])
+        dots[m].set_array(mirror(eps, 1)[order])
+    fig.suptitle(f"t = {1e6 * t:.0f} µs")
+
+
+ch.animate(fig, draw, range(min(len(frames[m]) for m in METHODS)), "06_2d_impact.gif",
+           caption="The 2D Taylor slab hitting the wall, ESPH (left) and TLSPH (right), mirrored and coloured by "
+                   "effective plastic strain: the foot spreads along the wall, the plastic front runs up the bar "
+                   "and stops.")
 
 # %% [markdown]
 # ### Why plane strain cannot match the experiment
 #
-# The slab is not a cylinder. Its foot can spread sideways in
-# one direction only; a cylinder's spreads in every radial direction. Plastic flow keeps the volume, so the slab
-# must push all the shortened material out along $x$. The constraint of no strain out of the plane also makes
-# the slab stiffer against shortening: for a von Mises material, the axial stress needed to make it flow is
-# $2/\sqrt3 \approx 1.15$ times the uniaxial yield stress. And its "diameter" is a width. So the 2D numbers
-# above are a size comparison, not a validation: the 2D case teaches the mechanics (the wall, the plastic front,
-# the rebound, the two methods side by side).
+# The slab is not a cylinder. Its foot can spread sideways in one direction only; a cylinder's spreads in every
+# radial direction. Plastic flow keeps the volume, so the slab must push all the shortened material out along $x$.
+# The constraint of no strain out of the plane also makes the slab stiffer against shortening: for a von Mises
+# material, the axial stress needed to make it flow is $2/\sqrt3 \approx 1.15$ times the uniaxial yield stress.
+# And its "diameter" is a width. So the 2D numbers above are a size comparison, not a validation: the 2D case
+# teaches the mechanics (the wall, the plastic front, the rebound, the two methods side by side).
 #
 # ### The wall impulse and the rebound
 #
@@ -485,7 +517,7 @@ for m in METHODS:
     assert abs(P1 - P0 - res3[m].summary["diagnostics"]["wall_impulse"][0]) < 1e-9 * abs(P0)
 
 # %%
-fig, axes = plt.subplots(1, 2, figsize=(8, 7.5), constrained_layout=True, sharey=True)
+fig, axes = plt.subplots(1, 2, figsize=(6.4, 6.4), constrained_layout=True, sharey=True)
 vmax3 = max(res3[m].state.eps_p.max() for m in METHODS)
 for ax, m in zip(axes, METHODS):
     s = res3[m].state

@@ -455,25 +455,37 @@ for m, r in res.items():
 # %% [markdown]
 # ## Your turn
 #
+# Predict first, run, then open *What you should see*. The last exercise asks for code, graded against the package.
+#
 # ### Exercise 1 — A faster tool
 #
 # Predict: the tool hits the block twice as fast. What happens to the force in the first few nanoseconds, the
 # impact? Does it double, grow by less, or hardly change? Use the impact estimate above.
 
 # %% tags=["exercise"]
+from functools import cache
+
+
+@cache                                   # (each speed runs once)
+def impact_peak(v):
+    """ESPH, the first 60 ns with the tool at speed v: the largest force of the block on the tool [N/m]."""
+    st = scene.setup(2, PRESSING_RESOLUTIONS_M[0], True)
+    st.state.v[st.info["n_block"]:, 0] = -v
+    st.rigid, st.t_end = (RigidBody("tool", 1, (-v, 0.0)),), 60e-9                # the first 60 ns only
+    return float(np.asarray(simulate(st, "esph", scene=scene, progress=False).history["reaction"]["tool"])[:, 0].max())
+
+
 V = 200.0          # <- tool speed [m/s]: change this (e.g. to 400) and run the cell again
-st = scene.setup(2, PRESSING_RESOLUTIONS_M[0], True)
-st.state.v[st.info["n_block"]:, 0] = -V
-st.rigid, st.t_end = (RigidBody("tool", 1, (-V, 0.0)),), 60e-9                    # the first 60 ns only
-rh = simulate(st, "esph", scene=scene, progress=False).history["reaction"]
-f = np.asarray(rh["tool"])[:, 0]
-print(f"v = {V:.0f} m/s: impact peak of the tool force {1e-6 * f.max():.2f} MN/m; estimate "
+print(f"v = {V:.0f} m/s: impact peak of the tool force {1e-6 * impact_peak(V):.2f} MN/m; estimate "
       f"{1e-6 * impact_force(V):.2f} MN/m (at 200 m/s: {1e-6 * impact_force(200.0):.2f} MN/m)")
 
 # %% [markdown]
-# What you should see: the impact force grows about in proportion to the speed (the $\rho c_B v$ term
-# dominates, the elastic precursor adds a little), and it follows the estimate. The mean pressing force later would
-# hardly change: the rate term $C\ln\dot\varepsilon^*$ of Johnson–Cook is small.
+# <details><summary>What you should see</summary>
+#
+# The impact force grows about in proportion to the speed (the $\rho c_B v$ term dominates, the elastic precursor
+# adds a little), and it follows the estimate. The mean pressing force later would hardly change: the rate term
+# $C\ln\dot\varepsilon^*$ of Johnson–Cook is small.
+# </details>
 
 # %% [markdown]
 # ### Exercise 2 — How hard is the pinball?
@@ -481,16 +493,24 @@ print(f"v = {V:.0f} m/s: impact peak of the tool force {1e-6 * f.max():.2f} MN/m
 # Predict: with a smaller pinball factor $K_p$, does the tool sink deeper into the TLSPH block, or less deep?
 
 # %% tags=["exercise"]
+@cache
+def penetration(K_p):
+    """TLSPH, 0.05 mm of tool travel: the deepest pinball penetration, in spacings."""
+    r = run("pressing", "tlsph", dp=PRESSING_RESOLUTIONS_M[0], progress=False, options=dict(travel=0.05e-3),
+            numerics=dict(contact_Kp=K_p))
+    return r.summary["diagnostics"]["max_pinball_penetration_m"] / r.setup.dp
+
+
 K_P = 50.0         # <- pinball scaling factor: change this (e.g. to 5) and run the cell again
-r = run("pressing", "tlsph", dp=PRESSING_RESOLUTIONS_M[0], progress=False, options=dict(travel=0.05e-3),
-        numerics=dict(contact_Kp=K_P))
-pen = r.summary["diagnostics"]["max_pinball_penetration_m"] / r.setup.dp
-print(f"K_p = {K_P:g}: deepest pinball penetration {pen:.3f} dp after 0.05 mm of tool travel")
+print(f"K_p = {K_P:g}: deepest pinball penetration {penetration(K_P):.3f} dp after 0.05 mm of tool travel")
 
 # %% [markdown]
-# What you should see: the smaller $K_p$, the deeper the penetration (the first branch of the force stops an
-# approach less hard); with a large $K_p$ the penetration is a small fraction of a spacing. $K_p$ is a numerical
-# stiffness, not a material property.
+# <details><summary>What you should see</summary>
+#
+# The smaller $K_p$, the deeper the penetration (the first branch of the force stops an approach less hard); with
+# a large $K_p$ the penetration is a small fraction of a spacing. $K_p$ is a numerical stiffness, not a material
+# property.
+# </details>
 
 # %% [markdown]
 # ### Exercise 3 — Switch off the heating
@@ -501,16 +521,80 @@ print(f"K_p = {K_P:g}: deepest pinball penetration {pen:.3f} dp after 0.05 mm of
 # %% tags=["exercise"]
 import dataclasses
 
-HEATING = True     # <- change this to False (isothermal: no heating by plastic work, Eq. 28) and run again
-st = scene.setup(2, DP, True)
-st.strength = dataclasses.replace(st.strength, heating=HEATING)   # the law's own switch
-r = simulate(st, "esph", scene=scene, progress=False) if not HEATING else res["esph"]   # True: the chapter's run
-for label, s, mt in (("chapter, heating", res["esph"].state, res["esph"].summary["metrics"]),
-                     (f"heating = {HEATING}", r.state, r.summary["metrics"])):
+
+def pressing_esph(heating):
+    """The chapter's ESPH run, with or without heating by plastic work (Eq. 28); True: the run above."""
+    if heating:
+        return res["esph"]
+    st = scene.setup(2, DP, True)
+    st.strength = dataclasses.replace(st.strength, heating=False)              # the law's own switch
+    return simulate(st, "esph", scene=scene, progress=False)
+
+
+HEATING = True     # <- change this to False (isothermal: no heating by plastic work) and run again
+for label, r in (("chapter, heating", res["esph"]), (f"heating = {HEATING}", pressing_esph(HEATING))):
+    mt = r.summary["metrics"]
     print(f"{label:17s}: mean tool force {1e-6 * mt['tool_force_mean_N_per_m']:.3f} MN/m, max T "
-          f"{mt['max_temperature_K']:.0f} K, 99th percentile of eps_p {np.percentile(s.eps_p[:n_b], 99):.3f}")
+          f"{mt['max_temperature_K']:.0f} K, 99th percentile of eps_p {np.percentile(r.state.eps_p[:n_b], 99):.3f}")
 
 # %% [markdown]
-# What you should see: without heating the temperature stays at room temperature, the material stays stronger,
-# the pressing force is a few per cent higher, and the strain in the bands is lower: thermal softening is what
-# helps the strain to localise, and in machining it is what lets the chip form.
+# <details><summary>What you should see</summary>
+#
+# Without heating the temperature stays at room temperature, the material stays stronger, the pressing force is a
+# few per cent higher, and the strain in the bands is lower: thermal softening is what helps the strain to
+# localise, and in machining it is what lets the chip form.
+# </details>
+
+# %% [markdown]
+# ### Exercise 4 — The tool and the clamp, yourself
+#
+# The tool and the clamped column are prescribed motions, imposed on the rates of every stage: the tool's rows
+# (`n_block` onwards) move with their velocity (dx/dt = v, dv/dt = 0), the clamp's rows (`clamp`) stay put
+# (dx/dt = dv/dt = 0). The force the block exerts on each is $\sum_i m_i\,\dot{\mathbf v}_i$ over its rows,
+# with the accelerations `a` the SPH sums and the contact gave them (pairs inside one body cancel): the momentum
+# the constraint removes. Write it: return the force on the tool, on the clamp (N/m, shape (2,)) and the rates
+# dv/dt and dx/dt after the constraints. The grader uses the chapter's states with random accelerations. Predict:
+# which outputs are wrong if you zero the rates first?
+
+# %% tags=["exercise"]
+def my_constraints(m, v, a, n_block, clamp):
+    """(force on the tool, force on the clamp, dv/dt, dx/dt) of the pressing's tool and clamp, from the masses m,
+    velocities v and the accelerations a of every particle before the constraints."""
+    raise NotImplementedError("write the tool and the clamp here")      # <- replace this line by your code
+
+
+from types import SimpleNamespace
+
+from refsph.boundaries import Clamp, Constraints
+from refsph.state import Rates
+from refsph.teaching.grader import case, check
+
+
+def pkg_constraints(m, v, a, n_block, clamp):
+    n, d = v.shape
+    s = SimpleNamespace(n=n, dim=d, m=m, v=v, x=np.zeros_like(v), t=0.0, body=(np.arange(n) >= n_block).astype(int))
+    cons = Constraints(rigid=(RigidBody("tool", 1, tuple(v[-1])),), clamps=(Clamp("clamp", clamp),))
+    cons.bind(s)
+    r = Rates(x=v.copy(), v=a, rho=None, S=np.zeros((n, d, d)), S_zz=np.zeros(n))
+    cons.constrain(s, r)
+    cons.log.close_step(0.0, 1.0)                                   # one step of 1 s: the log holds the forces
+    h = cons.reaction_history()
+    return h["tool"][0], h["clamp"][0], r.v, r.x
+
+
+rng_ex = np.random.default_rng(4)
+v_rand = np.concatenate([rng_ex.normal(scale=50.0, size=(n_b, 2)), st0.state.v[n_b:]])     # the tool keeps its v
+cases_ex4 = [case(s.m, v, rng_ex.normal(scale=1e9, size=v.shape), n_b, st0.clamps[0].index, label=label)
+             for s, v, label in ((st0.state, st0.state.v, "the set-up, t = 0"),
+                                 (res["esph"].state, res["esph"].state.v, "ESPH, end of the run"),
+                                 (res["tlsph"].state, res["tlsph"].state.v, "TLSPH, end of the run"),
+                                 (st0.state, v_rand, "the set-up, random velocities"))]
+report = check(my_constraints, pkg_constraints, cases_ex4, names=("F_tool", "F_clamp", "dv/dt", "dx/dt"))
+
+# %% [markdown]
+# <details><summary>What you should see</summary>
+#
+# As handed out: `FAIL ... not written yet`. Zeroing first gives forces of zero: `F_tool` fails in the first
+# case. Forgetting the masses, or $\dot{\mathbf x} = \mathbf v$ left on the clamp, fail too. This is why the
+# momentum balance above holds to round-off: the logged force is exactly the momentum the constraint takes out.
+# </details>

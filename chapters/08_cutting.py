@@ -72,7 +72,7 @@ V_TOOL, FEEDS = CUTTING_GEOMETRY["tool_speed_m_s"], CUTTING_GEOMETRY["feeds_m"]
 DP_PAPER = CUTTING_TABLE5["particle_spacing_m"]
 DP = 0.05e-3 if ch.quick else 0.025e-3                  # this chapter's spacing
 TRAVEL = 0.3e-3 if ch.quick else 1.0e-3                 # length of cut of the lesson's runs
-TRAVEL_EX = 0.2e-3 if ch.quick else 0.5e-3              # ... and of the exercises
+TRAVEL_EX = TRAVEL if ch.quick else 0.5e-3              # ... and of the exercises (quick: the lesson's runs)
 COL = dict(esph="C0", tlsph="C3")
 BENCH = {r["name"]: r for r in json.loads((repository_root() / "benchmarks" / "cutting.json").read_text())}
 print(f"this chapter: dp = {1e3 * DP:.3f} mm ({DP / DP_PAPER:.1f} x the paper's), {1e3 * TRAVEL:.1f} mm of cut")
@@ -319,13 +319,20 @@ for angle, spacing in ((45.0, 0.12e-3), (60.0, 0.2e-3)):
 # ## Cutting at a coarse spacing
 #
 # Both methods at feed 0.3 mm, at this chapter's spacing and cut length (printed at the top). One helper runs a
-# case; the snapshots go to a scratch folder.
+# case (once: asked again, it returns the run it made); the snapshots go to a scratch folder.
 
 # %%
+RUNS, NUMERICS = {}, SCENE.setup(2, DP, False).numerics          # the runs made so far; the scene's numerics
+
+
 def cut(method, feed=FEEDS[0], travel=TRAVEL, numerics=None, tag=""):
-    """One cutting run (raises SimulationError if the state goes non-finite)."""
-    return run("cutting", method, dp=DP, out=ch.tmp / f"{method}-{1e3 * feed:g}{tag}", progress=False,
-               numerics=numerics, options=dict(feed=feed, travel=travel))
+    """One cutting run (raises SimulationError if the state goes non-finite); a case run before is not run again."""
+    changed = tuple(sorted((k, v) for k, v in (numerics or {}).items() if getattr(NUMERICS, k) != v))
+    key = (method, feed, travel, changed)
+    if key not in RUNS:
+        RUNS[key] = run("cutting", method, dp=DP, out=ch.tmp / f"{method}-{1e3 * feed:g}{tag}", progress=False,
+                        numerics=numerics, options=dict(feed=feed, travel=travel))
+    return RUNS[key]
 
 
 res = {m: cut(m) for m in ("tlsph", "esph")}
@@ -514,6 +521,10 @@ print(f"benchmark, TLSPH without updates at dp = {q['dp_mm']:.3f} mm: lost after
 # %% [markdown]
 # ## Your turn
 #
+# Predict first, run, then open *What you should see*. The last exercise asks for code, graded against the package.
+# In quick mode the exercises' runs are the lesson's TLSPH run with one thing changed (cut length printed at the
+# top), so the unchanged case costs nothing.
+#
 # ### Exercise 1 — A deeper cut
 #
 # Predict: if the feed goes from 0.3 mm to 0.5 mm, by how much does the cutting force grow? (Merchant: at a fixed
@@ -522,38 +533,50 @@ print(f"benchmark, TLSPH without updates at dp = {q['dp_mm']:.3f} mm: lost after
 
 # %% tags=["exercise"]
 FEED = 0.3e-3          # <- change this (e.g. to 0.5e-3) and run the cell again
-r = cut("tlsph", feed=FEED, travel=TRAVEL_EX, tag="-ex1")
+r = cut("tlsph", feed=FEED, travel=TRAVEL_EX, tag="-ex")
 Fc = r.summary["metrics"]["cutting_force_mean_N_per_m"]
 print(f"feed {1e3 * FEED:.2f} mm: Fc = {1e-6 * Fc:.3f} MN/m, Fc / feed = {Fc / FEED / 1e9:.2f} GJ/m^3")
 
 # %% [markdown]
-# What you should see: the cutting force grows with the feed, roughly in proportion (the paper: "the increase of
-# the feeding length increases the cutting force"), so $F_c/f$ stays about the same: a material constant of
-# machining, the specific cutting energy.
+# <details><summary>What you should see</summary>
 #
+# The cutting force grows with the feed, by somewhat less than the ratio of the feeds (the paper: "the increase of
+# the feeding length increases the cutting force"), so $F_c/f$ stays about the same: the specific cutting
+# energy, close to a material constant of machining.
+# </details>
+
+# %% [markdown]
 # ### Exercise 2 — TLSPH without reference updates
 #
 # Predict: switch TLSPH's reference updates off (`None`). The chip must separate from the workpiece along the cut
 # line. What happens to the new surface under the tool, the layer just below the cut line?
 
 # %% tags=["exercise"]
-REF_UPDATE = 0.5       # <- change this (to None: never update the reference configuration) and run again
-try:
-    r = cut("tlsph", travel=TRAVEL_EX, numerics=dict(ref_update_strain=REF_UPDATE), tag=f"-ex2-{REF_UPDATE}")
+def new_surface(r):
+    """Mean plastic strain of the two rows under the cut line that the tool has passed: the new surface."""
     n, y0, dy = r.setup.info["n_work"], r.setup.info["y0"], r.setup.info["dy"]
     X, x_tip = r.setup.state.x[:n], r.state.x[n:, 0].min()
-    surface = (X[:, 1] < y0) & (X[:, 1] > y0 - 2 * dy) & (X[:, 0] > x_tip)    # two rows under the cut, cut already
+    return float(r.state.eps_p[:n][(X[:, 1] < y0) & (X[:, 1] > y0 - 2 * dy) & (X[:, 0] > x_tip)].mean())
+
+
+REF_UPDATE = 0.5       # <- change this (to None: never update the reference configuration) and run again
+try:
+    r = cut("tlsph", travel=TRAVEL_EX, numerics=dict(ref_update_strain=REF_UPDATE), tag=f"-ex-{REF_UPDATE}")
     print(f"reference updates: {r.summary['diagnostics']['reference_updates']}; new surface: mean plastic strain "
-          f"{r.state.eps_p[:n][surface].mean():.2f}; hottest particle {r.state.T[:n].max():.0f} K")
+          f"{new_surface(r):.2f}; hottest particle {r.state.T[:r.setup.info['n_work']].max():.0f} K")
 except SimulationError as e:
     print(f"the run is lost: {e}")
 
 # %% [markdown]
-# What you should see: no updates, and the layer under the cut line strained noticeably more, and the hottest
-# particle hotter: the material below the cut is still tied to its old neighbours in the chip and is dragged
-# along. This short cut survives; a longer one does not (the benchmark's run without updates stops with
-# non-finite positions, printed under "Where it fails").
+# <details><summary>What you should see</summary>
 #
+# No updates, and the layer under the cut line strained noticeably more, and the hottest particle hotter: the
+# material below the cut is still tied to its old neighbours in the chip and is dragged along. The quick cut
+# survives; the full mode's, finer and longer, is lost, like the benchmark's run without updates at 0.025 mm
+# (non-finite positions after 0.29 mm of cut, printed under "Where it fails").
+# </details>
+
+# %% [markdown]
 # ### Exercise 3 — How fine must the particles be to see a band?
 #
 # Predict: we draw five bands 0.15 mm apart (about the spacing TLSPH finds at the paper's resolution), each 1.5
@@ -573,6 +596,57 @@ ch.show(fig, caption="Five shear bands drawn 0.15 mm apart, each 1.5 spacings wi
                      "coloured by plastic strain; the title says how many the band measure finds.")
 
 # %% [markdown]
-# What you should see: at 0.025 mm all five are still found; at 0.05 mm each band is as wide as the gap between
-# bands, they merge into one smear, and the measure finds one. A simulation cannot do better than its particles:
-# that is why the band counts in quick mode are zero and why the benchmark runs at the paper's spacing.
+# <details><summary>What you should see</summary>
+#
+# At 0.025 mm all five are still found; at 0.05 mm each band is as wide as the gap between bands, they merge into
+# one smear, and the measure finds one. A simulation cannot do better than its particles: that is why the band
+# counts in quick mode are zero and why the benchmark runs at the paper's spacing.
+# </details>
+
+# %% [markdown]
+# ### Exercise 4 — The force history, yourself
+#
+# The reaction log holds, for every step $k$, its midpoint time $t_k$, its size $\Delta t_k$ and the force
+# $\mathbf F_k$ on the tool: $F_c$ (x) and $F_t$ (y). The curves of the force figure are the summary's
+# `cutting_force_history` and `thrust_force_history`: $[0, t_\mathrm{end}]$ cut into `n_bins` equal bins, each
+# step put in the bin of its midpoint, and in each bin the time mean $\sum F_k\Delta t_k / \sum\Delta t_k$. Write it:
+# return the centres of the bins that hold a step, and the mean $F_c$ and $F_t$ in them. Predict: which case fails
+# if you take the plain mean of the steps' forces in each bin?
+
+# %% tags=["exercise"]
+def my_force_history(t, dt, F, t_end, n_bins):
+    """(bin centres [s], mean Fc [N/m], mean Ft [N/m]) of the bins that hold a step, as described above."""
+    raise NotImplementedError("write the binned means here")      # <- replace this line by your code
+
+
+from refsph.scenes.measure import N_FORCE_BINS, binned_mean
+from refsph.teaching.grader import case, check
+
+
+def pkg_force_history(t, dt, F, t_end, n_bins):
+    return binned_mean(t, dt, F[:, 0], t_end, n_bins) + binned_mean(t, dt, F[:, 1], t_end, n_bins)[1:]
+
+
+def log_of(r, n_bins, label):
+    rh = r.history["reaction"]
+    return case(np.asarray(rh["t"]), np.asarray(rh["dt"]), np.asarray(rh["tool"]), r.setup.t_end, n_bins, label=label)
+
+
+for m, r in res.items():                 # the package's histories are the summary's
+    tb, fc, ft = pkg_force_history(*log_of(r, N_FORCE_BINS, "").args)
+    assert np.array_equal(np.stack([tb, fc], 1), r.summary["metrics"]["cutting_force_history"])
+    assert np.array_equal(np.stack([tb, ft], 1), r.summary["metrics"]["thrust_force_history"])
+cases_ex4 = [log_of(res["tlsph"], N_FORCE_BINS, f"TLSPH, {N_FORCE_BINS} bins (the summary's)"),
+             log_of(res["esph"], N_FORCE_BINS, f"ESPH, {N_FORCE_BINS} bins"),
+             log_of(res["tlsph"], 12, "TLSPH, 12 bins"),
+             log_of(res["esph"], 2000, "ESPH, 2000 bins: more bins than steps")]
+report = check(my_force_history, pkg_force_history, cases_ex4, names=("t", "Fc", "Ft"))
+
+# %% [markdown]
+# <details><summary>What you should see</summary>
+#
+# As handed out: `FAIL ... not written yet`. The plain mean fails already in the first case: the CFL step
+# changes during the cut (by a factor of about 4 here), and a short step must count less. With more bins than
+# steps some bins stay empty: they are left out, not returned as nan. The time mean is what turns TLSPH's
+# impulsive contact force into a curve you can read.
+# </details>

@@ -72,13 +72,18 @@ def my_cubic_3d(r, h, norm=1.0 / np.pi):
     return 0.0, 0.0
 
 
-def my_backend(case_name, out_root, kernel):
+def kernel_outputs(case_name, kernel):
+    """W, dW/dr and grad W of a kernel case's inputs, one pair at a time."""
     with np.load(GOLDEN / case_name / "input.npz") as z:
         r, h, xij = z["r"], float(z["h"]), z["x_ij"]
     W, dW = np.array([kernel(ri, h) for ri in r]).T
     grad = np.array([kernel(np.linalg.norm(x), h)[1] * x / np.linalg.norm(x) for x in xij])
+    return dict(W=W, dW_dr=dW, grad_W=grad)
+
+
+def my_backend(case_name, out_root, kernel):
     (out_root / case_name).mkdir(parents=True, exist_ok=True)
-    np.savez(out_root / case_name / "output.npz", W=W, dW_dr=dW, grad_W=grad)
+    np.savez(out_root / case_name / "output.npz", **kernel_outputs(case_name, kernel))
 
 
 mine = ch.tmp / "mine"
@@ -106,7 +111,7 @@ assert not any(r.passed for r in rows)
 # sums add in a fixed order), so a rerun on another thread count must pass.
 
 # %%
-kw = dict(dim=2, quick=True, progress=False, t_end=4e-6)
+kw = dict(dim=2, quick=True, progress=False, t_end=6e-6)       # 6 us: one period, about
 run("bar", "tlsph", out=ch.tmp / "one", numerics=dict(threads=1), **kw)
 run("bar", "tlsph", out=ch.tmp / "two", numerics=dict(threads=2), **kw)
 rows = compare(ch.tmp / "one", ch.tmp / "two")
@@ -224,18 +229,148 @@ for a, b in pairs:
 #
 # ## Your turn
 #
-# ### Exercise 1 — The Wendland kernel from its equation
+# Predict first, run, then open *What you should see*. The last exercise asks for code, graded against the package.
+
+# %% [markdown]
+# ### Exercise 1 — The Wendland kernel, and a porting bug
 #
-# Write the 2D Wendland C2 kernel, $W = \frac{7}{4\pi h^2}(1-q/2)^4(2q+1)$ for $q \le 2$, as a plain function like
-# `my_cubic_3d`, run it on `kernel_wendland_2d` and make `compare(..., only=["kernel_wendland_2d"])` pass.
+# The 2D Wendland C2 kernel is $W = \frac{7}{4\pi h^2}(1-q/2)^4(2q+1)$ for $q \le 2$. Below it is written like
+# `my_cubic_3d` and compared with `kernel_wendland_2d`. Predict: with the 3D constant, $21/(16\pi)$ instead of
+# $7/(4\pi)$, which rows fail, and what error does the table show? Would a wrong power of $(1-q/2)$ show the same?
+
+# %% tags=["exercise"]
+NORM = 7 / (4 * np.pi)      # <- change this to 21 / (16 * np.pi), the 3D constant, and run the cell again
+
+
+def my_wendland_2d(r, h, norm=NORM):
+    q = r / h
+    if q >= 2.0:
+        return 0.0, 0.0
+    t = 1.0 - 0.5 * q
+    return norm / h**2 * t**4 * (2 * q + 1), norm / h**3 * (-5.0 * q * t**3)
+
+
+my_backend("kernel_wendland_2d", mine, my_wendland_2d)
+print(format_table(compare(GOLDEN, mine, only=["kernel_wendland_2d"])))
+
+# %% [markdown]
+# <details><summary>What you should see</summary>
 #
+# With $7/(4\pi)$ all three rows pass, to round-off. With $21/(16\pi)$ all three fail with the same error, 0.25:
+# $1 - \frac{21/16}{7/4} = \frac14$. One error in every array is the signature of a wrong constant; a wrong power
+# fails only the arrays that use it, each with an error of its own.
+# </details>
+
+# %% [markdown]
 # ### Exercise 2 — A full neighbour list
 #
-# GPU codes usually store both $(i, j)$ and $(j, i)$. Build such a list for 50 random points with
-# `cKDTree.query_pairs`, give it to `refsph.neighbours.check_half_pairs`, read the message, then keep the half
-# refsph expects and check that it passes.
+# GPU codes usually store both $(i, j)$ and $(j, i)$. Predict: does `check_half_pairs` accept such a full list of
+# 50 random points? And the full list with each pair written as (min, max)? How many pairs does refsph want?
+
+# %% tags=["exercise"]
+from scipy.spatial import cKDTree
+
+from refsph.neighbours import check_half_pairs
+
+x_nb = np.random.default_rng(0).random((50, 2))
+half = cKDTree(x_nb).query_pairs(0.3, output_type="ndarray")                  # each pair once, i < j
+I_full, J_full = np.concatenate([half[:, 0], half[:, 1]]), np.concatenate([half[:, 1], half[:, 0]])
+LIST = "full"      # <- change this to "min-max", then to "I < J", and run the cell again
+lists = {"full": (I_full, J_full), "min-max": (np.minimum(I_full, J_full), np.maximum(I_full, J_full)),
+         "I < J": (I_full[I_full < J_full], J_full[I_full < J_full])}
+I_try, J_try = lists[LIST]
+try:
+    check_half_pairs(I_try, J_try, len(x_nb))
+    print(f"{LIST}: {len(I_try)} pairs accepted")
+except ValueError as e:
+    print(f"{LIST}: {len(I_try)} pairs refused: {e}")
+
+# %% [markdown]
+# <details><summary>What you should see</summary>
 #
+# The full list (474 pairs) is refused, and the message names the convention: half pairs, each interacting pair
+# once with $I < J$. Written as (min, max) it is refused too: now every pair appears twice. Keeping $I < J$ leaves
+# 237 pairs, exactly the k-d tree's half list, and passes. A full list would double every SPH sum.
+# </details>
+
+# %% [markdown]
 # ### Exercise 3 — Which tolerance does a time step need?
 #
-# Run the 2D quick bar with `--set courant=0.15` and compare it with the Courant 0.3 run. Which rows fail at the
-# default 1e-6? Write a tolerance file that passes the wave speed at 1e-3 and compares nothing else.
+# Predict: run the 2D bar above with half the Courant number (0.15) and compare it with the run at 0.3 (`one`).
+# Which rows fail at the default 1e-6, and by how much? Then write a tolerance dict that compares the wave speed
+# at 1e-3 and nothing else (the file format of `refsph compare --tolerances`).
+
+# %% tags=["exercise"]
+COURANT = 0.3      # <- change this to 0.15 and run the cell again
+TOL = None         # <- then write a tolerance dict here: {"fields": ..., "metrics": ..., "field": ..., "metric": ...}
+test = ch.tmp / "two" if COURANT == 0.3 else ch.tmp / f"courant-{COURANT}"
+if not test.exists():
+    run("bar", "tlsph", out=test, numerics=dict(courant=COURANT), **kw)
+rows = compare(ch.tmp / "one", test, TOL)
+bad = [r for r in rows if not r.passed]
+print(f"Courant {COURANT} against 0.3: {len(rows)} rows, {len(bad)} fail; errors of the failing ones from "
+      f"{min((r.error for r in bad), default=0):.1e} to {max((r.error for r in bad), default=0):.1e}")
+print(format_table([r for r in rows if "wave_speed" in r.quantity]))
+
+# %% [markdown]
+# <details><summary>What you should see</summary>
+#
+# At 0.3 against its rerun on two threads every row passes. At 0.15 the positions, velocities and stresses fail
+# after $t = 0$, by 3e-5 to 2e-3, while the density and $\mathbf F$ pass. The wave speed moves by 4e-5, the energy
+# by 2e-6; the momentum drift (a round-off number) and the wave speed's error against theory (a small difference
+# of two close numbers) by several per cent, which means nothing. Another time step is another discretisation, not
+# a bug; `{"field": None, "metric": None, "metrics": {"wave_speed_m_s": 1e-3}}` compares the wave speed alone.
+# </details>
+
+# %% [markdown]
+# ### Exercise 4 — The error column, yourself
+#
+# Every row of `refsph compare` on golden cases is one output array of a case, with an error measure the case
+# chooses (`case.json`'s `"measure"`, keyed by array; absent: the default): the default $\max\lvert t - r\rvert
+# / \max\lvert r\rvert$ (just $\max\lvert t - r\rvert$ where $r$ is all zero); `{"kind": "l2"}`: $\lVert t - r\rVert
+# / \lVert r\rVert$; `{"kind": "pointwise", "floor": f}`: $\max_i \lvert t_i - r_i\rvert/(\lvert r_i\rvert + f)$.
+# Write it: the error of array `key` of golden case `name` when a backend returns `test`, with $r$ from the
+# case's `output.npz`. Predict: which case fails if you always use the default?
+
+# %% tags=["exercise"]
+def my_error(name, key, test):
+    """The error refsph compare reports for array `key` of golden case `name` against the array `test`."""
+    raise NotImplementedError("write the error measures here")      # <- replace this line by your code
+
+
+from refsph.crosscheck.compare import compare_case
+from refsph.teaching.grader import case, check
+
+
+def pkg_error(name, key, test):
+    with np.load(GOLDEN / name / "output.npz") as z:
+        out = {k: z[k] for k in z.files}
+    return next(r.error for r in compare_case(GOLDEN / name, {**out, key: test}) if r.quantity == f"{name}/{key}")
+
+
+def golden_array(name, key):
+    with np.load(GOLDEN / name / "output.npz") as z:
+        return z[key]
+
+
+ESPH, TLSPH = "metrics_pressing_quick_esph", "metrics_pressing_quick_tlsph"
+cases_ex4 = [case("kernel_cubic_3d", "W", kernel_outputs("kernel_cubic_3d", lambda r, h: my_cubic_3d(
+                  r, h, norm=10 / (7 * np.pi)))["W"], label="the cubic kernel with the 2D constant"),
+             case("kernel_cubic_3d", "grad_W", kernel_outputs("kernel_cubic_3d", my_cubic_3d)["grad_W"],
+                  label="the cubic kernel, right"),
+             case(ESPH, "plastic_strain_line_eps_p", golden_array(TLSPH, "plastic_strain_line_eps_p"),
+                  label="chapter 7's strain line: TLSPH against ESPH"),
+             case(TLSPH, "plastic_strain_line_eps_p", golden_array(ESPH, "plastic_strain_line_eps_p"),
+                  label="chapter 7's strain line: ESPH against TLSPH"),
+             case(TLSPH, "tool_force_mean_N_per_m", golden_array(ESPH, "tool_force_mean_N_per_m"),
+                  label="chapter 7's mean tool force: ESPH against TLSPH")]
+report = check(my_error, pkg_error, cases_ex4)
+
+# %% [markdown]
+# <details><summary>What you should see</summary>
+#
+# As handed out: `FAIL ... not written yet`. The default alone fails at the strain lines of chapter 7: the ESPH
+# case measures each point against its own size, with a floor (a tight tolerance, 1e-4, on a line that passes
+# through small strains), the TLSPH case the L2 difference (TLSPH's line is reproducible to a few per cent only,
+# so no single point may decide). The measure is part of what a case asserts.
+# </details>

@@ -38,7 +38,7 @@ from scipy.spatial import Delaunay
 from refsph.paper_data import AISI1045_RLA, rla_cutting_case
 from refsph.pfem import solid
 from refsph.pfem.mesh import alpha_shape_mesh, topology as mesh_topology
-from refsph.teaching.notebook import chapter
+from refsph.teaching.notebook import chapter, repository_root
 ch = chapter("12_pfem")
 
 # %%
@@ -102,8 +102,6 @@ print(f"plain loop = refsph.pfem.mesh.alpha_shape_mesh for alpha = None, 1.4, 0.
 # mesh has vertices − edges + triangles = bodies − holes) and of triangles inside the notch.
 
 # %%
-
-
 def topology(x, mesh):
     bodies, holes = mesh_topology(len(x), mesh.tri)
     c = x[mesh.tri].mean(axis=1)
@@ -121,13 +119,13 @@ assert topo[1.4] == dict(topo[1.4], bodies=2, holes=0, notch=0) and topo[0.8]["h
 assert topo[None]["bodies"] == topo[2.0]["bodies"] == 1 and topo[None]["notch"] > 0
 
 # %%
-fig, axes = plt.subplots(1, 4, figsize=(16, 2.1), constrained_layout=True)
-for ax, (a, m) in zip(axes, meshes.items()):
+fig, axes = plt.subplots(2, 2, figsize=(10, 3.6), constrained_layout=True)
+for ax, (a, m) in zip(axes.flat, meshes.items()):
     ax.triplot(pts[:, 0], pts[:, 1], m.tri, lw=0.6, color="C0")
     for i, j in m.edges:
         ax.plot(pts[[i, j], 0], pts[[i, j], 1], color="C3", lw=1.5)
-    t = topo[a]
-    ax.set(aspect="equal", title=f"alpha = {a}: {t['bodies']} bodies, {t['holes']} holes", xticks=[], yticks=[])
+    ax.set(aspect="equal", title=f"alpha = {a}: {topo[a]['bodies']} bodies, {topo[a]['holes']} holes", xticks=[],
+           yticks=[])
 ch.show(fig, "12_alpha_shape.png", caption="Two bodies three spacings apart, meshed by Delaunay (alpha = None) "
         "and by the alpha-shape at alpha = 2.0, 1.4 and 0.8: boundary edges in red. Only 1.4 keeps the bodies "
         "apart without opening holes.")
@@ -138,9 +136,7 @@ ch.show(fig, "12_alpha_shape.png", caption="Two bodies three spacings apart, mes
 # the paper's Figure 3 in numbers: too large bridges real gaps, too small opens false holes, and the safe window
 # (1.2–1.5 in PFEM codes) is narrow. When a chip curls back to within about a spacing of the workpiece, every α
 # of the window bridges the gap: in the PFEM the α-shape, not a contact law, decides when two surfaces touch.
-#
-# `alpha_shape_mesh` also refuses any triangle whose three nodes are not of one body (`body=`): the tool and the
-# workpiece are meshed apart.
+# `alpha_shape_mesh` also refuses triangles whose nodes are of two bodies (`body=`): tool and workpiece mesh apart.
 
 # %% [markdown]
 # ## 2. The mixed P1-P1 triangle
@@ -250,8 +246,7 @@ nodes = solid.make_nodes(x, np.ones(12), rng.uniform(293, 900, 12))
 du, p = rng.normal(0, 2e-6, (12, 2)), rng.normal(0, 1e8, 12)
 R_loop = residual_loop(x, mesh.tri, du, p, hist, nodes.T, steel)
 R_pkg = solid.assemble(nodes, mesh, hist, steel, du, p, 1e-6, dynamic=False, tangent=False)[0]
-err_u = np.abs(R_loop - R_pkg)[:24].max() / np.abs(R_pkg[:24]).max()
-err_p = np.abs(R_loop - R_pkg)[24:].max() / np.abs(R_pkg[24:]).max()
+err_u, err_p = (np.abs(R_loop - R_pkg)[k].max() / np.abs(R_pkg[k]).max() for k in (slice(24), slice(24, None)))
 print(f"{len(mesh.tri)} triangles: |plain loop - assemble| / max: {err_u:.1e} (forces), {err_p:.1e} (pressure rows)")
 assert err_u < 1e-12 and err_p < 1e-10
 
@@ -282,43 +277,39 @@ assert patch_u < 1e-12 and patch_p < 1e-11
 # **Near incompressibility.** Plastic flow keeps the volume: $K/G$ is effectively infinite. A linear triangle with
 # displacement only then *locks*: three nodes cannot keep every triangle's area and still bend. Treating $p$ as an
 # unknown removes the locking, but P1-P1 fails the inf-sup condition: pressure modes that the displacement cannot
-# see (a checkerboard) are left free. The test is a plane-strain cantilever, clamped at $x = 0$, a parabolic shear
-# load $P$ at the tip, $\nu = 0.4999$ ($K/G = 5000$): its tip deflection against Timoshenko's, its pressure
-# against the linear bending field $p = \frac{1+\nu}{3}P(L - x)y/I$. Then the same without the stabilisation term
-# (patched out for one call).
+# see (a checkerboard) are left free. The test: a plane-strain cantilever, clamped at $x = 0$, a parabolic shear
+# load $P$ at the tip, $\nu = 0.4999$ ($K/G = 5000$), its tip deflection against Timoshenko's and its pressure
+# against the bending field $p = \frac{1+\nu}{3}P(L - x)y/I$; then without the stabilisation (patched out).
 
 # %%
 from unittest import mock
 
 
-def tip_loaded_beam(ny, L, H, P):
-    """The beam's nodes (ny elements deep), its mesh, the tip nodes and the parabolic tip shear load P [N/m] on
-    them (trapezoid weights)."""
+def tip_loaded_beam(ny, nu, L=10.0, H=1.0, P=5e5):
+    """The beam (ny elements deep, clamped at x = 0, a parabolic shear P [N/m] on its tip, trapezoid weights): nodes,
+    mesh, the node at the middle of the tip, loads, elastic law and Timoshenko's tip deflection."""
     x = grid(int(ny * L / H), ny, 0, L, -H / 2, H / 2)
-    mesh = alpha_shape_mesh(x, None)
     tip = np.isclose(x[:, 0], L)
     w = (1 - 4 * x[tip, 1] ** 2 / H**2) * np.where(np.isclose(np.abs(x[tip, 1]), H / 2), 0.5, 1.0)
     f = np.zeros((len(x), 2))
     f[tip, 1] = -P * w / w.sum()
-    return x, mesh, tip, f
+    loads = solid.Loads(fixed=np.repeat((x[:, 0] == 0)[:, None], 2, axis=1), du_fixed=np.zeros_like(x), f_ext=f)
+    law = solid.SolidLaw(rho0=7800.0, G=E / (2 * (1 + nu)), K=E / (3 * (1 - 2 * nu)), alpha_T=0.0, T_ref=293.0,
+                         strength=Elastic())
+    d_tim = P * L**3 / (3 * E / (1 - nu**2) * H**3 / 12) + P * L / (5 / 6 * law.G * H)
+    return x, alpha_shape_mesh(x, None), np.flatnonzero(tip & (np.abs(x[:, 1]) < 1e-12))[0], loads, law, d_tim
 
 
 def cantilever(ny, nu, stabilised=True, L=10.0, H=1.0, P=5e5):
     """(deflection / Timoshenko, max |p - p_exact| / max |p_exact| away from the ends, x, mesh, p)."""
-    x, mesh, tip, f = tip_loaded_beam(ny, L, H, P)
-    law = solid.SolidLaw(rho0=7800.0, G=E / (2 * (1 + nu)), K=E / (3 * (1 - 2 * nu)), alpha_T=0.0, T_ref=293.0,
-                         strength=Elastic())
-    loads = solid.Loads(fixed=np.repeat((x[:, 0] == 0)[:, None], 2, axis=1), du_fixed=np.zeros_like(x), f_ext=f)
+    x, mesh, mid_tip, loads, law, d_tim = tip_loaded_beam(ny, nu, L, H, P)
     off = (lambda A: 0.0 * ppp_stabilisation(A)) if not stabilised else ppp_stabilisation
     with mock.patch.object(solid, "ppp_stabilisation", off):
         r = solid.newton_step(solid.make_nodes(x, np.ones(len(x)), 293.0), mesh, fresh(mesh), law, 1.0, loads,
                               dynamic=False, max_iter=60)
-    I = H**3 / 12
-    d_tim = P * L**3 / (3 * E / (1 - nu**2) * I) + P * L / (5 / 6 * law.G * H)
-    p_exact = (1 + nu) / 3 * P * (L - x[:, 0]) * x[:, 1] / I
+    p_exact = (1 + nu) / 3 * P * (L - x[:, 0]) * x[:, 1] / (H**3 / 12)
     mid = (x[:, 0] > 1) & (x[:, 0] < L - 1)
-    d = -r.du[tip & (np.abs(x[:, 1]) < 1e-12), 1][0]
-    return d / d_tim, np.abs(r.p - p_exact)[mid].max() / np.abs(p_exact).max(), x, mesh, r.p
+    return -r.du[mid_tip, 1] / d_tim, np.abs(r.p - p_exact)[mid].max() / np.abs(p_exact).max(), x, mesh, r.p
 
 
 levels = (2, 4, 8)
@@ -327,9 +318,12 @@ for ny, (d, e, *_) in runs.items():
     print(f"nu = 0.4999, {ny:2d} elements deep: deflection / Timoshenko {d:.3f}, pressure error {e:.3f}")
 bare = cantilever(4, 0.4999, stabilised=False)
 print(f"without the stabilisation, 4 deep: deflection / Timoshenko {bare[0]:.3f}, pressure error {bare[1]:.2f}")
+nu03 = {stab: cantilever(4, 0.3, stabilised=stab)[:2] for stab in (True, False)}
+print("nu = 0.3, 4 deep, stabilised / bare: deflection / Timoshenko {:.3f} / {:.3f}, pressure error {:.2f} / {:.2f}"
+      .format(nu03[True][0], nu03[False][0], nu03[True][1], nu03[False][1]))
 err = [runs[ny][1] for ny in levels]
 assert runs[levels[-1]][0] > 0.95 and all(e1 < 0.7 * e0 for e0, e1 in zip(err, err[1:]))
-assert bare[0] < runs[4][0] and bare[1] > 1.0
+assert bare[0] < runs[4][0] and bare[1] > 1.0 and nu03[False][1] < 1.5 * nu03[True][1] < 0.5
 
 # %%
 fig, axes = plt.subplots(3, 1, figsize=(10, 4.4), constrained_layout=True, sharex=True)
@@ -347,21 +341,21 @@ ch.show(fig, "12_cantilever_pressure.png", caption="Pressure in the bent cantile
 
 # %% [markdown]
 # With the projection term the nearly incompressible bar converges to Timoshenko's deflection (no locking) and its
-# pressure error falls with each halving of the element (no checkerboard). Without it the deflection is too small
-# (the bar partly locks) and the pressure oscillates from node to node, larger than the true field itself: the
-# pressure block $M_p/K$ is nearly zero, and the modes the displacement cannot see are held by nothing else. At
-# $\nu = 0.3$ the bare element is nearly as good (exercise 2): $M_p/K$ itself holds $p$ when $K$ is not huge.
+# pressure error falls with each halving of the element (no checkerboard). Without it the bar partly locks and the
+# pressure oscillates from node to node, larger than the true field: the pressure block $M_p/K$ is nearly zero, and
+# nothing else holds the modes the displacement cannot see. At $\nu = 0.3$ the bare element is nearly as good,
+# pressure included: $M_p/K$ holds $p$ when $K$ is not huge. The checkerboard belongs to the incompressible limit.
 
 # %% [markdown]
 # ## 4. Newton–Raphson, and a tangent by central differences
 #
 # In time the paper uses the trapezoidal rule (Eq. (21): $\mathbf v_{n+1} = -\mathbf v_n + \frac2{\Delta t}
 # \Delta\mathbf u$, $\mathbf a_{n+1} = -\mathbf a_n - \frac4{\Delta t}\mathbf v_n + \frac4{\Delta t^2}\Delta\mathbf u$;
-# the minus signs are lost in its typesetting) and solves Eqs. (19)–(20), the equations of motion and of the
-# pressure at $t_{n+1}$, together by Newton–Raphson: $K\,\delta = -R$, update, repeat. Its rate depends on $K$ being
-# the derivative of $R$. Our test: plane-strain compression of a 1 mm steel square (the paper's AISI 1045, modified
-# Johnson–Cook, the yield stress at the previous step's strain rate: see below), ten steps to a log strain of 0.2, and
-# in the sixth step two Newton loops written out: with refsph's tangent, and with an elastic solid's.
+# its typesetting lost the minus signs) and solves Eqs. (19)–(20), motion and pressure at $t_{n+1}$, together by
+# Newton–Raphson: $K\,\delta = -R$, update, repeat, at a rate that depends on $K$ being the derivative of $R$. Our
+# test: plane-strain compression of a 1 mm square of the paper's AISI 1045 (modified Johnson–Cook, the previous
+# step's strain rate: see below), ten steps to a log strain of 0.2, and in the sixth step two Newton loops written
+# out: with refsph's tangent, and with an elastic solid's.
 
 # %%
 from dataclasses import replace
@@ -386,8 +380,7 @@ m_nodes = np.bincount(mesh.tri.ravel(), np.repeat(S45["rho"] * A_e / 3, 3), minl
 
 
 def newton(nodes, hist, law, dt, du_fixed, tangent_law, tol=1e-10, max_iter=30):
-    """Eqs. (19)-(20), quasi-static: the scaled residual norm after each Newton iteration, the matrix taken from
-    assemble() with tangent_law (the step's own law: refsph's tangent)."""
+    """Eqs. (19)-(20), quasi-static: the scaled residual norms, the matrix from assemble() with tangent_law."""
     n = nodes.n
     free = np.concatenate([~fixed.ravel(), np.ones(n, bool)])            # every pressure is free
     du, p, norms = np.zeros((n, 2)), nodes.p.copy(), []
@@ -417,13 +410,11 @@ for k in range(10):
         mid_state = (nodes, hist, du_top)
     r = solid.newton_step(nodes, mesh, hist, law45, dt, solid.Loads(fixed=fixed, du_fixed=du_top), dynamic=False)
     nodes, hist = solid.commit(nodes, r, dt, dynamic=False), r.history
-    heat = np.bincount(mesh.tri.ravel(), np.repeat(mjc.chi * r.d_w_p * r.area / 3, 3), minlength=nodes.n)
-    nodes.T = nodes.T + heat / (nodes.m * mjc.cp)                        # adiabatic plastic heating
+    nodes.T = nodes.T + solid.plastic_heat(mesh, r, mjc, nodes.n) / (nodes.m * mjc.cp)   # adiabatic: chi dW_p A / 3
 for name, nr in norms.items():
     print(f"{name:16s} ({len(nr):2d} iterations):", " ".join(f"{v:.1e}" for v in nr[:8]), "..." * (len(nr) > 8))
 print(f"after 10 steps: mean plastic strain {hist.eps_p.mean():.3f}, T up to {nodes.T.max():.0f} K")
-exact = norms["refsph's tangent"]
-slow = norms["elastic tangent"]
+exact, slow = norms["refsph's tangent"], norms["elastic tangent"]
 assert exact[-1] < 1e-10 and len(exact) <= 6 and slow[-1] > 1e-8 and all(b < a for a, b in zip(slow, slow[1:]))
 
 # %%
@@ -436,16 +427,14 @@ ch.show(fig, "12_newton.png", caption="Scaled residual per Newton iteration in o
         "with refsph's tangent, linear with the elastic one.")
 
 # %% [markdown]
-# With refsph's tangent the residual falls as $r_{k+1} \approx C r_k^2$: the digits double each iteration. With
-# the elastic stiffness the iteration still converges, but linearly, by a constant factor per iteration. refsph's
-# tangent is the *exact derivative of the discrete residual*: the pressure columns are linear and written out; the
-# displacement columns are central differences of each element's residual (six perturbations, step $10^{-7}$ of
-# the element size). That is a **stated choice**: the analytic consistent tangent of the Hughes–Winget update with
-# the radial return, the rate and temperature dependence and the geometric stiffness is pages of algebra for each
-# strength law, and a wrong term costs the quadratic rate silently; central differences give it for every law of
-# `refsph.strength` at the price of 12 element evaluations, with the rounding error of a difference,
-# $10^{-16}/10^{-7}$, far below what Newton needs. A check of the assembled matrix against a directional
-# derivative of the whole residual:
+# With refsph's tangent the residual falls as $r_{k+1} \approx C r_k^2$: the digits double each iteration; with the
+# elastic stiffness it falls by a constant factor per iteration. refsph's tangent is the *exact derivative of the
+# discrete residual*: the pressure columns written out, the displacement columns central differences of each
+# element's residual (six perturbations of $10^{-7}$ of the element size). A **stated choice**: the analytic
+# consistent tangent of the Hughes–Winget update with the radial return, the rate and temperature dependence and the
+# geometric stiffness is pages of algebra per strength law, and a wrong term costs the quadratic rate silently;
+# central differences serve every law of `refsph.strength` for 12 element evaluations, with a rounding error
+# ($10^{-16}/10^{-7}$) far below what Newton needs. The assembled matrix against a derivative of the whole residual:
 
 # %%
 nodes5, hist5, du5 = mid_state
@@ -465,8 +454,7 @@ assert dir_err < 1e-5
 # cone point at $\mathbf d = 0$: where a flowing element unloads, $\partial\sigma_y/\partial\mathbf d \sim
 # C\sigma_y/|\mathbf d|$ grows without bound (until the rate falls below $\dot\varepsilon_0$) and Newton stalls.
 # refsph takes the rate of the *previous* step (`History.eps_dot`, filled by `history_from_nodes`), so the step's
-# residual is smooth: a staggered treatment of the rate, one step behind, stated here because the paper does not
-# say what it does.
+# residual is smooth: the rate staggered one step behind, stated here because the paper does not say what it does.
 
 # %% [markdown]
 # ## 5. The heat step (Eq. (22))
@@ -474,8 +462,8 @@ assert dir_err < 1e-5
 # After the mechanics, at fixed configuration, the heat equation (Eq. (14): $\rho c_p\dot T = k\nabla^2T + Q_s$)
 # discretised as Eq. (18) and stepped by backward Euler, Eq. (22):
 # $$C\,\frac{T_{n+1} - T_n}{\Delta t} + K\,T_{n+1} = F_{ext}(T_{n+1}),$$
-# $K_{ab} = \sum_e k A_e\nabla N_a\cdot\nabla N_b$, $C$ lumped ($C_{aa} = \sum_e \rho c_p A_e/3$: it keeps the
-# maximum principle, exercise 4), $F_{ext}$ the plastic heat (Eq. (5), $\chi\,\Delta W_p/\Delta t$ per triangle, a
+# $K_{ab} = \sum_e k A_e\nabla N_a\cdot\nabla N_b$, $C$ lumped ($C_{aa} = \sum_e \rho c_p A_e/3$; why lumped:
+# exercise 3), $F_{ext}$ the plastic heat (Eq. (5), $\chi\,\Delta W_p/\Delta t$ per triangle, a
 # third to each node) minus the losses of Eq. (6). Insulated, it is one linear solve, here dense and by a plain loop:
 
 # %%
@@ -485,8 +473,7 @@ from refsph.thermal import SurfaceLoss
 
 k45, rc45 = S45["k_W_mK"], S45["rho"] * S45["cp_J_kgK"]
 P = thermal.nodal_source(nodes.x, mesh.tri, mjc.chi * r.d_w_p / dt)     # the last step's plastic heat [W/m]
-n = nodes.n
-C_loop, K_loop = np.zeros((n, n)), np.zeros((n, n))
+C_loop, K_loop = np.zeros((nodes.n, nodes.n)), np.zeros((nodes.n, nodes.n))
 for t in mesh.tri:
     g, A = triangle(nodes.x[t])[:2]
     for a in range(3):
@@ -499,9 +486,8 @@ print(f"insulated step: |plain solve - thermal_step| = {np.abs(T_loop - T_pkg).m
 assert np.abs(T_loop - T_pkg).max() < 1e-9
 
 # %% [markdown]
-# With the losses of Eq. (6) on the α-shape's boundary edges (convection and radiation, the paper's $h_c$ and
-# emissivity) and the bottom held at 293 K, the step is nonlinear ($T^4$) and Newton solves it. Its ledger must
-# close: the heat made = stored + lost + removed by the held nodes.
+# With Eq. (6)'s losses (convection and radiation) on the α-shape's boundary edges and the bottom held at 293 K, the
+# step is nonlinear ($T^4$) and Newton solves it. Its ledger must close: heat made = stored + lost + removed.
 
 # %%
 from refsph.paper_data import RLA_SURFACE_LOSS
@@ -520,34 +506,29 @@ print(f"the step's diffusion length sqrt(k dt / rho c_p) = {ell * 1e6:.1f} um, m
 assert abs(ledger.residual) < 1e-12 * ledger.source
 
 # %% [markdown]
-# The adiabatic heating had warmed the bottom row too; holding it at 293 K lets its heat go in the first step
-# (the paper holds its fixed faces at 293 K from the start). In one step heat diffuses far less than a spacing:
-# conduction matters over many steps, and at the scale of the shear zones.
+# The adiabatic heating had warmed the bottom row too; held at 293 K, it lets its heat go in one step (the paper
+# holds its fixed faces at 293 K from the start). Heat diffuses far less than a spacing per step: conduction acts
+# over many steps, at the scale of the shear zones.
 #
 # ## 6. Where it fails, and what is still missing
 #
 # **Remeshing averages the history.** Between remeshings each triangle keeps its own stress, plastic strain and
 # $J$. The new triangles of a remeshing do not match the old, so refsph projects the history to the nodes
-# (area-weighted means) and gives each new triangle the mean of its three nodes. That is a smoothing, applied at
-# every remeshing. Its effect on the simplest case: the elastic cantilever of section 3 ($\nu$ = 0.3, 4 elements
-# deep) under its constant tip load, stepped quasi-statically with nothing changing, remeshed after every step as
-# Algorithm 1 does in the cut, and not remeshed.
+# (area-weighted means) and gives each new triangle the mean of its three nodes: a smoothing, at every remeshing.
+# Its effect on the simplest case: section 3's elastic cantilever ($\nu$ = 0.3, 4 elements deep) under its constant
+# tip load, stepped quasi-statically, remeshed after every step as Algorithm 1 does in the cut, and not remeshed.
 
 # %%
-def held_cantilever(ny, steps, transfer, L=10.0, H=1.0, P=5e5, nu=0.3):
+def held_cantilever(ny, steps, transfer, nu=0.3):
     """Tip deflection / Timoshenko after each of `steps` quasi-static steps under a constant tip load, remeshed
     after every step with the history moved by `transfer` (None: never remeshed), and the peak bending stress
     |s_xx| that each remeshing keeps (a fraction)."""
-    x, mesh, tip, f = tip_loaded_beam(ny, L, H, P)
-    loads = solid.Loads(fixed=np.repeat((x[:, 0] == 0)[:, None], 2, axis=1), du_fixed=np.zeros_like(x), f_ext=f)
-    law = solid.SolidLaw(rho0=7800.0, G=E / (2 * (1 + nu)), K=E / (3 * (1 - 2 * nu)), alpha_T=0.0, T_ref=293.0,
-                         strength=Elastic())
+    x, mesh, mid_tip, loads, law, d_tim = tip_loaded_beam(ny, nu)
     nodes, hist, out, kept = solid.make_nodes(x, np.ones(len(x)), 293.0), fresh(mesh), [], []
-    d_tim = P * L**3 / (3 * E / (1 - nu**2) * H**3 / 12) + P * L / (5 / 6 * law.G * H)
     for _ in range(steps):
         r = solid.newton_step(nodes, mesh, hist, law, 1.0, loads, dynamic=False)
         nodes, hist = solid.commit(nodes, r, 1.0, dynamic=False), r.history
-        out.append(-nodes.x[tip & (np.abs(x[:, 1]) < 1e-12), 1][0] / d_tim)
+        out.append(-nodes.x[mid_tip, 1] / d_tim)
         if transfer is not None:                       # Algorithm 1's remeshing, after every step
             for name in ("S", "S_zz", "eps_p", "W_p", "J"):
                 setattr(nodes, name, solid.project_to_nodes(mesh, r.area, getattr(r.history, name), nodes.n))
@@ -588,15 +569,14 @@ ch.show(fig, "12_remeshing_creep.png", caption="Tip deflection of a held cantile
         "when kept triangles keep theirs.")
 
 # %% [markdown]
-# Under a constant load and with nothing else changing, the bar whose every triangle is averaged **creeps**: each
-# projection lowers the bending stress at the outer fibres (a boundary node's mean is taken from inside the body
-# only), the bar is no longer in equilibrium and bends further. Never remeshed, it does not move after the first
-# step. A transfer that lets a triangle the remeshing kept keep its own history
-# (`refsph.pfem.solid.transfer_history`, what `refsph.pfem.cutting` uses) creeps far less, and stops: the nodes
-# hardly move, but each square of the lattice has four points on one circle, so Delaunay may cut it along either
-# diagonal; the squares whose diagonal flipped are averaged, once, and then the mesh settles. In a cut the
-# triangles that change (around the edge, in the chip) are averaged at every remeshing; how much each averaging
-# costs falls fast with the spacing (exercise 3).
+# Under a constant load the bar whose every triangle is averaged **creeps**: each projection lowers the bending
+# stress at the outer fibres (a boundary node's mean comes from inside the body only), so the bar is out of
+# equilibrium and bends further; never remeshed, it does not move after the first step. Letting a triangle the
+# remeshing kept keep its own history (`solid.transfer_history`, what `refsph.pfem.cutting` uses) creeps far less,
+# and stops: each square of the lattice has four points on one circle, Delaunay may cut it along either diagonal,
+# and the squares whose diagonal flipped are averaged once; then the mesh settles. In a cut the triangles that
+# change (around the edge, in the chip) are averaged at every remeshing; what that costs falls fast with the spacing
+# (exercise 2).
 
 # %%
 from refsph.pfem.cutting import pfem_cut
@@ -608,13 +588,12 @@ print(f"case 1: finest spacing {cut.info['dx'] * 1e6:.0f} um, edge radius {cut.i
 # %% [markdown]
 # **The first tool contact.** `refsph.pfem.cutting` builds the paper's cut (Figure 5: graded nodes, the rounded
 # tool as an exact shape, a penalty contact with Coulomb friction inside the Newton iterations). Newton stalled at
-# the first contact, twice over. The start: the trapezoidal rule's velocities ring at an impact, so the predictor
-# du = dt v drove contact nodes deep into the tool; each step now starts from du = 0, with the contact and slip
-# sets frozen within a solve (`solve_with_active_set`). The size of a correction: the tangent is exact, yet a node
-# on the tool, held by flowing (soft) elements, got a correction of about 12 spacings that a few tenths of one
-# would do, and the line search crawled. `max_move=0.05` scales each correction so that no node moves by more
-# than 0.05 of its local size: the quick cut's first 15 steps took 140 s with 10 halved steps at 0.25, 43 s with
-# one at 0.05; the whole quick cut (case 1, t_u/5, 4 t_u) now runs in about two minutes, heat included.
+# the first contact, twice over. The trapezoidal rule's velocities ring at an impact, so the predictor du = dt v
+# drove contact nodes deep into the tool: each step now starts from du = 0, the contact and slip sets frozen within
+# a solve (`solve_with_active_set`). And a node on the tool, held by soft flowing elements, got an (exact) correction
+# of about 12 spacings where tenths would do: `max_move=0.05` scales each correction so that no node moves more than
+# 0.05 of its local size (the quick cut's first 15 steps: 140 s with 10 halved steps at 0.25, 43 s with one at
+# 0.05). The quick cut (case 1, t_u/5, 4 t_u) runs in about two minutes, heat included.
 #
 # **The cut, side by side.** `refsph run thermal_cutting --method pfem` writes a run folder like an SPH run's
 # (with the triangles); `python benchmarks/thermal_cutting.py --study pfem` runs the 18 cases, too slow for this
@@ -622,21 +601,19 @@ print(f"case 1: finest spacing {cut.info['dx'] * 1e6:.0f} um, edge radius {cut.i
 
 # %%
 import json
-from refsph.teaching.notebook import repository_root
 records = json.loads((repository_root() / "benchmarks" / "thermal_cutting.json").read_text())["runs"]
-print("case     method  Fc [N/mm]  Fp/Fc  T_RF [K]  T_FCS [K]  chip [mm]  nodes  wall [s]")
 for case in (1, 10):
     c = rla_cutting_case(case)
-    for name, key in (("PFEM", f"case {case} pfem n_tu 5"), ("SPH", f"case {case} n_tu 5")):
+    for name, key in (("refsph PFEM", f"case {case} pfem n_tu 5"), ("refsph SPH", f"case {case} n_tu 5")):
         r = records.get(key, {})
-        m = r.get("metrics", {}) if r.get("status") == "ok" else None
-        print(f"{case:4d} {name:>10} " + (f"({r.get('status', 'not recorded')}: {key})" if m is None else
-              f"{m['cutting_force_N_per_m'] / 1e3:10.1f} {m['force_ratio']:6.2f} {m['rake_face_temperature_K']:9.0f} "
-              f"{m['free_chip_surface_temperature_K']:10.0f} {m['chip_thickness_mm']:10.3f} {r['n_particles']:6d} "
-              f"{r['wall_time_s']:9.0f}"))
+        m = r["metrics"] if r.get("status") == "ok" else None
+        print(f"case {case:2d} {name:11s} " + (f"{r.get('status', 'not recorded')} ({key})" if m is None else
+              f"Fc {m['cutting_force_N_per_m'] / 1e3:.0f} N/mm, Fp/Fc {m['force_ratio']:.2f}, T_RF "
+              f"{m['rake_face_temperature_K']:.0f} K, T_FCS {m['free_chip_surface_temperature_K']:.0f} K, chip "
+              f"{m['chip_thickness_mm']:.3f} mm ({r['n_particles']} particles, {r['wall_time_s']:.0f} s)"))
     for name, t in (("measured", "exp"), ("paper PFEM", "pfem")):
-        print(f"{case:4d} {name:>10} {c[f'Fp_{t}_N'] / c[f'Fc_{t}_N']:17.2f} {c[f'TRF_{t}_K']:9.0f} "
-              f"{c[f'TFCS_{t}_K']:10.0f}")
+        print(f"case {case:2d} {name:11s} Fp/Fc {c[f'Fp_{t}_N'] / c[f'Fc_{t}_N']:.2f}, T_RF {c[f'TRF_{t}_K']:.0f} K, "
+              f"T_FCS {c[f'TFCS_{t}_K']:.0f} K")
 
 # %% [markdown]
 # **Where it stands.** Mind chapter 11's scatter (Fc 17 % at t_u/5). The full cut fails at 5 t_u (slivers along
@@ -645,53 +622,48 @@ for case in (1, 10):
 # %% [markdown]
 # ## Your turn
 #
+# Predict first, run, then open *What you should see*. The last exercise asks for code, graded against the package.
+#
 # ### Exercise 1 — The α window
 #
-# Predict: for the point set of section 1, which is the largest α that still keeps the two bodies apart, and the
-# smallest that opens no hole? Sweep α from 0.7 to 2.5 and print `topology(...)` for each.
+# Predict, for section 1's point set: the largest α that still keeps the two bodies apart, and the smallest that
+# opens no hole. Then sweep α from 0.7 to 2.5 and print `topology(...)` for each.
 
 # %% tags=["exercise"]
 for alpha in (0.8, 1.4, 2.0):       # <- sweep more finely
     print(alpha, topology(pts, alpha_shape_mesh(pts, alpha)))
 
 # %% [markdown]
-# What you should see: a window around 1.4, with 2 bodies, no hole and an empty notch; above it the gap is
-# bridged (3 spacings, minus the jitter), below it holes open. Its edges depend on the jitter and on the gap.
+# <details><summary>What you should see</summary>
 #
-# ### Exercise 2 — The stabilisation at ν = 0.3
-#
-# Predict: does the cantilever's pressure checkerboard also appear without the stabilisation at ν = 0.3?
-
-# %% tags=["exercise"]
-NU_EX = 0.4999      # <- change to 0.3
-for stab in (True, False):
-    d, e, *_ = cantilever(4, NU_EX, stabilised=stab)
-    print(f"nu = {NU_EX}, stabilised {stab}: deflection / Timoshenko {d:.3f}, pressure error {e:.3f}")
+# One unbroken window around 1.4 with 2 bodies, no hole and an empty notch, from about 0.9 to 1.55; above it the
+# gap is bridged (3 spacings, less the jitter), below it holes open. Its edges depend on the jitter and on the gap.
+# </details>
 
 # %% [markdown]
-# What you should see: at ν = 0.3 the bare element is nearly as good, pressure included: the $M_p/K$ term holds
-# the pressure when $K$ is comparable to $G$. The checkerboard is a failure of the nearly incompressible solid.
+# ### Exercise 2 — Remeshing creep and the spacing
 #
-# ### Exercise 3 — Remeshing creep and the spacing
-#
-# Predict: with 2, 4 and 8 elements through the depth, how does the creep per remeshing of the plain transfer
-# (`held_cantilever(ny, 4, averaged)`) change? Linearly with the spacing, or faster?
+# Predict: with 2, 4 and 8 elements through the depth, does the creep per remeshing of the plain transfer
+# (`held_cantilever(ny, 4, averaged)`) fall linearly with the spacing, or faster?
 
 # %% tags=["exercise"]
-for ny in (2, 4):                   # <- add 8 (a few seconds)
+for ny in (2, 4):                   # <- add 8 (a second)
     c = held_cantilever(ny, 4, averaged)[0]
     print(f"{ny} deep: deflection / Timoshenko {np.round(c, 3)}, creep per remeshing {np.diff(c).mean():.4f}")
 
 # %% [markdown]
-# What you should see: the creep per remeshing falls faster than the spacing (more than twice for each halving,
-# towards four): the averaging reaches one spacing into the body, and the error it makes there is itself
-# proportional to the spacing. Fine meshes help, but they need more steps, hence more remeshings.
+# <details><summary>What you should see</summary>
 #
-# ### Exercise 4 — Lumped or consistent heat capacity
+# The creep per remeshing falls faster than the spacing, more than twice per halving: the averaging reaches one
+# spacing into the body, and its error there is itself proportional to the spacing. Fine meshes help, but they need
+# more steps, hence more remeshings.
+# </details>
+
+# %% [markdown]
+# ### Exercise 3 — Lumped or consistent heat capacity
 #
-# Hold one node on the edge of a cold (293 K) 1 mm steel square at 1300 K for one short step (`dt` = $10^{-3}\rho
-# c_p h^2/k$) with `thermal.thermal_step(..., fixed=[i], T_fixed=1300.0, lumped=...)`. Predict: which capacity
-# keeps every temperature between 293 and 1300 K?
+# Hold an edge node of a cold (293 K) 1 mm steel square at 1300 K for one short step, `dt` = $10^{-3}\rho c_p h^2/k$
+# (`thermal.thermal_step`). Predict: which heat capacity, lumped or consistent, keeps every T within 293–1300 K?
 
 # %% tags=["exercise"]
 LUMPED = True       # <- and False
@@ -702,5 +674,39 @@ T_ex, _ = thermal.thermal_step(sq, alpha_shape_mesh(sq, None).tri, np.full(len(s
 print(f"lumped {LUMPED}: T from {T_ex.min():.2f} to {T_ex.max():.2f} K")
 
 # %% [markdown]
-# What you should see: the lumped one does (an M-matrix on a Delaunay mesh: a new temperature is a weighted mean
-# of old and fixed ones); the consistent one undershoots next to the hot node, well below 293 K.
+# <details><summary>What you should see</summary>
+#
+# The lumped one does: on a Delaunay mesh it makes an M-matrix, so each new temperature is a weighted mean of old
+# and fixed ones. The consistent one undershoots next to the hot node, far below 293 K.
+# </details>
+
+# %% [markdown]
+# ### Exercise 4 — Write the mixed triangle yourself
+#
+# Section 2's `triangle` takes one triangle, by quadrature. Write all M at once, in closed form, with no loop: from
+# the vertices `xe` (M, 3, 2) return the shape gradients $\nabla N_a$ (M, 3, 2), the signed areas $A$ (M,) (positive
+# counter-clockwise), $\int N_aN_b\,dA$ and $\int(N_a-\frac13)(N_b-\frac13)\,dA$ (each (M, 3, 3)). The grader
+# compares with `shape_gradients`, `pressure_mass` and `ppp_stabilisation`. Predict: which case fails with $|A|$?
+
+# %% tags=["exercise"]
+def my_triangles(xe):
+    """(grad N (M, 3, 2), A (M,), int N_a N_b dA (M, 3, 3), int (N_a - 1/3)(N_b - 1/3) dA (M, 3, 3))."""
+    raise NotImplementedError("write the mixed triangle here")      # <- replace this line by your code
+
+
+from refsph.teaching.grader import case, check
+patch = grid(6, 6, 0, 1e-3, 0, 1e-3) + rng.uniform(-3e-5, 3e-5, (49, 2))
+cases_ex4 = [case(xe[None], label="section 2's triangle"),
+             case(patch[alpha_shape_mesh(patch, None).tri], label="a jittered mesh, 1 mm square"),
+             case(xe[None, ::-1], label="section 2's triangle, clockwise")]
+report = check(my_triangles, lambda xe: (*shape_gradients(xe), pressure_mass(shape_gradients(xe)[1]),
+                                         ppp_stabilisation(shape_gradients(xe)[1])), cases_ex4,
+               names=("grad N", "A", "int N N dA", "int (N - 1/3)(N - 1/3) dA"))
+
+# %% [markdown]
+# <details><summary>What you should see</summary>
+#
+# As handed out: `FAIL ... not written yet`. With $|A|$ the clockwise triangle fails: its gradients change sign,
+# and $\nabla N_a = (y_b - y_c,\ x_c - x_b)/(2A)$ needs the signed area to give them back. Hint: `np.roll` along
+# the vertex axis gives $b$ and $c$ for every $a$ at once; both matrices are $A$ times a fixed 3 × 3 matrix.
+# </details>

@@ -119,12 +119,14 @@ def test_rendering_problems_names_each_kind(tmp_path):
 # --- figures and warnings ---------------------------------------------------------------------------------------
 
 def shown_figures(path: Path):
-    """(line, caption or None) of each figure a chapter shows: ch.show(...) calls and bare plt.show()."""
+    """(line, caption or None) of each figure a chapter shows: ch.show(...) and ch.animate(...) calls and bare
+    plt.show()."""
     out = []
     for node in ast.walk(ast.parse(path.read_text())):
-        if isinstance(node, ast.Call) and isinstance(node.func, ast.Attribute) and node.func.attr == "show":
+        if isinstance(node, ast.Call) and isinstance(node.func, ast.Attribute) and node.func.attr in ("show",
+                                                                                                     "animate"):
             owner = ast.unparse(node.func.value)
-            if owner == "plt":
+            if owner == "plt" and node.func.attr == "show":
                 out.append((node.lineno, None))
             elif owner == "ch":
                 caption = [ast.literal_eval(k.value) for k in node.keywords if k.arg == "caption"]
@@ -217,7 +219,9 @@ def shown_figure_notebook(path: Path) -> Path:
             "x = np.stack(np.meshgrid(np.arange(8), np.arange(8)), -1).reshape(-1, 2)\n"
             "ax.scatter(x[:, 0], x[:, 1], c=x[:, 0])\n"
             "ch.show(fig, caption='A square of 64 particles, coloured by *x*.')\n"
-            "print('printed after the figure')")
+            "print('printed after the figure')\n"
+            "fig, ax = plt.subplots(figsize=(2, 2))\n"
+            "ch.animate(fig, lambda k: ax.plot([0, 1], [0, k]), range(3), caption='A line that turns, in 3 frames.')")
     nb = v4.new_notebook(cells=[v4.new_markdown_cell("# A shown figure"), v4.new_code_cell(code)])
     nbclient.NotebookClient(nb, timeout=120, kernel_name="python3",
                             resources={"metadata": {"path": str(path.parent)}}).execute()
@@ -247,6 +251,7 @@ def test_the_book_renders_from_the_unexecuted_chapters(tmp_path):
     assert (out / "chapters" / "03_tlsph.html").exists()
     page = (out / "chapters" / "99_figure.html").read_text()
     assert "<figcaption>" in page and 'alt="A square of 64 particles, coloured by x."' in page, page
+    assert re.search(r'<img alt="A line that turns, in 3 frames." src="[^"]+\.gif"', page), page   # the animation
     assert "printed after the figure" in page and "A square of 64 particles, coloured by x.</em>" not in page
     assert "MyST-NB skips a cell" not in page                  # the hidden cells' placeholder source
     if runpy.run_path(str(book_folder() / "conf.py")).get("MATHJAX_SOURCE") is None:

@@ -7,12 +7,8 @@ least one exercise is a graded "write it yourself" task (a stub that raises NotI
 :func:`refsph.teaching.grader.check` against the package), and the worked solutions live apart from the student's
 copy, in ``chapters/solutions/NN_name.py`` (one ``### Solution N`` per exercise). The lecturer's copy, the chapter
 with its solutions merged in (:mod:`refsph.teaching.handout`), runs here in quick mode: the handed-out stub fails its
-grader, the worked solution passes it, and every solution's asserts hold, so no solution can rot.
-
-Chapters not converted yet (07 onwards, issue 25) keep an answer key, ``chapters/answers/NN_name.py`` with functions
-answer_1, answer_2, ..., that runs here; the test that they teach is an expected failure (strict: converting a chapter
-makes it pass, and then the chapter must leave the list of answer keys)."""
-import importlib.util
+grader, the worked solution passes it, and every solution's asserts hold, so no solution can rot. Every chapter
+has its worked solutions (the answer keys of the first version, test scripts beside the student's copy, are gone)."""
 import re
 from pathlib import Path
 
@@ -25,22 +21,13 @@ ROOT = Path(__file__).resolve().parent.parent
 CHAPTERS = chapter_files()
 MAX_LINES, MAX_WORDS = 600, 250
 HIDDEN = re.compile(r"<details><summary>What you should see</summary>\n\n.+?\n</details>", re.S)
-TEACHING = [p for p in CHAPTERS if solutions_path(p).exists()]
-ANSWER_KEYS = [p for p in CHAPTERS if not solutions_path(p).exists()]
+TEACHING = CHAPTERS
 
 
 def cells(path: Path):
     """(kind, text, tags) of each cell of a percent-format chapter."""
     jupytext = pytest.importorskip("jupytext")
     return [(c.cell_type, c.source, c.metadata.get("tags", [])) for c in jupytext.read(path).cells]
-
-
-def answers_module(path: Path):
-    key = ROOT / "chapters" / "answers" / path.name
-    spec = importlib.util.spec_from_file_location(f"answers_{path.stem}", key)
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
-    return mod
 
 
 def exercise_sections(path: Path) -> dict:
@@ -73,26 +60,16 @@ def test_chapter_is_a_lesson(path):
     assert "## Your turn" in md, f"{path.name} has no 'Your turn' section"
     n_ex = len(re.findall(r"^### Exercise \d", md, re.M))
     assert 2 <= n_ex <= 4, f"{path.name}: {n_ex} exercises (2-4)"
-    if solutions_path(path).exists():
-        sol = solutions_path(path)
-        numbers = sorted(int(n) for kind, text, _ in cells(sol) if kind == "markdown" for n in SOLUTION.findall(text))
-        assert numbers == list(range(1, n_ex + 1)), f"{sol}: solutions {numbers} for exercises 1-{n_ex}"
-        for kind, text, _ in cells(sol):
-            words = len(re.findall(r"\S+", text))
-            assert kind != "markdown" or words <= MAX_WORDS, f"{sol.name}: a markdown cell of {words} words"
-    else:
-        answers = [n for n in dir(answers_module(path)) if re.fullmatch(r"answer_\d+", n)]
-        assert len(answers) == n_ex, f"{path.name}: {n_ex} exercises but {len(answers)} answers"
+    sol = solutions_path(path)
+    assert sol.exists(), f"{path.name}: no worked solutions in {sol}"
+    numbers = sorted(int(n) for kind, text, _ in cells(sol) if kind == "markdown" for n in SOLUTION.findall(text))
+    assert numbers == list(range(1, n_ex + 1)), f"{sol}: solutions {numbers} for exercises 1-{n_ex}"
+    for kind, text, _ in cells(sol):
+        words = len(re.findall(r"\S+", text))
+        assert kind != "markdown" or words <= MAX_WORDS, f"{sol.name}: a markdown cell of {words} words"
 
 
-def _teaching_param(p):
-    if p in TEACHING:
-        return pytest.param(p, id=p.stem)
-    return pytest.param(p, id=p.stem, marks=pytest.mark.xfail(strict=True, reason="issue 25: still an answer key, "
-                                                                "no hidden results, no graded task"))
-
-
-@pytest.mark.parametrize("path", [_teaching_param(p) for p in CHAPTERS])
+@pytest.mark.parametrize("path", CHAPTERS, ids=[p.stem for p in CHAPTERS])
 def test_exercises_teach(path):
     """Predict -> run -> compare: every exercise's expected result is hidden in a collapsed block after its cell (never
     the next visible text), at least one exercise is a graded stub, and the worked solutions live apart."""
@@ -127,16 +104,6 @@ def test_worked_solutions_run(path, tmp_path):
     solved = "".join(text(c) for c in nb.cells if "solution" in c.metadata.get("tags", []))
     assert stubs and all("FAIL" in text(c) and "not written yet" in text(c) for c in stubs)
     assert solved.count("PASS") >= len(stubs), "each graded task's worked solution passes its grader"
-
-
-@pytest.mark.parametrize("path", ANSWER_KEYS, ids=[p.stem for p in ANSWER_KEYS])
-def test_answer_key_runs(path, monkeypatch, tmp_path):
-    monkeypatch.setenv("REFSPH_QUICK", "1")
-    monkeypatch.setenv("MPLBACKEND", "Agg")
-    monkeypatch.chdir(tmp_path)
-    mod = answers_module(path)
-    for name in sorted(n for n in dir(mod) if re.fullmatch(r"answer_\d+", n)):
-        getattr(mod, name)()                 # each asserts what the student should see
 
 
 FORMULA_FILES = CHAPTERS + [solutions_path(p) for p in TEACHING]

@@ -50,15 +50,14 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 import scipy.sparse as sp
-from scipy.sparse.csgraph import reverse_cuthill_mckee
-from scipy.sparse.linalg import splu
+from scipy.sparse.linalg import spsolve
 
 from .element import ppp_stabilisation, pressure_mass, shape_gradients
 from .mesh import Mesh, signed_areas
 
 __all__ = ["SolidLaw", "Nodes", "History", "Loads", "StepResult", "element_response", "element_residual",
            "volumetric_pressure", "assemble", "newton_step", "commit", "project_to_nodes", "history_from_nodes",
-           "make_nodes", "NewtonFailed", "band_order", "sparse_solve", "transfer_history", "settle_nodes", "Newmark",
+           "make_nodes", "NewtonFailed", "transfer_history", "settle_nodes", "Newmark",
            "TRAPEZOIDAL", "newmark_of"]
 
 
@@ -348,7 +347,6 @@ def newton_step(nodes: Nodes, mesh: Mesh, hist: History, law: SolidLaw, dt: floa
     fix = np.concatenate([fixed.ravel(), ~meshed])
     f_ext = np.zeros(2 * n) if loads.f_ext is None else np.asarray(loads.f_ext, dtype=float).ravel()
     history = []
-    order = None                                                  # the solve's ordering (one mesh: one pattern)
 
     def evaluate(du, p, tangent):
         return _residual(nodes, mesh, hist, law, du, p, dt, dynamic, f_ext, loads.contact, tangent)
@@ -377,8 +375,7 @@ def newton_step(nodes: Nodes, mesh: Mesh, hist: History, law: SolidLaw, dt: floa
             break
         keep = sp.diags((~fix).astype(float))
         Kf = (keep @ Kg @ keep + sp.diags(fix.astype(float))).tocsc()
-        order = band_order(Kf) if order is None else order
-        step = sparse_solve(Kf, -(R_free + keep @ (Kg @ lift)), order) + lift
+        step = spsolve(Kf, -(R_free + keep @ (Kg @ lift))) + lift
         if not np.all(np.isfinite(step)):
             break
         s = 1.0 if max_move is None else min(1.0, max_move / max(float(np.max(
@@ -396,25 +393,6 @@ def newton_step(nodes: Nodes, mesh: Mesh, hist: History, law: SolidLaw, dt: floa
         R, Kg, resp, scale, fc = evaluate(du, p, True)
     raise NewtonFailed(f"Newton-Raphson did not converge in {max_iter} iterations (residuals {history[-3:]})",
                        history, (du, p))
-
-
-def band_order(K) -> np.ndarray:
-    """A reverse Cuthill-McKee ordering of the unknowns of the sparse matrix K (its pattern made symmetric): the
-    three unknowns of a node and those of its neighbours close together, so that the LU factors stay narrow."""
-    return reverse_cuthill_mckee(sp.csr_matrix(abs(K) + abs(K).T), symmetric_mode=True)
-
-
-def sparse_solve(K, b: np.ndarray, order: np.ndarray | None = None) -> np.ndarray:
-    """x = K^{-1} b by a sparse LU (SuperLU, column ordering COLAMD) of K with its rows and columns taken in
-    ``order`` (:func:`band_order`; None: as they come). Reordered first, the PFEM's mixed (u, p) matrices factor
-    about three times faster than as assembled (u of all nodes, then p of all nodes): 8538 unknowns, 0.40 s ->
-    0.14 s (benchmarks/pfem_solver.py)."""
-    if order is None:
-        return splu(sp.csc_matrix(K)).solve(b)
-    Kp = sp.csr_matrix(K)[order][:, order].tocsc()
-    x = np.empty_like(b)
-    x[order] = splu(Kp).solve(b[order])
-    return x
 
 
 def _residual(nodes, mesh, hist, law, du, p, dt, dynamic, f_ext, contact, tangent=True):

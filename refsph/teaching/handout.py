@@ -17,7 +17,6 @@
 Neither overwrites a notebook that is already there (a student's edited copy) unless ``--force``. The tests
 (``tests/test_exercises.py``) execute every lecturer's copy in quick mode (:func:`execute`): the handed-out stub
 fails its grader, the worked solution passes it, and the solutions' asserts hold, so a solution cannot rot.
-Chapters without a solutions file (still with an answer key in ``chapters/answers/``) are handed out as they are.
 """
 from __future__ import annotations
 

@@ -2,6 +2,7 @@
 
     from refsph.teaching.notebook import chapter
     ch = chapter("05_contact")      # ch.quick, ch.show(fig, "name.png", caption="..."), ch.tmp, ch.elapsed()
+                                    # ch.animate(fig, draw, frames, "name.gif", caption="...")
 
 * **Quick mode.** ``REFSPH_QUICK=1`` (the tests, the book) makes every chapter run in under a minute;
   without it a chapter runs at full resolution. ``ch.quick`` says which.
@@ -11,10 +12,17 @@
   ``build/``), so running a chapter never changes the repository. Only ``REFSPH_WRITE_FIGURES=1`` writes the
   committed ``figures/<name>`` instead (do it at full resolution, on purpose). ``REFSPH_FIGURES=DIR`` sends them
   to DIR.
+* **Animations.** ``ch.animate(fig, draw, frames, name, caption="...")`` calls ``draw(frame)`` for each frame,
+  and shows the frames as an animated GIF (no ffmpeg, no JavaScript: it plays in Jupyter, in the book, offline
+  and on a slide), captioned like a figure; with a name it is saved too (``name.gif``, next to the figures).
+  Keep them small: at most :data:`MAX_FRAMES` frames at 80 dpi is a few hundred kB in the book.
 * **Warnings** are shown as ``Category: message``, without the file and line that raised them (a path of the
   machine that ran the chapter, which would otherwise end up in the book).
 * **Scratch space.** ``ch.tmp``: a temporary folder for run output, removed when the kernel exits.
-* **Style.** Figures for slides: larger fonts, the perceptual colour map viridis (:data:`FIELD_CMAP`).
+* **Style.** Figures for slides, by one rule for every chapter (:mod:`refsph.teaching.plots`): at most 10 x 6.5
+  in, every text at least 14 pt at that size (:func:`refsph.teaching.plots.slide_style`, applied here), and the
+  perceptual colour map viridis (:data:`FIELD_CMAP`). Each figure shown records its size and what breaks the
+  rule, if anything, in its output's metadata; the tests read it (``tests/test_figures.py``).
 """
 from __future__ import annotations
 
@@ -29,10 +37,12 @@ import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 
-__all__ = ["Chapter", "chapter", "FIELD_CMAP", "repository_root", "show_figure", "format_warning", "CAPTION_KEY"]
+__all__ = ["Chapter", "chapter", "FIELD_CMAP", "repository_root", "show_figure", "show_animation", "animation_gif",
+           "format_warning", "CAPTION_KEY", "MAX_FRAMES"]
 
 FIELD_CMAP = "viridis"
 CAPTION_KEY = "refsph"        # output metadata {"refsph": {"caption": ...}} of a figure (or {"caption_text": true})
+MAX_FRAMES = 30               # frames of an animation at most: the book stays lean
 
 
 def repository_root() -> Path:
@@ -62,6 +72,19 @@ class Chapter:
             self.save(fig, name, dpi=dpi)
         show_figure(fig, caption)
 
+    def animate(self, fig, draw, frames, name: str | None = None, *, caption: str, fps: float = 6,
+                dpi: int = 80) -> None:
+        """Show an animation with its caption: ``draw(frame)`` updates ``fig`` for each item of ``frames`` (at most
+        :data:`MAX_FRAMES`), and the frames are shown as an animated GIF (:func:`animation_gif`), saved first as
+        ``name`` (a ``.gif``) when one is given. The caption says what moves, in plain text, as a figure's does
+        (:meth:`show`); the figure is closed afterwards."""
+        if not " ".join(caption.split()):
+            raise ValueError("an animation needs a caption: a sentence or two saying what moves")
+        gif = animation_gif(fig, draw, frames, fps=fps, dpi=dpi)
+        if name is not None:
+            (self.figures / name).write_bytes(gif)
+        show_animation(gif, caption, fig)
+
     def elapsed(self) -> float:
         """Seconds since the chapter started."""
         return time.perf_counter() - self.started
@@ -79,7 +102,6 @@ def show_figure(fig, caption: str) -> None:
         raise ValueError("a figure needs a caption: a sentence or two saying what it shows")
     try:
         from IPython import get_ipython
-        from IPython.display import display
     except ImportError:
         get_ipython = None
     if get_ipython is None or get_ipython() is None:
@@ -89,12 +111,87 @@ def show_figure(fig, caption: str) -> None:
         return
     buf = io.BytesIO()
     fig.savefig(buf, format="png", bbox_inches="tight")       # what the inline backend would show
+    slide = _slide_check(fig)
     plt.close(fig)
-    png = base64.b64encode(buf.getvalue()).decode("ascii")
-    display({"image/png": png, "text/plain": f"<Figure: {caption}>"}, raw=True,
-            metadata={CAPTION_KEY: {"caption": caption}})
+    _display("image/png", buf.getvalue(), caption, slide)
+
+
+def _slide_check(fig) -> dict:
+    """The figure's size as saved and its size-rule problems (:func:`refsph.teaching.plots.slide_problems`), for the
+    output's metadata (the tests read it)."""
+    from .plots import slide_problems
+
+    box = fig.get_tightbbox(fig.canvas.get_renderer())
+    return {"width_in": round(box.width, 2), "height_in": round(box.height, 2), "problems": slide_problems(fig)}
+
+
+def _display(mime: str, data: bytes, caption: str, slide: dict) -> None:
+    """An image output carrying the caption (and the slide check) in its metadata, then the caption in italics."""
+    from IPython.display import display
+
+    kind = "Animation" if mime == "image/gif" else "Figure"
+    display({mime: base64.b64encode(data).decode("ascii"), "text/plain": f"<{kind}: {caption}>"}, raw=True,
+            metadata={CAPTION_KEY: {"caption": caption, "slide": slide}})
     display({"text/markdown": f"*{caption}*", "text/plain": caption}, raw=True,
             metadata={CAPTION_KEY: {"caption_text": True}})
+
+
+def animation_gif(fig, draw, frames, *, fps: float = 6, dpi: int = 80) -> bytes:
+    """An animated GIF of ``fig``: ``draw(frame)`` is called for each item of ``frames`` (at most
+    :data:`MAX_FRAMES`) and the figure is rendered at ``dpi`` on the same canvas each time (not cropped, so the
+    frames line up). One palette of 128 colours for all frames, no dithering: flat plots stay flat and small.
+    The GIF loops, ``fps`` frames a second; returns its bytes."""
+    from PIL import Image
+
+    frames = list(frames)
+    if not 2 <= len(frames) <= MAX_FRAMES:
+        raise ValueError(f"an animation needs 2 to {MAX_FRAMES} frames (the book stays lean), got {len(frames)}")
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    canvas = fig.canvas if hasattr(fig.canvas, "buffer_rgba") else FigureCanvasAgg(fig)      # Agg (and inline)
+    images, dpi0 = [], fig.dpi
+    fig.set_dpi(dpi)                                            # the whole canvas, drawn: the frames line up
+    try:
+        for frame in frames:
+            draw(frame)
+            canvas.draw()
+            images.append(Image.frombuffer("RGBA", canvas.get_width_height(), canvas.buffer_rgba()).convert("RGB"))
+    finally:
+        fig.set_dpi(dpi0)
+    w, h = images[0].size
+    some = images[::-(-len(images) // 6)] + images[-1:]         # one palette for all, from up to 7 of the frames
+    sheet = Image.new("RGB", (w, h * len(some)))
+    for k, im in enumerate(some):
+        sheet.paste(im, (0, k * h))
+    palette = sheet.quantize(colors=128, method=Image.Quantize.MEDIANCUT)
+    frames_p = [im.quantize(palette=palette, dither=Image.Dither.NONE) for im in images]
+    out = io.BytesIO()
+    frames_p[0].save(out, format="GIF", save_all=True, append_images=frames_p[1:], duration=round(1000 / fps),
+                     loop=0, optimize=True)
+    return out.getvalue()
+
+
+def show_animation(gif: bytes, caption: str, fig=None) -> None:
+    """Display an animated GIF with its caption, as :func:`show_figure` does a figure (the book makes it a captioned
+    figure with alt text); ``fig``, the figure it was drawn from, is checked against the size rule and closed."""
+    import matplotlib.pyplot as plt
+
+    caption = " ".join(caption.split())
+    if not caption:
+        raise ValueError("an animation needs a caption: a sentence or two saying what moves")
+    slide = {}
+    if fig is not None:
+        fig.canvas.draw()                                       # laid out at its own dpi, as a figure is shown
+        slide = _slide_check(fig)
+        plt.close(fig)
+    try:
+        from IPython import get_ipython
+    except ImportError:
+        get_ipython = None
+    if get_ipython is None or get_ipython() is None:
+        print(f"Animation ({len(gif) / 1e3:.0f} kB): {caption}")
+        return
+    _display("image/gif", gif, caption, slide)
 
 
 def format_warning(message, category, filename, lineno, line=None) -> str:
@@ -112,10 +209,12 @@ def _shown(path: Path, root: Path) -> str:
 
 
 def _style() -> None:
+    """Figures for slides (the size rule of :mod:`refsph.teaching.plots`) and the colour map of fields."""
     import matplotlib as mpl
-    mpl.rcParams.update({"font.size": 11, "axes.titlesize": 11, "axes.labelsize": 11, "xtick.labelsize": 10,
-                         "ytick.labelsize": 10, "legend.fontsize": 9, "image.cmap": FIELD_CMAP,
-                         "figure.dpi": 100})
+
+    from .plots import slide_style
+
+    mpl.rcParams.update(dict(slide_style(), **{"image.cmap": FIELD_CMAP}))
 
 
 def chapter(name: str) -> Chapter:

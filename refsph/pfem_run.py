@@ -197,7 +197,7 @@ def _summary(scene_name: str, run: CutRun, res: dict, kwargs: dict, args: dict, 
                    scene_info=dict(cut.info), heat_balance=res["heat_balance"],
                    newton=dict(iterations=int(it.sum()), max_per_step=int(it.max()) if len(it) else 0,
                                halved_steps=run.retries, remeshes=run.remeshes, max_move=cut.max_move,
-                               max_iter=cut.max_iter),
+                               max_iter=cut.max_iter, nodes_inserted=run.inserted, nodes_removed=run.removed),
                    options=kwargs, run_args=args, wall_time_s=run.wall, snapshots=snapshots,
                    particle_steps_per_s=run.nodes.n * run.steps / run.wall if run.wall > 0 else 0.0,
                    reaction_forces_file="reaction_forces.csv", provenance=provenance(1))

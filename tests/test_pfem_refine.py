@@ -7,7 +7,8 @@ import pytest
 
 from refsph.pfem import solid
 from refsph.pfem.mesh import alpha_shape_mesh
-from refsph.pfem.refine import NodeRule, refine_nodes, renumber_mesh, tributary_areas
+from refsph.pfem.mesh import tributary_areas
+from refsph.pfem.refine import NodeRule, refine_nodes, renumber_mesh
 
 RHO, DX = 7800.0, 1e-4
 

@@ -56,7 +56,7 @@ from ..scenes.thermal_cutting import (CLEARANCE_DEG, EDGE_RADIUS, RAKE_DEG, chip
                                       tool_particles, tool_shape)
 from ..thermal import SurfaceLoss
 from .contact import StepContact, ToolContact, boundary_lengths, solve_with_active_set
-from .mesh import Mesh, alpha_shape_mesh, remesh_needed, signed_areas
+from .mesh import Mesh, alpha_shape_mesh, remesh_needed, tributary_areas
 from .refine import NodeRule, refine_nodes, renumber_mesh
 from .solid import (TRAPEZOIDAL, History, Loads, Newmark, NewtonFailed, Nodes, SolidLaw, commit, history_from_nodes,
                     make_nodes, plastic_heat, settle_nodes, transfer_history)
@@ -186,8 +186,7 @@ def pfem_cut(case: int, n_tu: float = 10.0, travel: float = 16.0, length: float 
     if conduction:
         tool = TOOL_CARBIDE_RLA
         tmesh = alpha_shape_mesh(xt, 1.4, np.full(len(xt), dx))
-        area = np.repeat(np.abs(signed_areas(xt, tmesh.tri)) / 3.0, 3)
-        tool_mc = tool["rho"] * tool["cp_J_kgK"] * np.bincount(tmesh.tri.ravel(), area, minlength=len(xt))
+        tool_mc = tool["rho"] * tool["cp_J_kgK"] * tributary_areas(xt, tmesh.tri, len(xt))
         k_w, k_t = mat["k_W_mK"], tool["k_W_mK"]
         heat = CutHeat(k_work=k_w, cp_work=mat["cp_J_kgK"], x_tool=xt, tool_tri=tmesh.tri, k_tool=k_t,
                        tool_mc=tool_mc, tool_fixed=np.flatnonzero(tool_held),

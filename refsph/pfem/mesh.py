@@ -31,7 +31,7 @@ from scipy.spatial import Delaunay, cKDTree
 from ..surface import circumradius
 
 __all__ = ["Mesh", "nodal_spacing", "alpha_shape_mesh", "boundary_edges", "signed_areas", "triangle_quality",
-           "topology", "remesh_needed"]
+           "topology", "remesh_needed", "tributary_areas"]
 
 
 @dataclass
@@ -57,6 +57,11 @@ def signed_areas(x: np.ndarray, tri: np.ndarray) -> np.ndarray:
     """A_e = ((x_1 - x_0) x (x_2 - x_0)) / 2: positive for a counter-clockwise triangle."""
     a, b, c = x[tri[:, 0]], x[tri[:, 1]], x[tri[:, 2]]
     return 0.5 * ((b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (b[:, 1] - a[:, 1]) * (c[:, 0] - a[:, 0]))
+
+
+def tributary_areas(x: np.ndarray, tri: np.ndarray, n: int) -> np.ndarray:
+    """a_k: a third of the area of each triangle of node k (the lumped mass of a node is rho a_k)."""
+    return np.bincount(tri.ravel(), np.repeat(np.abs(signed_areas(x, tri)) / 3.0, 3), minlength=n)
 
 
 def nodal_spacing(x: np.ndarray) -> np.ndarray:

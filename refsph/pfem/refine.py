@@ -31,11 +31,10 @@ from dataclasses import dataclass, replace
 import numpy as np
 from scipy.spatial import cKDTree
 
-from .mesh import Mesh, signed_areas
+from .mesh import Mesh, signed_areas, tributary_areas
 from .solid import History, Nodes
 
-__all__ = ["NodeRule", "NodeChange", "refine_nodes", "renumber_mesh", "close_pairs", "pick_merges", "pick_insertions",
-           "tributary_areas"]
+__all__ = ["NodeRule", "NodeChange", "refine_nodes", "renumber_mesh", "close_pairs", "pick_merges", "pick_insertions"]
 
 NODAL = ("S", "S_zz", "eps_p", "W_p", "J", "p", "a", "eps_dot")     # mass-weighted in a merge
 ELEMENT = ("S", "S_zz", "eps_p", "W_p", "J", "eps_dot")              # an inserted node takes its triangle's
@@ -108,11 +107,6 @@ def pick_insertions(nodes: Nodes, mesh: Mesh, h: np.ndarray, used: np.ndarray, a
     a = tributary_areas(nodes.x, mesh.tri, nodes.n)
     rho = np.where(a > 0, nodes.m / np.where(a > 0, a, 1.0), 0.0)
     return ins, rho[mesh.tri[ins]] * (A[ins] / 9.0)[:, None]
-
-
-def tributary_areas(x: np.ndarray, tri: np.ndarray, n: int) -> np.ndarray:
-    """a_k: a third of the area of each triangle of node k."""
-    return np.bincount(tri.ravel(), np.repeat(np.abs(signed_areas(x, tri)) / 3.0, 3), minlength=n)
 
 
 def refine_nodes(nodes: Nodes, mesh: Mesh, hist: History, h: np.ndarray, fixed: np.ndarray, rule: NodeRule,

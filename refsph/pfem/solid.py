@@ -57,8 +57,8 @@ from .mesh import Mesh, signed_areas
 
 __all__ = ["SolidLaw", "Nodes", "History", "Loads", "StepResult", "element_response", "element_residual",
            "volumetric_pressure", "assemble", "newton_step", "commit", "project_to_nodes", "history_from_nodes",
-           "make_nodes", "NewtonFailed", "transfer_history", "settle_nodes", "Newmark",
-           "TRAPEZOIDAL", "newmark_of"]
+           "make_nodes", "NewtonFailed", "transfer_history", "settle_nodes", "Newmark", "TRAPEZOIDAL",
+           "newmark_of"]
 
 
 class NewtonFailed(RuntimeError):

@@ -4,6 +4,7 @@ J2 compression against the rigid-plastic curve, the cantilever's period, and a r
 momentum exactly."""
 import numpy as np
 import pytest
+import scipy.sparse as sp
 
 from refsph.pfem import solid
 from refsph.pfem.element import ppp_stabilisation, pressure_mass, shape_gradients
@@ -313,3 +314,16 @@ def test_graded_workpiece_is_held_along_its_bottom_and_left(n_tu):
     held = cut.fixed.all(axis=1)
     assert np.all(held[cut.nodes.x[:, 1] == 0.0]) and np.all(held[cut.nodes.x[:, 0] == 0.0])
     assert held[cut.nodes.x[:, 1] == 0.0].sum() > 10
+
+
+def test_solve_linear_fast_path_and_fallback():
+    """solve_linear: the diagonal-pivot SuperLU path solves a PFEM-like matrix; a matrix whose diagonal vanishes
+    (where diagonal pivots fail) falls back to partial pivoting and is still solved."""
+    rng = np.random.default_rng(3)
+    n = 60
+    B = sp.random(n, n, density=0.05, random_state=4) + sp.diags(np.full(n, 4.0))
+    A = (B + B.T).tocsc()
+    b = rng.normal(size=n)
+    assert np.allclose(A @ solid.solve_linear(A, b), b, rtol=0, atol=1e-10 * np.linalg.norm(b))
+    P = sp.csc_matrix(np.array([[0.0, 2.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 3.0]]))
+    assert np.allclose(solid.solve_linear(P, np.array([4.0, 1.0, 6.0])), [1.0, 2.0, 2.0])

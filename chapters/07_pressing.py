@@ -122,7 +122,7 @@ for dp in PRESSING_RESOLUTIONS_M:
 # %%
 st0 = scene.setup(2, DP, True)
 n_b, x0 = st0.info["n_block"], st0.state.x
-fig, ax = plt.subplots(figsize=(8, 4.2), constrained_layout=True)
+fig, ax = plt.subplots(figsize=(8, 5), constrained_layout=True)
 ms = 5 if ch.quick else 1.2
 ax.plot(1e3 * x0[:n_b, 0], 1e3 * x0[:n_b, 1], ".", ms=ms, color="0.6", label="block (AISI 4340)")
 ax.plot(*(1e3 * x0[st0.clamps[0].index].T), "s", ms=ms, color="k", label="clamped column")
@@ -131,7 +131,7 @@ ax.plot(1e3 * x0[n_b:, 0], 1e3 * x0[n_b:, 1], ".", ms=ms, color="C1", label="rig
 ax.annotate("200 m/s", xy=(1.15, 0.25), xytext=(1.3, 0.25), arrowprops=dict(arrowstyle="->", lw=2), va="center")
 ax.set(aspect="equal", xlim=(-0.05, 1.5), ylim=(-0.15, 0.65), xlabel="x [mm]", ylabel="y [mm]",
        title=f"The pressing test (cf. the paper's Fig. 6), dp = {1e3 * DP:.4f} mm")
-ax.legend(loc="upper left", ncol=2, fontsize=8)
+ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.17), ncol=2)
 ch.show(fig, "07_pressing_setup.png", caption="The pressing test: the AISI 4340 block (grey) with its clamped column "
                                               "(black) and the row of particles at mid-height (green), and the rigid "
                                               "tool (orange).")
@@ -319,7 +319,7 @@ def running_mean(t, f, width):
 
 
 assert abs(yield_plain(0.3, 2e5, 600.0) / float(yield_stress(jc, 0.3, 2e5, 600.0)) - 1) < 1e-14
-fig, ax = plt.subplots(figsize=(9, 4.2), constrained_layout=True)
+fig, ax = plt.subplots(figsize=(9, 5.6), constrained_layout=True)
 for m, r in res.items():
     rh = r.history["reaction"]
     t, f_tool, f_clamp = np.asarray(rh["t"]), np.asarray(rh["tool"])[:, 0], -np.asarray(rh["left_side"])[:, 0]
@@ -339,7 +339,7 @@ ax.axvline(1e9 * LX / c_L, color="0.6", lw=0.8)
 ax.text(1e9 * LX / c_L + 5, 2.5, "$L / c_L$", color="0.4")
 ax.set(xlabel="t [ns]", ylabel="force [MN/m]", title="Forces of the block on tool and clamp (25 ns running mean)")
 ax.grid(alpha=0.3)
-ax.legend(fontsize=8, ncol=2)
+ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.17), ncol=2)
 ch.show(fig, "07_pressing_forces.png", caption="The forces of the block on the tool (solid) and on the clamp (dashed) "
                                                "with ESPH and TLSPH, as 25 ns running means, and the elastic-plastic "
                                                "impact estimate (dotted).")

@@ -132,13 +132,14 @@ fig, ax = plt.subplots(figsize=(10, 4), constrained_layout=True)
 sc = particle_field(ax, st0.state.x, kind, DP, body=st0.state.body, xlim=(-0.05, 4.0), ylim=(-0.05, 1.85),
                     cmap=plt.matplotlib.colors.ListedColormap(["0.8", "C1", "k"]), vmin=-0.5, vmax=2.5,
                     rigid_color="C0")
-ax.annotate(f"tool, {V_TOOL:.0f} m/s", xy=(3.55, 1.5), xytext=(3.6, 1.75), fontsize=10)
-ax.annotate("", xy=(3.1, 1.3), xytext=(3.5, 1.3), arrowprops=dict(arrowstyle="->", lw=2))
+ax.annotate("tool", xy=(3.55, 1.5), xytext=(3.55, 1.55))
+ax.annotate(f"{V_TOOL:.0f} m/s", xy=(3.1, 1.3), xytext=(3.55, 1.3), va="center",
+            arrowprops=dict(arrowstyle="->", lw=2))
 cb = colorbar(fig, sc, ax, "particle", ticks=[0, 1, 2])
 cb.ax.set_yticklabels(["workpiece", "cut layer", "held"])
 ax.set(xlabel="x [mm]", ylabel="y [mm]", title=f"Set-up, feed {1e3 * FEEDS[0]:.1f} mm, dp = {1e3 * DP:.3f} mm")
 ch.show(fig, "08_setup.png", caption="The cutting set-up at this chapter's coarse spacing: the workpiece, the layer "
-                                     "to be cut and the held particles, and the tool (grey).")
+                                     "to be cut and the held particles, and the tool (blue).")
 
 # %% [markdown]
 # ## The measurements
@@ -349,27 +350,58 @@ for m, r in res.items():
 
 # %%
 XLIM, YLIM = ((1.9, 3.3), (0.3, 1.55)) if ch.quick else ((1.3, 3.6), (0.25, 2.15))
-fig, axs = plt.subplots(2, 2, figsize=(10, 8), constrained_layout=True)
-T_hi = max(r.state.T.max() for r in res.values())
-for col, (m, r) in enumerate(res.items()):
-    s = r.state
-    a = particle_field(axs[0, col], s.x, s.eps_p, DP, body=s.body, xlim=XLIM, ylim=YLIM, vmin=0, vmax=2.0)
-    b = particle_field(axs[1, col], s.x, s.T, DP, body=s.body, xlim=XLIM, ylim=YLIM, cmap="inferno",
-                       vmin=r.setup.strength.T_room, vmax=T_hi)
-    for ax in axs[:, col]:
-        ax.set(title=f"{m.upper()}, {1e3 * V_TOOL * s.t:.2f} mm of cut", xlabel="x [mm]", ylabel="y [mm]")
-colorbar(fig, a, axs[0, 1], "plastic strain [-] (scale cut at 2)", extend="max")
-colorbar(fig, b, axs[1, 1], "temperature [K]")
-ch.show(fig, "08_chip_end.png", caption="The chip at the end of the cut, ESPH (left) and TLSPH (right): effective "
-                                        "plastic strain (top) and temperature (bottom); the tool's surface layers in "
-                                        "grey.")
+T_hi, T_r = max(r.state.T.max() for r in res.values()), res["esph"].setup.strength.T_room
+for key, label, scale in (("eps_p", "plastic strain [-] (cut at 2)", dict(vmin=0, vmax=2.0)),
+                          ("T", "temperature [K]", dict(cmap="inferno", vmin=T_r, vmax=T_hi))):
+    fig, axs = plt.subplots(1, 2, figsize=(10, 4.6), sharey=True)
+    fig.subplots_adjust(left=0.08, right=0.84, bottom=0.14, top=0.92, wspace=0.06)   # fixed: marker sizes
+    for ax, (m, r) in zip(axs, res.items()):
+        pc = particle_field(ax, r.state.x, getattr(r.state, key), DP, body=r.state.body, xlim=XLIM, ylim=YLIM,
+                            **scale)
+        ax.set(title=f"{m.upper()}, {1e3 * V_TOOL * r.state.t:.2f} mm of cut", xlabel="x [mm]")
+    axs[0].set_ylabel("y [mm]")
+    colorbar(fig, pc, list(axs), label, extend="max" if key == "eps_p" else "neither", fraction=0.05, pad=0.03)
+    ch.show(fig, f"08_chip_end_{key}.png", caption=f"The chip at the end of the cut, TLSPH (left) and ESPH (right), "
+            f"coloured by {'effective plastic strain' if key == 'eps_p' else 'temperature'}; the tool's surface "
+            "layers in grey.")
 
 # %% [markdown]
 # The plastic strain gathers in a **primary shear zone** running from the cutting edge up to the free surface
 # ahead of the tool, and the cut layer above it turns up along the tool's face: a chip. The temperature follows
 # the plastic work. The highest strain and temperature sit in a few particles pressed against the face next to the
-# edge (see "Where it fails").
-#
+# edge (see "Where it fails"). The whole cut, from the run's snapshots (an eighth of the cut a frame):
+
+# %%
+from refsph.io import load_snapshot
+
+snaps = {m: [load_snapshot(ch.tmp / f"{m}-{1e3 * FEEDS[0]:g}" / "snapshots" / f) for f in r.summary["snapshots"]]
+         for m, r in res.items()}
+fig, axs = plt.subplots(1, 2, figsize=(10, 4.8), sharey=True)
+fig.subplots_adjust(left=0.08, right=0.84, bottom=0.14, top=0.86, wspace=0.06)       # fixed: marker sizes
+work = st0.state.body == 0
+dots = [particle_field(ax, snaps[m][0]["x"], snaps[m][0]["eps_p"], DP, body=st0.state.body, xlim=XLIM, ylim=YLIM,
+                       vmin=0, vmax=2.0, fill=None) for ax, m in zip(axs, res)]
+for ax, m in zip(axs, res):
+    ax.set(title=m.upper(), xlabel="x [mm]")
+axs[0].set_ylabel("y [mm]")
+colorbar(fig, dots[0], list(axs), "plastic strain [-] (cut at 2)", extend="max", fraction=0.05, pad=0.03)
+
+
+def draw(k):
+    for ax, dot, m in zip(axs, dots, res):
+        x, e = 1e3 * snaps[m][k]["x"], snaps[m][k]["eps_p"][work]
+        ax.collections[0].set_offsets(x[~work])                                     # the tool
+        dot.set_offsets(x[work][np.argsort(e, kind="stable")])
+        dot.set_array(np.sort(e, kind="stable"))
+    fig.suptitle(f"{1e3 * V_TOOL * snaps['esph'][k]['t']:.2f} mm of cut")
+
+
+ch.animate(fig, draw, range(len(snaps["esph"])), "08_cut.gif", fps=3,
+           caption="The cut at this chapter's spacing, TLSPH (left) and ESPH (right), coloured by effective plastic "
+                   "strain: the tool (grey) moves left, the shear zone forms at its edge and the cut layer turns up "
+                   "its face into a chip.")
+
+# %% [markdown]
 # ### The force on the tool
 #
 # The force history, the plain mean against the package's, and a conservation check: the workpiece's change of
@@ -377,7 +409,8 @@ ch.show(fig, "08_chip_end.png", caption="The chip at the end of the cut, ESPH (l
 # runs of the benchmark (from `benchmarks/cutting.json`).
 
 # %%
-fig, axs = plt.subplots(1, 2, figsize=(12, 4), constrained_layout=True, sharey=True)
+fig, axs = plt.subplots(1, 2, figsize=(10, 5.4), sharey=True)
+fig.subplots_adjust(left=0.1, right=0.98, bottom=0.31, top=0.93, wspace=0.12)
 for m, r in res.items():
     mt, rh, n = r.summary["metrics"], r.history["reaction"], r.setup.info["n_work"]
     t, dt, F = np.asarray(rh["t"]), np.asarray(rh["dt"]), np.asarray(rh["tool"])
@@ -403,7 +436,7 @@ for ax, label in zip(axs, ("cutting force $F_c$", "thrust force $F_t$")):
     ax.set(xlabel="cut length [mm]", title=label, xlim=(0, 1.0))
     ax.grid(alpha=0.3)
 axs[0].set_ylabel("force on the tool [MN/m]")
-axs[1].legend(fontsize=8)
+fig.legend(*axs[0].get_legend_handles_labels(), loc="lower center", ncol=2)
 ch.show(fig, "08_forces.png", caption="Cutting force (left) and thrust force (right) on the tool against the cut "
                                       "length, ESPH and TLSPH at this chapter's spacing and (dashed) the benchmark's "
                                       "runs at the paper's resolution.")
@@ -447,7 +480,7 @@ for m, r in res.items():
 # same profile of the paper-resolution run:
 
 # %%
-fig, axs = plt.subplots(1, 2, figsize=(12, 4), constrained_layout=True)
+fig, axs = plt.subplots(1, 2, figsize=(10, 4.6), constrained_layout=True)
 for ax, (m, r) in zip(axs, res.items()):
     info, s1 = r.setup.info, r.state
     args = (*lattice_shape(info), info["dx"], info["dy"], info["feed_m"], float(s1.x[info["n_work"]:, 0].min())
@@ -467,10 +500,10 @@ for ax, (m, r) in zip(axs, res.items()):
     ax.plot(prof[:, 0], prof[:, 1], "o-", color="0.3", ms=4,
             label=f"dp = {1e3 * DP:.3f} mm: {r.summary['metrics']['n_shear_bands']} bands")
     ax.set(xlabel="initial x of the material [mm]", ylabel="plastic strain, middle row [-]", title=m.upper(),
-           ylim=(0, 1.25 * q[q[:, 0] < q[-1, 0] - 0.05, 1].max()))
-    ax.legend(fontsize=8)
+           ylim=(0, 1.5 * q[q[:, 0] < q[-1, 0] - 0.05, 1].max()))
+    ax.legend(loc="upper left")
 ch.show(fig, "08_band_profiles.png", caption="Plastic strain along the chip's middle row against the material's "
-                                             "initial x, ESPH (left) and TLSPH (right): the bands of the "
+                                             "initial x, TLSPH (left) and ESPH (right): the bands of the "
                                              "paper-resolution run against the broad humps at this chapter's spacing.")
 
 # %% [markdown]

@@ -91,28 +91,113 @@ for method, numerics in (("esph", {}), ("esph", dict(esph_correction=True))):
 # continuum to the SPH sums. We run each method with its remedy off and on (45 µs: the impact and the rebound):
 
 # %%
+import dataclasses
+from scipy.spatial import cKDTree
+from refsph.scenes import get_scene
+from refsph.simulate import simulate
+from refsph.teaching.plots import colorbar
+
+
+def with_frames(scene, method, numerics, t_end, n=12):
+    """A quick run that keeps n + 1 frames of the positions (for the figures and the animation), kept in `done` as
+    quick(...) keeps its runs: the exercises reuse it."""
+    setup, frames = get_scene(scene).setup(2, None, True), []
+    setup.numerics, setup.t_end = dataclasses.replace(setup.numerics, threads=1, **numerics), t_end
+
+    def keep(state, solver):
+        if state.t >= len(frames) * t_end / n:
+            frames.append((state.t, state.x.copy()))
+    res = simulate(setup, method, scene=get_scene(scene), hook=keep, progress=False)
+    run_ = done[repr((scene, method, sorted(numerics.items()), [("t_end", t_end)]))] = (
+        res.summary["metrics"], res.summary["wall_time_s"], res)
+    return (*run_, frames)
+
+
+def nearest_in_ring(x, body, dp):
+    """Each particle's distance to the nearest particle of its own ring, / dp."""
+    near = np.empty(len(x))
+    for b in np.unique(body):
+        near[body == b] = cKDTree(x[body == b]).query(x[body == b], k=2)[0][:, 1] / dp
+    return near
+
+
 ring_runs = {"TLSPH, no hourglass control": ("tlsph", dict(hourglass=0.0)),
              "TLSPH, hourglass = 1": ("tlsph", dict(hourglass=1.0)),
-             "ESPH, gamma = 0": ("esph", dict(gamma=0.0)),
-             "ESPH, gamma = 0.3": ("esph", dict(gamma=0.3))}
-rings = {name: quick("rings", method, numerics, t_end=45e-6) for name, (method, numerics) in ring_runs.items()}
-fig, axes = plt.subplots(2, 2, figsize=(10, 6.2), constrained_layout=True)
-xy = np.concatenate([res.state.x for _, _, res in rings.values()]) * 1e3
-lims = [(lo - 0.5, hi + 0.5) for lo, hi in zip(xy.min(axis=0), xy.max(axis=0))]     # one scale for all four [mm]
-for ax, (name, (m, wall, res)) in zip(axes.flat, rings.items()):
+             "ESPH, gamma = 0": ("esph", dict(gamma=0.0)), "ESPH, gamma = 0.3": ("esph", dict(gamma=0.3))}
+rings = {}
+for name, (method, numerics) in ring_runs.items():
+    m, wall, res, frames = rings[name] = with_frames("rings", method, numerics, 45e-6)
     print(f"{name:28s}: {m['n_fragments']} pieces, restitution {m['restitution']:.2f}, closest pair "
           f"{m['min_pair_distance_over_dp']:.3f} dp, closest rings {m['min_interbody_distance_over_dp']:.2f} dp"
           f"  ({wall:.1f} s)")
-    particle_field(ax, res.state.x, res.state.body.astype(float), res.setup.dp, vmin=0, vmax=1, xlim=lims[0],
-                   ylim=lims[1])
-    ax.set_title(name)
+dp_r, body_r = res.setup.dp, res.state.body
+xy = 1e3 * np.concatenate([x for r in rings.values() for _, x in r[3]])          # one scale for all: every frame
+lims = dict(xlim=(xy[:, 0].min() - 0.5, xy[:, 0].max() + 0.5), ylim=(xy[:, 1].min() - 0.5, xy[:, 1].max() + 0.5))
+
+# %%
+fig, axes = plt.subplots(2, 2, figsize=(10, 5.4), sharex=True, sharey=True)
+fig.subplots_adjust(left=0.08, right=0.99, bottom=0.11, top=0.93, wspace=0.05, hspace=0.25)   # fixed: marker sizes
+for ax, (name, (m, wall, res, frames)) in zip(axes.flat, rings.items()):
+    particle_field(ax, res.state.x, body_r.astype(float), dp_r, vmin=-0.5, vmax=1.5, cmap="coolwarm",
+                   **lims)
+    ax.set_title(f"{name}: restitution {m['restitution']:.2f}", fontsize=14)
 for ax in axes[1]:
     ax.set_xlabel("x [mm]")
 for ax in axes[:, 0]:
     ax.set_ylabel("y [mm]")
 ch.show(fig, "10_rings.png", caption="Two elastic rings after their impact and rebound (45 µs), one colour per ring, "
-                                     "on one scale: TLSPH without and with hourglass control (top), ESPH with "
-                                     "γ = 0 and with γ = 0.3 (bottom).")
+                                     "all four runs at the same scale: TLSPH without and with hourglass control, "
+                                     "ESPH with γ = 0 and with γ = 0.3.")
+
+# %% [markdown]
+# At this scale both TLSPH runs end as two whole rings flying apart (ringing, out of phase): what goes wrong
+# without hourglass control happens during the impact, where the rings touch, and heals as they part. Closer, in
+# the frame where two particles of a ring come closest, each particle coloured by the distance to its nearest
+# neighbour *in its own ring*:
+
+# %%
+fig, axes = plt.subplots(1, 2, figsize=(10, 4.6), sharex=True, sharey=True)
+fig.subplots_adjust(left=0.09, right=0.86, bottom=0.15, top=0.9, wspace=0.06)              # fixed: marker sizes
+frames = rings["TLSPH, no hourglass control"][3]                 # the frame where a ring's pair is closest
+k = int(np.argmin([nearest_in_ring(x, body_r, dp_r).min() for _, x in frames]))
+for ax, name in zip(axes, ("TLSPH, no hourglass control", "TLSPH, hourglass = 1")):
+    t, x = rings[name][3][k]
+    sc = particle_field(ax, x, nearest_in_ring(x, body_r, dp_r), dp_r, vmin=0.0, vmax=1.0, spread=0.8, fill=None,
+                        xlim=(-1.6, 1.6), ylim=(-1.5, 1.5))
+    ax.set(title=f"{name.split(', ')[1]}, {1e6 * t:.0f} µs", xlabel="x [mm]")
+axes[0].set_ylabel("y [mm]")
+colorbar(fig, sc, list(axes), "nearest in its ring / dp [-]", fraction=0.05, pad=0.03)
+ch.show(fig, "10_rings_collapse.png", caption="Where the two TLSPH rings touch, 3 mm across, in the frame where "
+                                              "the particles of a ring come closest, coloured by each particle's "
+                                              "distance to its nearest neighbour in its own ring: without hourglass "
+                                              "control (left) the rings' particles collapse onto each other in pairs "
+                                              "(dark), with it (right) the lattice stays whole.")
+
+# %% [markdown]
+# The whole impact (the same colours as the first figure):
+
+# %%
+fig, axes = plt.subplots(2, 2, figsize=(10, 5.6), sharex=True, sharey=True)
+fig.subplots_adjust(left=0.08, right=0.99, bottom=0.11, top=0.86, wspace=0.05, hspace=0.25)   # fixed: marker sizes
+dots = []
+for ax, (name, (m, wall, res, frames)) in zip(axes.flat, rings.items()):
+    dots.append(particle_field(ax, frames[0][1], body_r.astype(float), dp_r, vmin=-0.5, vmax=1.5, fill=None,
+                               cmap="coolwarm", **lims))
+    ax.set_title(name)
+for ax in axes[1]:
+    ax.set_xlabel("x [mm]")
+
+
+def draw(k):
+    for dot, (m, wall, res, frames) in zip(dots, rings.values()):
+        dot.set_offsets(1e3 * frames[k][1][np.argsort(body_r, kind="stable")])
+    fig.suptitle(f"t = {1e6 * frames[k][0]:.0f} µs")
+
+
+n_frames = min(len(r[3]) for r in rings.values())
+ch.animate(fig, draw, range(n_frames), "10_rings.gif",
+           caption=f"Two elastic rings thrown at each other, 45 µs in {n_frames} frames: TLSPH without and with "
+                   "hourglass control (top), ESPH with γ = 0 and with γ = 0.3 (bottom); one colour per ring.")
 
 # %% [markdown]
 # Without hourglass control, TLSPH's rings bounce but some particles of a ring collapse onto each other (the
@@ -127,25 +212,38 @@ ch.show(fig, "10_rings.png", caption="Two elastic rings after their impact and r
 # amplification is $\sqrt{1 + (\omega\,\Delta t)^4/4} > 1$: without artificial viscosity the particle-scale modes
 # grow every step. The leapfrog (`integrator=leapfrog`, the second paper's scheme; `refsph.integrate`) is
 # symplectic: the energy oscillates by $(\omega\,\Delta t)^2/8$ and does not drift. The undamped elastic bar, 10
-# periods at Courant 0.3:
+# periods at Courant 0.3 (5 in quick mode):
 
 # %%
-fig, ax = plt.subplots(figsize=(7, 3.6))
-period = 2 * 20e-3 / 5382.7
-for integrator in ("predictor_corrector", "leapfrog"):
+from refsph.scenes.measure import elastic_energy, kinetic_energy
+
+fig, ax = plt.subplots(figsize=(9, 4.4), layout="constrained")
+period, n_periods = 2 * 20e-3 / 5382.7, 5 if ch.quick else 10
+for integrator, colour in (("predictor_corrector", "C3"), ("leapfrog", "C0")):
+    energy = []                                          # kept step by step: a run that fails keeps its history
+    setup = get_scene("bar").setup(2, None, True)
+    setup.numerics = dataclasses.replace(setup.numerics, beta1=0.0, beta2=0.0, integrator=integrator, threads=1)
+    setup.t_end = n_periods * period
     try:
-        m, wall, res = quick("bar", "tlsph", dict(beta1=0.0, beta2=0.0, integrator=integrator), t_end=10 * period)
-        e = np.asarray(m["energy_history"])
-        ax.plot(e[:, 0] / period, (e[:, 1] + e[:, 2]) / (e[0, 1] + e[0, 2]), label=integrator)
-        print(f"{integrator:19s}: energy end / start {m['energy_final_over_initial']:.6f}  ({wall:.1f} s, "
-              f"{res.summary['n_steps']} steps)")
+        res = simulate(setup, "tlsph", scene=get_scene("bar"), progress=False, hook=lambda s, _: energy.append(
+            (s.t, kinetic_energy(s) + elastic_energy(s, setup.material))))
+        print(f"{integrator:19s}: energy end / start {res.summary['metrics']['energy_final_over_initial']:.6f}  "
+              f"({res.summary['wall_time_s']:.1f} s, {res.summary['n_steps']} steps)")
     except SimulationError as err:
         print(f"{integrator:19s}: {err}")
-ax.set(xlabel="t / period", ylabel="energy / initial", ylim=(0.99, 1.01))
-ax.legend()
-ch.show(fig, "10_integrators.png", caption="Total energy of the undamped elastic bar over 10 periods at Courant 0.3: "
-                                           "the predictor-corrector's grows (where its run has not failed), the "
-                                           "leapfrog's oscillates without drift.")
+    t, E = np.array(energy).T
+    ax.semilogy(t / period, np.abs(E / E[0] - 1) + 1e-12, colour, lw=1.2, label=integrator.replace("_", "-"))
+    if t[-1] < 0.99 * setup.t_end:
+        ax.plot(t[-1] / period, abs(E[-1] / E[0] - 1), colour + "X", ms=12, label="the run fails")
+ax.set(xlabel="t / period of the bar", ylabel="|energy / initial - 1|", xlim=(0, n_periods))
+ax.set_ylim(bottom=1e-7)
+ax.grid(alpha=0.3)
+ax.legend(loc="center right")
+ch.show(fig, "10_integrators.png", caption=f"The change of the total energy of the undamped elastic bar over "
+                                           f"{n_periods} periods at Courant 0.3, on a log scale: the "
+                                           "predictor-corrector's grows exponentially until its run fails (the "
+                                           "cross); the leapfrog's stays at the small oscillation of a symplectic "
+                                           "scheme.")
 
 # %% [markdown]
 # ## 5. The stability map

@@ -204,6 +204,13 @@ def test_the_course_map_covers_every_chapter(tmp_path):
         assert f"* **{number} " in index, f"no learning outcomes for {stem} in index.md"
     path = draw_dependencies(load_course(), tmp_path / "deps.png")
     assert path.stat().st_size > 10_000
+    from PIL import Image
+
+    from refsph.teaching.plots import SLIDE
+    png = Image.open(path)
+    dpi = png.info["dpi"][0]
+    assert png.width <= dpi * SLIDE["max_width_in"] + 1 and png.height <= dpi * SLIDE["max_height_in"] + 1, \
+        "the course map breaks the size rule of refsph.teaching.plots"
 
 
 def shown_figure_notebook(path: Path) -> Path:

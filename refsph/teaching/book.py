@@ -125,15 +125,20 @@ def _positions(needs: dict[str, list[str]]) -> dict[str, tuple[float, float]]:
 
 def draw_dependencies(course: dict, path: Path) -> Path:
     """Draw which chapter needs which (an arrow from each chapter to those that build on it), one column per
-    depth, and save it as ``path`` (PNG). Fonts of 13 pt: readable on a projector."""
+    depth, and save it as ``path`` (PNG). It keeps to the size rule of :mod:`refsph.teaching.plots`: at most 10 x
+    6.5 in (1.25 in a column and a row: eight columns, five rows), text of 14 pt (long ``short`` names in
+    book/course.json are broken into lines)."""
     from matplotlib.figure import Figure
+
+    from .plots import SLIDE
 
     chapters = course["chapters"]
     needs = {stem: list(c["needs"]) for stem, c in chapters.items()}
     pos = _positions(needs)
     n_cols = 1 + max(x for x, _ in pos.values())
     half = max(abs(y) for _, y in pos.values()) + 0.6
-    fig = Figure(figsize=(1.75 * n_cols + 0.4, 1.1 * 2 * half))
+    pitch = 1.25                                            # inches a column (and a row) where the slide has room
+    fig = Figure(figsize=(min(pitch * n_cols, SLIDE["max_width_in"]), min(pitch * 2 * half, SLIDE["max_height_in"])))
     ax = fig.add_axes((0, 0, 1, 1))
     ax.set_xlim(-0.6, n_cols - 0.4)
     ax.set_ylim(-half, half)
@@ -143,7 +148,8 @@ def draw_dependencies(course: dict, path: Path) -> Path:
     for stem, (x, y) in pos.items():
         number = stem.split("_", 1)[0] + ("+" if stem == "05_penalty_contact" else "")
         labels[stem] = ax.text(x, y, f"{number}\n{chapters[stem].get('short', chapters[stem]['title'])}",
-                               ha="center", va="center", fontsize=13, bbox=box, zorder=3, family="DejaVu Sans")
+                               ha="center", va="center", fontsize=SLIDE["min_font_pt"], bbox=box, zorder=3,
+                               family="DejaVu Sans")
     for stem, ns in needs.items():
         for n in ns:
             ax.annotate("", xy=pos[stem], xytext=pos[n], zorder=4,        # after the boxes: clipped to them

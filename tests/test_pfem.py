@@ -316,6 +316,25 @@ def test_graded_workpiece_is_held_along_its_bottom_and_left(n_tu):
     assert held[cut.nodes.x[:, 1] == 0.0].sum() > 10
 
 
+def test_contact_sets_that_grow_end_a_cycle():
+    """StepContact.freeze: a node grazing the tool that leaves the contact set on the next solve changes the sets
+    (a cycle can follow); with ``grow`` it keeps its place, so the sets stop changing."""
+    from refsph.contact import CoulombFriction
+    from refsph.penalty import RoundedPolygon
+    from refsph.pfem.contact import StepContact, ToolContact
+    flat = RoundedPolygon.from_polygon([[-1e-3, -1e-3], [3e-3, -1e-3], [3e-3, 0.0], [-1e-3, 0.0]], 0.0, [0.0, 0.0])
+    params = ToolContact(k_normal=1e12, k_tangent=1e12,
+                         friction=CoulombFriction(mu0=0.3, q=1.0, T_room=293.0, T_melt=1800.0))
+    x = np.array([[0.0, 1e-4], [1e-4, 1e-4]])
+    c = StepContact(params, flat, [0.0, 0.0], [0.0, 0.0], x, np.zeros(2), np.full(2, 293.0), np.full(2, 1e-4),
+                    np.arange(2))
+    inside, outside = x - [0.0, 1e-4 + 1e-9], x - [0.0, 1e-4 - 1e-9]
+    assert c.freeze(inside) and c.active.all()
+    assert c.freeze(outside) and not c.active.any()                  # plain: the grazing nodes leave, then return
+    assert c.freeze(inside)
+    assert not c.freeze(outside, grow=True) and c.active.all()       # grown: they stay, nothing changes
+
+
 def test_solve_linear_fast_path_and_fallback():
     """solve_linear: the diagonal-pivot SuperLU path solves a PFEM-like matrix; a matrix whose diagonal vanishes
     (where diagonal pivots fail) falls back to partial pivoting and is still solved."""

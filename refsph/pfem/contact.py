@@ -71,9 +71,11 @@ class StepContact:
         self.last = None
         self.active = self.slip = None                         # frozen sets (None: decided by the gap / the cap)
 
-    def freeze(self, x_new: np.ndarray) -> bool:
+    def freeze(self, x_new: np.ndarray, grow: bool = False) -> bool:
         """Fix the contact and slip sets at positions x_new (the active-set strategy: within one Newton-Raphson
-        solve the forces are then smooth); True if the sets changed."""
+        solve the forces are then smooth); True if the sets changed. ``grow``: a node keeps its place in the sets
+        it is in (in contact; slipping, in its direction) and only joins others, so that sets which cycle (a node
+        grazing the tool, or at the friction cap, in and out on alternate solves) settle."""
         idx = self.nodes
         saved, self.active, self.slip = (self.active, self.slip), None, None
         res = self.forces(x_new[idx], idx)
@@ -83,6 +85,9 @@ class StepContact:
         trial = self.f_T_n[idx] - self.p.k_tangent * self.length[idx] * res["slip_raw"]
         cap = self.mu[idx] * res["f_N"]
         slip[idx] = np.where(active[idx] & (np.abs(trial) > cap), np.sign(trial), 0.0)
+        if grow and saved[0] is not None:
+            active |= saved[0]
+            slip = np.where(saved[1] != 0, saved[1], slip)
         changed = saved[0] is None or not (np.array_equal(saved[0], active) and np.array_equal(saved[1], slip))
         self.active, self.slip = active, slip
         return changed
@@ -134,19 +139,21 @@ def solve_with_active_set(nodes, mesh, hist, law, dt, loads, max_outer: int = 8,
     impact, and the predictor would drive the contact nodes deep into the tool), solved, set again from the
     solution, until the sets stop changing (the active-set strategy, Wriggers 2006, Section 6.3); then a last solve
     with the sets free checks that the solution satisfies the contact law itself. Each solve after the first starts
-    from the one before (``du0``: the first one's start, default zeros). The result's ``iterations`` counts those of
-    every solve."""
+    from the one before (``du0``: the first one's start, default zeros). Sets still changing after ``max_outer``
+    solves cycle (a node grazing the tool or at the friction cap, in and out on alternate solves): up to
+    ``max_outer`` more solves let the sets only grow (:meth:`StepContact.freeze` with ``grow``), which ends the
+    cycle, before the last solve with the sets free. The result's ``iterations`` counts those of every solve."""
     c = loads.contact
     c.freeze(nodes.x)
     total = 0
-    for _ in range(max_outer):
+    for k in range(2 * max_outer):
         r = newton_step(nodes, mesh, hist, law, dt, loads, dynamic=dynamic, predictor=False, max_iter=max_iter,
                         max_move=max_move, du0=du0)
         du0, total = r.du, total + r.iterations
-        if not c.freeze(nodes.x + r.du):
+        if not c.freeze(nodes.x + r.du, grow=k >= max_outer - 1):
             c.active = c.slip = None
             last = newton_step(nodes, mesh, hist, law, dt, loads, dynamic=dynamic, predictor=False,
                                max_iter=max_iter, max_move=max_move, du0=r.du)   # the sets free
             last.solves_iterations = total + last.iterations
             return last
-    raise NewtonFailed(f"the contact's active set kept changing over {max_outer} solves", [])
+    raise NewtonFailed(f"the contact's active set kept changing over {2 * max_outer} solves", [])

@@ -35,7 +35,9 @@ correction of about 12 spacings from a residual that a few tenths of one remove,
 step starts from du = 0, freezes the contact and slip sets within a Newton solve
 (:func:`~refsph.pfem.contact.solve_with_active_set`), and limits each correction to ``max_move`` = 0.05 of a node's
 local size (:func:`~refsph.pfem.solid.newton_step`). The quick cut's first 15 steps: 140 s and 10 halved steps with a
-limit of 0.25, 43 s and 1 with 0.05.
+limit of 0.25, 43 s and 1 with 0.05. Later in a cut a node grazing the tool (or at the friction cap) can drop out
+of the sets and come back on alternate solves, at any step size: case 4 failed so at step 145 even at dt / 16, and
+passes when the sets may only grow after 8 solves (the same function's second stage).
 
 The measures are the SPH scene's own functions (:func:`refsph.scenes.thermal_cutting.chip_measures`,
 :func:`~refsph.scenes.thermal_cutting.thermal_cutting_metrics`), so the two methods are measured alike.

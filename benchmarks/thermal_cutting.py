@@ -278,6 +278,7 @@ def report(res: dict, before: dict | None = None) -> str:
     lines += ["", P("pfem", done=sum(r["status"] == "ok" for r in pfem))] + [_case_line(r) for r in pfem]
     lines += ["", P("pfem_errors")] + _mean_error_lines(pfem, old)
     lines += ["", P("pfem_forces")] + [_pfem_force_line(r, res) for r in pfem]
+    lines += ["", P("dof")] + _dof_lines(pfem, coarse, res)
     lines += ["", P("forces")]
     for r in rows:
         lines.append(f"| {r['case']} | {_f(r['Fc_N_per_mm'], '.1f')} | {_f(r['Fp_N_per_mm'], '.1f')} | "
@@ -310,6 +311,25 @@ def _pfem_force_line(r: dict, res: dict) -> str:
             f"{_f(r['chip_mm'], '.3f')} | {_f(m.get('chip_thickness_mm'), '.3f')} | {_f(r['contact_mm'], '.3f')} | "
             f"{_f(pf.get('n_particles'), 'd')} | {_f(sph.get('n_particles'), 'd')} | "
             f"{_f(pf.get('wall_time_s'), '.0f')} | {_f(sph.get('wall_time_s'), '.0f')} |")
+
+
+def _dof_lines(pfem: list, coarse: list, res: dict) -> list[str]:
+    """Degrees of freedom against accuracy, per material, over the cases both methods ran at t_u / 5: the mean
+    node and particle counts, DOF (PFEM: u_x, u_y, p per node; SPH: x, y per particle), the mean errors and the
+    mean wall time of each."""
+    lines = []
+    for mat in ("AISI1045", "Ti6Al4V"):
+        both = [(a, b) for a, b in zip(pfem, coarse) if a["material"] == mat and a["status"] == b["status"] == "ok"]
+        if not both:
+            continue
+        n = {m: float(np.mean([res["runs"][f"case {a['case']}{k}"]["n_particles"] for a, _ in both]))
+             for m, k in (("pfem", PFEM), ("sph", COARSE))}
+        cells = [mat, str(len(both)), f"{n['pfem']:.0f} / {3 * n['pfem']:.0f}", f"{n['sph']:.0f} / {2 * n['sph']:.0f}"]
+        pf, sph = [a for a, _ in both], [b for _, b in both]
+        cells += [f"{_mean(pf, f'{q}_err'):.1f} / {_mean(sph, f'{q}_err'):.1f}" for q in ("TRF", "TFCS", "ratio")]
+        cells.append(f"{_mean(pf, 'wall_s') / 60:.1f} / {_mean(sph, 'wall_s') / 60:.1f}")
+        lines.append("| " + " | ".join(cells) + " |")
+    return lines
 
 
 def _mean_error_lines(rows: list, old: list | None) -> list[str]:

@@ -335,6 +335,28 @@ def test_contact_sets_that_grow_end_a_cycle():
     assert not c.freeze(outside, grow=True) and c.active.all()       # grown: they stay, nothing changes
 
 
+def test_a_slip_that_reverses_sticks_first():
+    """StepContact.freeze: a node that slipped one way in the last solve and whose trial force now points the other
+    way beyond the cap sticks (slip 0) rather than slips back; the solve after that decides. Without the rule the
+    stagnation node at the tool's edge radius flipped between slipping forwards and backwards on alternate solves
+    (case 1's short cut at t_u / 10, step 28: 297 Newton iterations and three halved steps, now 33)."""
+    from refsph.contact import CoulombFriction
+    from refsph.penalty import RoundedPolygon
+    from refsph.pfem.contact import StepContact, ToolContact
+    flat = RoundedPolygon.from_polygon([[-1e-3, -1e-3], [3e-3, -1e-3], [3e-3, 0.0], [-1e-3, 0.0]], 0.0, [0.0, 0.0])
+    params = ToolContact(k_normal=1e12, k_tangent=1e12,
+                         friction=CoulombFriction(mu0=0.3, q=1.0, T_room=293.0, T_melt=1800.0))
+    x_n = np.array([[0.0, -1e-7]])                                      # 1e-7 deep: f_N = 10 N/m, cap 3 N/m
+    c = StepContact(params, flat, [0.0, 0.0], [0.0, 0.0], x_n, np.zeros(1), np.full(1, 293.0), np.full(1, 1e-4),
+                    np.arange(1))
+    forwards, backwards = x_n + [1e-7, 0.0], x_n - [1e-7, 0.0]           # trial forces +-10 N/m, beyond the cap
+    c.freeze(forwards)
+    first = c.slip[0]
+    assert first != 0 and c.active[0]
+    assert c.freeze(backwards) and c.slip[0] == 0.0                     # reversed: sticks
+    assert c.freeze(backwards) and c.slip[0] == -first                  # from sticking, beyond the cap: slips
+
+
 def test_solve_linear_fast_path_and_fallback():
     """solve_linear: the diagonal-pivot SuperLU path solves a PFEM-like matrix; a matrix whose diagonal vanishes
     (where diagonal pivots fail) falls back to partial pivoting and is still solved."""

@@ -75,7 +75,10 @@ class StepContact:
         """Fix the contact and slip sets at positions x_new (the active-set strategy: within one Newton-Raphson
         solve the forces are then smooth); True if the sets changed. ``grow``: a node keeps its place in the sets
         it is in (in contact; slipping, in its direction) and only joins others, so that sets which cycle (a node
-        grazing the tool, or at the friction cap, in and out on alternate solves) settle."""
+        grazing the tool, or at the friction cap, in and out on alternate solves) settle. A node that slipped one
+        way and whose trial force now points the other way beyond the cap sticks (slip 0) rather than slips back,
+        as a return map from a slip state would: neither slip direction may be consistent (the stagnation node at
+        the tool's edge radius, where the chip and the machined surface part, flipped between them forever)."""
         idx = self.nodes
         saved, self.active, self.slip = (self.active, self.slip), None, None
         res = self.forces(x_new[idx], idx)
@@ -85,6 +88,8 @@ class StepContact:
         trial = self.f_T_n[idx] - self.p.k_tangent * self.length[idx] * res["slip_raw"]
         cap = self.mu[idx] * res["f_N"]
         slip[idx] = np.where(active[idx] & (np.abs(trial) > cap), np.sign(trial), 0.0)
+        if saved[1] is not None:
+            slip[(saved[1] != 0) & (slip == -saved[1])] = 0.0         # a slip that reverses sticks first
         if grow and saved[0] is not None:
             active |= saved[0]
             slip = np.where(saved[1] != 0, saved[1], slip)

@@ -113,6 +113,7 @@ def jobs(studies=STUDY_NAMES, only=None) -> dict:
             for k in (5, 10):
                 add("pfem", f"case 1 pfem short n_tu {k}", converged(1, n_tu=float(k), travel=4.0, length=1.2e-3),
                     dict(method="pfem"))
+    add("pfem", "case 1 pfem", converged(1, n_tu=10.0), dict(method="pfem"))   # the paper's resolution, 16 t_u
     add("scaling", "case 1 s/2", converged(1, mass_scale=_s(1) / 2))
     add("cases", "case 10", converged(10))
     add("scaling", "case 10 s/2", converged(10, mass_scale=_s(10) / 2))
@@ -424,8 +425,9 @@ STUDIES = (
      "detector; t_u/5)",
      ("case 1 n_tu 5", "case 1 n_tu 5 alpha detector", "case 10 n_tu 5", "case 10 n_tu 5 alpha detector"),
      BASIC + (("lost at the surface [% of work]", "lost_of_work", ".3f"),)),
-    ("The PFEM's resolution (case 1, the short cut of --quick: 4 t_u on a workpiece 1.2 mm long)",
-     ("case 1 pfem short n_tu 5", "case 1 pfem short n_tu 10"),
+    ("The PFEM's resolution (case 1: the short cut of --quick, 4 t_u on a workpiece 1.2 mm long, and the full cut "
+     "of 16 t_u)",
+     ("case 1 pfem short n_tu 5", "case 1 pfem short n_tu 10", "case 1 pfem n_tu 5", "case 1 pfem"),
      (("across t_u", "across", ".0f"), ("dx [um]", "dx_um", ".1f"), ("nodes", "n_particles", "d")) + BASIC
      + (("steps", "n_steps", "d"), ("wall [s]", "wall", ".0f"))),
     ("Contact and heat split (case 1: penalty contact, half the frictional heat into the chip)",

@@ -109,11 +109,11 @@ def jobs(studies=STUDY_NAMES, only=None) -> dict:
         add("detector", f"case {n}{COARSE} alpha detector", converged(n, n_tu=5.0, detector="alpha"))
     for n in [1, 10] + [k for k in range(2, 19) if k != 10]:   # the PFEM: cases 1 and 10 first
         add("pfem", f"case {n}{PFEM}", converged(n, n_tu=5.0), dict(method="pfem"))
-        if n == 10:                                          # the PFEM's resolution, on the short cut of --quick
-            for k in (5, 10):
+        if n == 10:                                          # the PFEM's resolution, on the short cut of --quick,
+            for k in (5, 10):                                # then case 1 at the paper's resolution (the long one)
                 add("pfem", f"case 1 pfem short n_tu {k}", converged(1, n_tu=float(k), travel=4.0, length=1.2e-3),
                     dict(method="pfem"))
-    add("pfem", "case 1 pfem", converged(1, n_tu=10.0), dict(method="pfem"))   # the paper's resolution, 16 t_u
+            add("pfem", "case 1 pfem", converged(1, n_tu=10.0), dict(method="pfem"))
     add("scaling", "case 1 s/2", converged(1, mass_scale=_s(1) / 2))
     add("cases", "case 10", converged(10))
     add("scaling", "case 10 s/2", converged(10, mass_scale=_s(10) / 2))

@@ -44,3 +44,19 @@ def test_study_page_is_generated_from_the_json(name, page):
     mod = _script(name)
     assert mod.report(json.loads((ROOT / "benchmarks" / f"{name}.json").read_text())) == \
         (ROOT / "benchmarks" / page).read_text()
+
+
+def test_pfem_rake_friction_record_keeps_its_bound():
+    """benchmarks/pfem_rake_friction.py: Fp/Fc of a chip on the rake face alone is tan(atan(m) - alpha) (zero at
+    m = tan(alpha), 0.55 at AISI 1045's mu0 = 0.81 and 10 deg), and each committed row's bounds are that
+    function of its own friction ratios (rake face and edge only: the flank carried nothing)."""
+    mod = _script("pfem_rake_friction")
+    assert abs(mod.rake_friction_bound(np.tan(np.radians(10.0)), 10.0)) < 1e-12
+    assert mod.rake_friction_bound(0.81, 10.0) == pytest.approx(0.5545, abs=1e-4)
+    rows = json.loads((ROOT / "benchmarks" / "pfem_rake_friction.json").read_text())["rows"]
+    assert rows
+    for r in rows:
+        assert r["bound_from_rake_friction"] == pytest.approx(mod.rake_friction_bound(r["rake_friction_ratio"], 10.0))
+        assert r["bound_from_mu_law"] == pytest.approx(mod.rake_friction_bound(r["rake_mu_law"], 10.0))
+        assert r["rake_friction_ratio"] < r["rake_mu_law"] + 1e-12     # Coulomb: never above the law's mu
+        assert 0.0 <= r["slipping_fraction"] <= 1.0

@@ -589,13 +589,11 @@ print(f"case 1: finest spacing {cut.info['dx'] * 1e6:.0f} um, edge radius {cut.i
 # **The first tool contact.** `refsph.pfem.cutting` builds the paper's cut (Figure 5: graded nodes, the rounded
 # tool as an exact shape, a penalty contact with Coulomb friction inside the Newton iterations). Newton stalled at
 # the first contact, twice over. The trapezoidal rule's velocities ring at an impact, so the predictor du = dt v
-# drove contact nodes deep into the tool: each step now starts from the last step's du, the contact and slip sets
-# frozen within a solve (`solve_with_active_set`). And a node on the tool, held by soft flowing elements, got an
-# (exact) correction of about 12 spacings where tenths would do: `max_move=0.05` scales each correction so that no
-# node moves more than 0.05 of its local size (the quick cut's first 15 steps: 140 s with 10 halved steps at 0.25,
-# 43 s with one at 0.05). At t_u/10 the node where chip and machined surface part slipped forwards in one solve and
-# backwards in the next, for ever: a slip that reverses now sticks first, as a return map would. The quick cut
-# (case 1, t_u/5, 4 t_u) runs in about a minute, heat included.
+# drove contact nodes deep into the tool: each step starts from the last step's du, the contact and slip sets
+# frozen within a solve (`solve_with_active_set`). A node on the tool, held by soft flowing elements, got an (exact)
+# correction of 12 spacings where tenths would do: `max_move=0.05` caps each correction at 0.05 of a node's size.
+# At t_u/10 the node where chip and machined surface part slipped forwards in one solve and backwards in the next:
+# a slip that reverses now sticks first, as a return map would. The quick cut runs in about a minute.
 #
 # **The cut, side by side.** `refsph run thermal_cutting --method pfem` writes a run folder like an SPH run's
 # (with the triangles); `python benchmarks/thermal_cutting.py --study pfem` runs the 18 cases, too slow for this

@@ -242,7 +242,8 @@ def _rising(values) -> bool | None:
 
 
 def trends(rows) -> dict:
-    """Per material: does Fc rise with t_u at every v_c, and T_RF with v_c at every t_u (refsph and measured)."""
+    """Per material: does Fc (Fp) rise with t_u at every v_c, and T_RF with v_c at every t_u (refsph and
+    measured)."""
     out = {}
     for mat in ("AISI1045", "Ti6Al4V"):
         get = {(r["vc"], r["tu"]): r for r in rows if r["material"] == mat}
@@ -254,6 +255,7 @@ def trends(rows) -> dict:
             verdicts = [_rising(vals) for vals in lines]
             return None if None in verdicts else all(verdicts)
         out[mat] = dict(Fc_rises_with_tu=every("Fc_N_per_mm", True), Fc_exp_rises_with_tu=every("Fc_exp", True),
+                        Fp_rises_with_tu=every("Fp_N_per_mm", True), Fp_exp_rises_with_tu=every("Fp_exp", True),
                         TRF_rises_with_vc=every("TRF", False), TRF_exp_rises_with_vc=every("TRF_exp", False))
     return out
 
@@ -291,9 +293,12 @@ def report(res: dict, before: dict | None = None) -> str:
         lines.append(_row([(r["case"], "d")] + [(v.get(key), fmt) for _, key, fmt in STEADY_COLUMNS]))
     lines += ["", P("trends")]
     yes = {True: "yes", False: "no", None: "-"}
-    for mat, t in trends(rows).items():
-        lines.append(f"| {mat} | {yes[t['Fc_rises_with_tu']]} / {yes[t['Fc_exp_rises_with_tu']]} | "
-                     f"{yes[t['TRF_rises_with_vc']]} / {yes[t['TRF_exp_rises_with_vc']]} |")
+    for label, sel in (("SPH, t_u/10", rows), ("SPH, t_u/5", coarse), ("PFEM, t_u/5", pfem)):
+        for mat, t in trends(sel).items():
+            lines.append(f"| {mat} | {label} | " + " | ".join(f"{yes[t[q + '_rises_with_' + x]]} / "
+                                                               f"{yes[t[q + '_exp_rises_with_' + x]]}"
+                                                               for q, x in (("Fc", "tu"), ("Fp", "tu"), ("TRF", "vc")))
+                         + " |")
     lines += _study_lines(res)
     todo = [k for k in jobs() if k not in res["runs"]]
     recorded = [r for r in res["runs"].values() if r.get("wall_time_s")]

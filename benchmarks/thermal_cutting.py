@@ -253,7 +253,7 @@ def trends(rows) -> dict:
             lines = [[get[(v, t)][key] for t in tus] for v in vcs] if along_tu else \
                 [[get[(v, t)][key] for v in vcs] for t in tus]
             verdicts = [_rising(vals) for vals in lines]
-            return None if None in verdicts else all(verdicts)
+            return None if None in verdicts or not verdicts else all(verdicts)
         out[mat] = dict(Fc_rises_with_tu=every("Fc_N_per_mm", True), Fc_exp_rises_with_tu=every("Fc_exp", True),
                         Fp_rises_with_tu=every("Fp_N_per_mm", True), Fp_exp_rises_with_tu=every("Fp_exp", True),
                         TRF_rises_with_vc=every("TRF", False), TRF_exp_rises_with_vc=every("TRF_exp", False))

@@ -60,3 +60,18 @@ def test_pfem_rake_friction_record_keeps_its_bound():
         assert r["bound_from_mu_law"] == pytest.approx(mod.rake_friction_bound(r["rake_mu_law"], 10.0))
         assert r["rake_friction_ratio"] < r["rake_mu_law"] + 1e-12     # Coulomb: never above the law's mu
         assert 0.0 <= r["slipping_fraction"] <= 1.0
+
+
+def test_thermal_cutting_trends_read_every_line():
+    """thermal_cutting.trends: a quantity 'rises with t_u' only if it rises at every v_c (one dip says no), and a
+    missing case makes the verdict '-' (None)."""
+    mod = _script("thermal_cutting")
+    rows = [dict(material="AISI1045", vc=vc, tu=tu, Fc_N_per_mm=100 * tu + vc, Fc_exp=tu, Fp_N_per_mm=1.0 * tu,
+                 Fp_exp=tu, TRF=vc + tu, TRF_exp=vc) for vc in (60, 120) for tu in (0.1, 0.15, 0.2)]
+    t = mod.trends(rows)["AISI1045"]
+    assert t["Fc_rises_with_tu"] and t["Fp_rises_with_tu"] and t["TRF_rises_with_vc"]
+    rows[4]["Fp_N_per_mm"] = 0.0                                       # vc 120, tu 0.15: a dip
+    assert mod.trends(rows)["AISI1045"]["Fp_rises_with_tu"] is False
+    rows[4]["Fp_N_per_mm"] = None                                      # not recorded
+    assert mod.trends(rows)["AISI1045"]["Fp_rises_with_tu"] is None
+    assert mod.trends(rows)["Ti6Al4V"]["Fc_rises_with_tu"] is None     # no Ti6Al4V rows at all

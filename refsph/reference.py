@@ -101,13 +101,25 @@ class ReferenceConfiguration:
     def end_step(self, state: State, n: int, several_bodies: bool) -> State:
         """rho = m / (J V0) (Eq. (2)) on the deformable rows; a reference update when max |E| >
         ``ref_update_strain``. The F computed here is kept for the first rate evaluation of the next step, which
-        starts from this very configuration (it is used only if x is unchanged, checked element by element)."""
+        starts from this very configuration (it is used only if x is unchanged, checked element by element).
+
+        A particle with J <= 0 is inverted (the motion is no longer one-to-one there; Eq. (2) would give it a
+        negative density and volume): ValueError naming it, which fails the step (a Lagrangian code's 'negative
+        volume' stop; J > 0: Belytschko, Liu, Moran & Elkhodary 2014, ch. 3). A NaN J is left to the step's
+        non-finite check."""
         body = self.rows(state, n)
         op = self.operator(body, several_bodies)
         F_ext = self.deformation_gradient(self.extended(body, op), op)
         F = F_ext[:body.n]
+        J = det(F)
+        inverted = np.flatnonzero(J <= 0.0)
+        if len(inverted):
+            k = int(inverted[0])
+            raise ValueError(f"inverted particle: J = det F = {float(J[k]):.6g} at particle {k} (and "
+                             f"{len(inverted) - 1} more), so rho = m / (J V0) = "
+                             f"{float(body.m[k] / (J[k] * body.V0[k])):.6g} kg/m^3 (Eq. (2))")
         rho = state.rho.copy()                  # (not in place: rho is not evolved, so shared with the old state)
-        rho[:body.n] = body.m / (det(F) * body.V0)
+        rho[:body.n] = body.m / (J * body.V0)
         state.rho = rho
         thr = self.params.ref_update_strain
         if thr is not None and float(np.max(green_lagrange_norm(F))) > thr:

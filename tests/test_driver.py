@@ -97,14 +97,44 @@ def test_summary_is_written_at_every_snapshot(tmp_path, monkeypatch):
     assert seen[-1][0] == "ok" and json.loads((tmp_path / "summary.json").read_text())["status"] == "ok"
 
 
-def test_nan_stops_and_keeps_last_good(tmp_path):
+def test_blow_up_stops_at_the_inverted_particle_and_keeps_last_good(tmp_path):
     out = tmp_path / "bad"
     setup = get_scene("bar").setup(2, get_scene("bar").default_dp(2, True), True)
     setup.t_end = 2e-5                           # a fixed dt 5 x above the CFL limit blows TLSPH up
-    setup.numerics = dataclasses.replace(setup.numerics, ref_update_strain=None)   # (else a reference update
-    #                                            refuses the inverted particles first, with status "error")
-    with pytest.raises(SimulationError, match=r"non-finite .* at particle \d+ in step \d+"):
+    setup.numerics = dataclasses.replace(setup.numerics, ref_update_strain=None)   # (no reference update either:
+    #                                            the end of the step refuses the first J = det F <= 0 itself)
+    with pytest.raises(SimulationError, match=r"step \d+ .* failed: inverted particle: J = det F = -.* at particle"):
         simulate(setup, "tlsph", scene=get_scene("bar"), out=out, dt=8e-8, progress=False)
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["status"] == "error" and "inverted particle" in summary["error"]
+    good = load_snapshot(out / "snapshots" / "last_good.npz")
+    assert np.isfinite(good["x"]).all() and np.isfinite(good["v"]).all() and np.all(good["rho"] > 0)
+
+
+def test_nan_stops_and_keeps_last_good(tmp_path):
+    """A non-finite field (here put into particle 3's velocity after the 5th step) stops the run with status 'nan'
+    and the field, particle and step named (a TLSPH blow-up stops earlier, at its first inverted particle)."""
+    from refsph.simulate import make_solver
+
+    class NaNAfter:
+        def __init__(self, inner, n):
+            self.inner, self.n, self.steps = inner, n, 0
+
+        def after_step(self, state):
+            state, self.steps = self.inner.after_step(state), self.steps + 1
+            if self.steps == self.n:
+                state.v[3, 0] = np.nan
+            return state
+
+        def __getattr__(self, name):                               # everything else: the wrapped solver's
+            return getattr(self.inner, name)
+
+    out = tmp_path / "bad"
+    setup = get_scene("bar").setup(2, get_scene("bar").default_dp(2, True), True)
+    setup.t_end = 2e-6
+    with pytest.raises(SimulationError, match=r"non-finite v at particle 3 in step 5 "):
+        simulate(setup, solver=NaNAfter(make_solver("esph", setup), 5), scene=get_scene("bar"), out=out,
+                 progress=False)
     summary = json.loads((out / "summary.json").read_text())
     assert summary["status"] == "nan" and "step" in summary["error"]
     good = load_snapshot(out / "snapshots" / "last_good.npz")

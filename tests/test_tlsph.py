@@ -285,6 +285,28 @@ def test_reference_update_refuses_a_singular_F():
         reference_update(st, F)
 
 
+def test_end_of_step_refuses_an_inverted_particle():
+    """A particle with J = det F <= 0 fails the step (ReferenceConfiguration.end_step) instead of taking the negative
+    density m / (J V0) of Eq. (2) into the next step (thermal_cutting case 10 at t_u/10: J = -0.031 gave rho =
+    -1.4e9 kg/m^3, and the heat step's surface area V^(1/2) of the negative volume turned its T into NaN). The reference
+    update's own J > 0 check does not see it: |E| stays below 1/2 for a particle collapsing along one direction
+    (E = (lambda^2 - 1) / 2 >= -1/2) or mirrored (E = 0), so no update runs; here the update is off."""
+    from refsph.reference import ReferenceConfiguration
+
+    X, V = _square()
+    ref = ReferenceConfiguration(dataclasses.replace(params(True), ref_update_strain=None), None, threads=1)
+    st = make_state(X, 0.0, MAT.rho0, V)
+    st.x = X * [1.01, 0.99]                                 # stretched, not inverted: rho = m / (J V0)
+    np.testing.assert_allclose(ref.end_step(st, st.n, False).rho, MAT.rho0 / (1.01 * 0.99), rtol=1e-10)
+    st = make_state(X, 0.0, MAT.rho0, V)
+    k = 100
+    near = np.linalg.norm(X - X[k], axis=1) <= H               # particle k and its nearest neighbours mirrored in x
+    st.x = X.copy()
+    st.x[near, 0] = 2.0 * X[k, 0] - X[near, 0]                 # (k alone inverted: J_k < 0, its neighbours' > 0)
+    with pytest.raises(ValueError, match=f"inverted particle: J = det F = -.* at particle {k} "):
+        ref.end_step(st, st.n, False)
+
+
 @pytest.mark.parametrize("corrected", [False, True])
 def test_viscous_heat_is_the_work_the_viscosity_takes(corrected):
     """Rates.heat_power (viscous_heat): every particle's share >= 0, their sum = -sum m v . a_visc (the power the

@@ -75,3 +75,13 @@ def test_thermal_cutting_trends_read_every_line():
     rows[4]["Fp_N_per_mm"] = None                                      # not recorded
     assert mod.trends(rows)["AISI1045"]["Fp_rises_with_tu"] is None
     assert mod.trends(rows)["Ti6Al4V"]["Fc_rises_with_tu"] is None     # no Ti6Al4V rows at all
+
+
+def test_pfem_time_step_report_is_generated_from_the_json():
+    """benchmarks/pfem_time_step_report.md is what pfem_time_step.report writes from the committed JSON, and the
+    committed study has the default step (courant 0.25) and a smaller one to measure it against."""
+    mod = _script("pfem_time_step")
+    rows = json.loads((ROOT / "benchmarks" / "pfem_time_step.json").read_text())["rows"]
+    assert mod.report(rows) == (ROOT / "benchmarks" / "pfem_time_step_report.md").read_text()
+    courants = {r["courant"] for r in rows if r["status"] == "ok"}
+    assert 0.25 in courants and min(courants) < 0.25

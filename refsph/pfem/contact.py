@@ -143,13 +143,12 @@ def solve_with_active_set(nodes, mesh, hist, law, dt, loads, max_outer: int = 8,
     x_n (the tool already at t_{n+1}), the first solve started from ``du0`` (default zeros; not the predictor dt v:
     the trapezoidal rule's velocities ring at an impact, and the predictor would drive the contact nodes deep into
     the tool; sets taken at x_n + du0 instead cost twice the iterations on case 1's short cut at t_u / 10), solved,
-    set again from the solution, until
-    the sets stop changing (the active-set strategy, Wriggers 2006, Section 6.3); then a last solve with the sets
-    free checks that the solution satisfies the contact law itself. Each solve after the first starts from the one
-    before. Sets still changing after ``max_outer``
-    solves cycle (a node grazing the tool or at the friction cap, in and out on alternate solves): up to
-    ``max_outer`` more solves let the sets only grow (:meth:`StepContact.freeze` with ``grow``), which ends the
-    cycle, before the last solve with the sets free. The result's ``iterations`` counts those of every solve."""
+    set again from the solution, until the sets stop changing (the active-set strategy, Wriggers 2006, Section
+    6.3); then a last solve with the sets free checks that the solution satisfies the contact law itself. Each
+    solve after the first starts from the one before. Sets still changing after ``max_outer`` solves cycle (a node
+    grazing the tool or at the friction cap, in and out on alternate solves): up to ``max_outer`` more solves let
+    the sets only grow (:meth:`StepContact.freeze` with ``grow``), which ends the cycle, before the last solve with
+    the sets free. The result's ``iterations`` counts those of every solve."""
     c = loads.contact
     c.freeze(nodes.x)
     total = 0

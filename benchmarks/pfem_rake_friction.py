@@ -119,6 +119,12 @@ def main(argv=None) -> int:
     runs = args.run or [d for d in SWEEP_RUNS if (d / "snapshots" / "restart.npz").exists()
                         and (d / "summary.json").exists()
                         and json.loads((d / "summary.json").read_text()).get("status") == "ok"]
+    missing = [str(d) for d in runs if not (Path(d) / "summary.json").exists()
+               or not (Path(d) / "snapshots" / "restart.npz").exists()]
+    if missing:
+        print(f"not a finished PFEM run folder (summary.json and snapshots/restart.npz): {', '.join(missing)}",
+              file=sys.stderr)
+        return 2
     with tempfile.TemporaryDirectory() as tmp:
         if not runs:
             runs = [quick_run(Path(tmp))]

@@ -70,6 +70,9 @@ def main(argv=None) -> int:
         rows = [run_one(c) for c in COURANTS]
         OUT_JSON.write_text(json.dumps(dict(rows=rows, made_by="python benchmarks/pfem_time_step.py"), indent=1)
                             + "\n")
+    if not OUT_JSON.exists():
+        print(f"no {OUT_JSON.name}: run python benchmarks/pfem_time_step.py first", file=sys.stderr)
+        return 2
     text = report(json.loads(OUT_JSON.read_text())["rows"])
     (OUT_JSON.parent / "pfem_time_step_report.md").write_text(text)
     print(text)

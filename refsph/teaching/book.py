@@ -29,8 +29,8 @@ from pathlib import Path
 
 from .notebook import CAPTION_KEY, repository_root
 
-__all__ = ["chapter_files", "execute_chapter", "executed_path", "build_book", "book_folder", "load_course",
-           "draw_dependencies", "caption_figures", "figure_markdown", "assemble", "render", "raw_tex",
+__all__ = ["chapter_files", "execute_chapter", "save_executed", "executed_path", "build_book", "book_folder",
+           "load_course", "draw_dependencies", "caption_figures", "figure_markdown", "assemble", "render", "raw_tex",
            "rendering_problems", "RAW_TEX"]
 
 
@@ -58,7 +58,6 @@ def execute_chapter(chapter: Path, quick: bool = True, timeout: int = 600, figur
     chapter's build folder, see :mod:`refsph.teaching.notebook`)."""
     import jupytext
     import nbclient
-    import nbformat
 
     env = dict(os.environ, REFSPH_QUICK="1" if quick else "0", MPLBACKEND="module://matplotlib_inline.backend_inline")
     if figures is not None:
@@ -69,11 +68,20 @@ def execute_chapter(chapter: Path, quick: bool = True, timeout: int = 600, figur
     t0 = time.perf_counter()
     client.execute(env=env)                      # the kernel's own environment: nothing of this process changes
     seconds = time.perf_counter() - t0
+    save_executed(chapter, nb, seconds, quick)
+    return nb, seconds
+
+
+def save_executed(chapter: Path, nb, seconds: float, quick: bool) -> Path:
+    """Keep an executed student's copy of ``chapter`` in ``build/executed/`` for the book, with the mode it ran in
+    and its seconds (the test suite saves the student's part of the lecturer's run here, so the book reuses it)."""
+    import nbformat
+
     nb.metadata["refsph"] = {"quick": quick, "seconds": seconds}
     out = executed_path(chapter)
     out.parent.mkdir(parents=True, exist_ok=True)
     nbformat.write(nb, out)
-    return nb, seconds
+    return out
 
 
 def _fresh(chapter: Path, quick: bool) -> bool:

@@ -28,7 +28,8 @@ from pathlib import Path
 
 from .notebook import repository_root
 
-__all__ = ["solutions_path", "student_notebook", "instructor_notebook", "execute", "write_handout"]
+__all__ = ["solutions_path", "student_notebook", "instructor_notebook", "execute", "cell_seconds", "student_part",
+           "names_from_solutions", "write_handout"]
 
 EXERCISE = re.compile(r"^### Exercise (\d+)", re.M)
 SOLUTION = re.compile(r"^### Solution (\d+)", re.M)
@@ -125,6 +126,61 @@ def execute(nb, quick: bool = True, timeout: int = 600, cwd: Path | None = None,
     t0 = time.perf_counter()
     client.execute(env=env)
     return time.perf_counter() - t0
+
+
+def cell_seconds(cell) -> float:
+    """The seconds a cell of an executed notebook ran (nbclient's timing: the kernel busy to idle); 0 if unrecorded."""
+    from datetime import datetime
+
+    t = cell.get("metadata", {}).get("execution", {})
+    start, end = t.get("iopub.status.busy"), t.get("iopub.status.idle") or t.get("shell.execute_reply")
+    if not (start and end):
+        return 0.0
+    return (datetime.fromisoformat(end.replace("Z", "+00:00"))
+            - datetime.fromisoformat(start.replace("Z", "+00:00"))).total_seconds()
+
+
+def student_part(nb):
+    """The student's copy inside an executed lecturer's copy: its cells without those tagged ``solution`` (their
+    outputs kept), for the book."""
+    out = copy.deepcopy(nb)
+    out.cells = [c for c in out.cells if "solution" not in c.metadata.get("tags", [])]
+    return out
+
+
+def _bound_and_used(source: str) -> tuple[set, set]:
+    """(names a cell binds, names it reads) of a code cell (IPython's % and ! lines left out)."""
+    import ast
+
+    code = "\n".join(line for line in source.splitlines() if not line.lstrip().startswith(("%", "!")))
+    bound, used = set(), set()
+    for node in ast.walk(ast.parse(code)):
+        if isinstance(node, ast.Name):
+            (used if isinstance(node.ctx, ast.Load) else bound).add(node.id)
+        elif isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef)):
+            bound.add(node.name)
+        elif isinstance(node, ast.arg) or (isinstance(node, ast.ExceptHandler) and node.name):
+            bound.add(node.arg if isinstance(node, ast.arg) else node.name)
+        elif isinstance(node, (ast.Import, ast.ImportFrom)):
+            bound.update((a.asname or a.name).split(".")[0] for a in node.names)
+    return bound, used
+
+
+def names_from_solutions(nb) -> set:
+    """The names a student's cell of the lecturer's copy reads that only a worked solution before it binds: such a
+    cell would fail in the student's copy, so a run of the lecturer's copy stands for a run of the student's only
+    when this is empty."""
+    own, from_solutions, missing = set(), set(), set()
+    for c in nb.cells:
+        if c.cell_type != "code":
+            continue
+        bound, used = _bound_and_used(c.source)
+        if "solution" in c.metadata.get("tags", []):
+            from_solutions |= bound - own
+        else:
+            missing |= (used & from_solutions) - own - bound
+            own |= bound
+    return missing
 
 
 def write_handout(out: Path, instructor: bool = False, only: list[str] | None = None, force: bool = False) -> list:

@@ -368,3 +368,21 @@ def test_solve_linear_fast_path_and_fallback():
     assert np.allclose(A @ solid.solve_linear(A, b), b, rtol=0, atol=1e-10 * np.linalg.norm(b))
     P = sp.csc_matrix(np.array([[0.0, 2.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 3.0]]))
     assert np.allclose(solid.solve_linear(P, np.array([4.0, 1.0, 6.0])), [1.0, 2.0, 2.0])
+
+
+def test_free_matrix_is_the_masked_tangent():
+    """The Newton matrix summed into a pattern found once per solve equals the tangent with the held dofs' rows and
+    columns replaced by the identity (keep K keep + diag(fix)), contact blocks and mass diagonal included."""
+    rng = np.random.default_rng(3)
+    x = rng.random((12, 2))
+    tri = alpha_shape_mesh(x, 10.0, np.full(12, 0.3)).tri
+    n = 12
+    dofs = solid._element_dofs(tri, n)
+    parts = solid.TangentParts(rng.standard_normal((len(tri), 9, 9)), dofs, n, diag=rng.random(3 * n),
+                               kc=rng.standard_normal((n, 2, 2)))
+    fix = rng.random(3 * n) < 0.3
+    keep = sp.diags((~fix).astype(float))
+    expected = (keep @ parts.sparse() @ keep + sp.diags(fix.astype(float))).toarray()
+    got = solid.FreeMatrix(dofs, n, fix)(parts)
+    assert got.format == "csc"
+    np.testing.assert_allclose(got.toarray(), expected, rtol=1e-14, atol=1e-14)

@@ -31,11 +31,14 @@ def shape_gradients(xe: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """grad N_a of the linear triangles with vertices xe (M, 3, 2), and their signed areas A (M,):
     grad N_a = (y_b - y_c, x_c - x_b) / (2 A) for (a, b, c) the cyclic order."""
     x, y = xe[..., 0], xe[..., 1]
-    b = np.stack([y[..., 1] - y[..., 2], y[..., 2] - y[..., 0], y[..., 0] - y[..., 1]], axis=-1)
-    c = np.stack([x[..., 2] - x[..., 1], x[..., 0] - x[..., 2], x[..., 1] - x[..., 0]], axis=-1)
+    g = np.empty(xe.shape[:-2] + (3, 2))
+    for a, (b, c) in enumerate(((1, 2), (2, 0), (0, 1))):          # the cyclic order
+        g[..., a, 0] = y[..., b] - y[..., c]
+        g[..., a, 1] = x[..., c] - x[..., b]
     A = 0.5 * (x[..., 1] * y[..., 2] - x[..., 2] * y[..., 1] + x[..., 2] * y[..., 0] - x[..., 0] * y[..., 2]
                + x[..., 0] * y[..., 1] - x[..., 1] * y[..., 0])
-    return np.stack([b, c], axis=-1) / (2.0 * A[..., None, None]), A
+    g /= (2.0 * A[..., None, None])
+    return g, A
 
 
 def pressure_mass(A: np.ndarray) -> np.ndarray:

@@ -233,6 +233,17 @@ def volumetric_pressure(J: np.ndarray, T: np.ndarray, law: SolidLaw, lnJ: np.nda
     return law.K * lnJ / J - 3.0 * law.K * law.alpha_T * (1.0 - lnJ) / J * (T - law.T_ref)
 
 
+def _rotated(S: np.ndarray, c: np.ndarray, s: np.ndarray) -> np.ndarray:
+    """Q S Q^T for the rotations Q = [[c, s], [-s, c]] and symmetric S (M, 2, 2), written out."""
+    a, b, d = S[:, 0, 0], S[:, 0, 1], S[:, 1, 1]
+    cc, ss, cs = c * c, s * s, c * s
+    out = np.empty_like(S)
+    out[:, 0, 0] = cc * a + 2.0 * cs * b + ss * d
+    out[:, 1, 1] = ss * a - 2.0 * cs * b + cc * d
+    out[:, 0, 1] = out[:, 1, 0] = (cc - ss) * b + cs * (d - a)
+    return out
+
+
 def element_response(xe: np.ndarray, due: np.ndarray, hist: History, Te: np.ndarray, dt: float,
                      law: SolidLaw) -> dict:
     """The triangles' state at t_{n+1} for the increment du (module text): S, S_zz, d_eps_p, d_w_p, J, p_hat, the
@@ -247,12 +258,11 @@ def element_response(xe: np.ndarray, due: np.ndarray, hist: History, Te: np.ndar
     d = 0.5 * (L + np.swapaxes(L, 1, 2))
     w = 0.5 * (L[:, 0, 1] - L[:, 1, 0])
     q = 1.0 / (1.0 + 0.25 * w * w)                                 # Q = (I - W/2)^-1 (I + W/2), W = [[0, w], [-w, 0]]
-    c, s = (1.0 - 0.25 * w * w) * q, w * q
-    Q = np.stack([np.stack([c, s], -1), np.stack([-s, c], -1)], -2)
+    c, s = (1.0 - 0.25 * w * w) * q, w * q                         # Q = [[c, s], [-s, c]]
     tr = d[:, 0, 0] + d[:, 1, 1]
     dev = d - (tr / 3.0)[:, None, None] * np.eye(2)
     dev_zz = -tr / 3.0
-    S_trial = Q @ hist.S @ np.swapaxes(Q, 1, 2) + 2.0 * law.G * dev
+    S_trial = _rotated(hist.S, c, s) + 2.0 * law.G * dev           # Q S_n Q^T + 2 G dev d
     S_zz_trial = hist.S_zz + 2.0 * law.G * dev_zz
     eps_dot = np.sqrt(np.maximum(2.0 / 3.0 * (np.einsum("mij,mij->m", dev, dev) + dev_zz * dev_zz), 0.0)) / dt
     rate = eps_dot if hist.eps_dot is None else hist.eps_dot
@@ -269,8 +279,9 @@ def element_residual(xe, due, pe, hist, Te, dt, law) -> tuple[np.ndarray, np.nda
     A = r["area"]
     sigma = r["S"] + pe.mean(axis=1)[:, None, None] * np.eye(2)
     r_u = A[:, None, None] * (r["grad"] @ np.swapaxes(sigma, 1, 2))       # sum_j sigma_ij dN_a/dx_j
-    r_p = ((pressure_mass(A) @ pe[:, :, None])[:, :, 0] - (A / 3.0 * r["p_hat"])[:, None]) / law.K \
-        + (ppp_stabilisation(A) @ pe[:, :, None])[:, :, 0] / law.G
+    p_sum = pe.sum(axis=1)[:, None]                   # M_e p = A/12 (p + sum p), S_e p = A (p/12 - sum p/36)
+    r_p = (A[:, None] / 12.0 * (pe + p_sum) - (A / 3.0 * r["p_hat"])[:, None]) / law.K \
+        + A[:, None] * (pe / 12.0 - p_sum / 36.0) / law.G
     return r_u, r_p, r
 
 

@@ -279,9 +279,8 @@ def element_residual(xe, due, pe, hist, Te, dt, law) -> tuple[np.ndarray, np.nda
     A = r["area"]
     sigma = r["S"] + pe.mean(axis=1)[:, None, None] * np.eye(2)
     r_u = A[:, None, None] * (r["grad"] @ np.swapaxes(sigma, 1, 2))       # sum_j sigma_ij dN_a/dx_j
-    p_sum = pe.sum(axis=1)[:, None]                   # M_e p = A/12 (p + sum p), S_e p = A (p/12 - sum p/36)
-    r_p = (A[:, None] / 12.0 * (pe + p_sum) - (A / 3.0 * r["p_hat"])[:, None]) / law.K \
-        + A[:, None] * (pe / 12.0 - p_sum / 36.0) / law.G
+    r_p = (np.einsum("mab,mb->ma", pressure_mass(A), pe) - (A / 3.0 * r["p_hat"])[:, None]) / law.K \
+        + np.einsum("mab,mb->ma", ppp_stabilisation(A), pe) / law.G
     return r_u, r_p, r
 
 

@@ -366,6 +366,13 @@ def test_solve_linear_fast_path_and_fallback():
     A = (B + B.T).tocsc()
     b = rng.normal(size=n)
     assert np.allclose(A @ solid.solve_linear(A, b), b, rtol=0, atol=1e-10 * np.linalg.norm(b))
+    ordering = {}
+    x1 = solid.solve_linear(A, b, ordering)                   # the first solve stores its ordering ...
+    assert sorted(ordering["inverse"]) == list(range(n))
+    A2 = A + sp.diags(rng.random(n))                          # ... the next one, on the same pattern, reuses it
+    x2 = solid.solve_linear(A2, b, ordering)
+    np.testing.assert_allclose(x1, solid.solve_linear(A, b), rtol=1e-12)
+    np.testing.assert_allclose(x2, solid.solve_linear(A2, b), rtol=1e-12)
     P = sp.csc_matrix(np.array([[0.0, 2.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 3.0]]))
     assert np.allclose(solid.solve_linear(P, np.array([4.0, 1.0, 6.0])), [1.0, 2.0, 2.0])
 

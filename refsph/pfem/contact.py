@@ -151,15 +151,15 @@ def solve_with_active_set(nodes, mesh, hist, law, dt, loads, max_outer: int = 8,
     the sets free. The result's ``iterations`` counts those of every solve."""
     c = loads.contact
     c.freeze(nodes.x)
-    total = 0
+    total, pattern = 0, {}                                        # the solves share the mesh's sparsity pattern
     for k in range(2 * max_outer):
         r = newton_step(nodes, mesh, hist, law, dt, loads, dynamic=dynamic, predictor=False, max_iter=max_iter,
-                        max_move=max_move, du0=du0)
+                        max_move=max_move, du0=du0, pattern=pattern)
         du0, total = r.du, total + r.iterations
         if not c.freeze(nodes.x + r.du, grow=k >= max_outer - 1):
             c.active = c.slip = None
             last = newton_step(nodes, mesh, hist, law, dt, loads, dynamic=dynamic, predictor=False,
-                               max_iter=max_iter, max_move=max_move, du0=r.du)   # the sets free
+                               max_iter=max_iter, max_move=max_move, du0=r.du, pattern=pattern)  # sets free
             last.solves_iterations = total + last.iterations
             return last
     raise NewtonFailed(f"the contact's active set kept changing over {2 * max_outer} solves", [])

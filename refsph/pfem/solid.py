@@ -401,7 +401,8 @@ def assemble(nodes: Nodes, mesh: Mesh, hist: History, law: SolidLaw, du: np.ndar
 
 def newton_step(nodes: Nodes, mesh: Mesh, hist: History, law: SolidLaw, dt: float, loads: Loads,
                 dynamic: bool = True, tol: float = 1e-10, max_iter: int = 25, predictor: bool = True,
-                max_move: float | None = None, du0: np.ndarray | None = None) -> StepResult:
+                max_move: float | None = None, du0: np.ndarray | None = None,
+                pattern: dict | None = None) -> StepResult:
     """Solve Eqs. (19)-(20) for the step's du and p by Newton-Raphson. Converged when the residual of the free
     displacement rows and that of the pressure rows are below ``tol`` times their scales (:func:`assemble`), or
     below 100 tol and no longer falling (the round-off floor of a large system: the sums of many forces).
@@ -410,7 +411,9 @@ def newton_step(nodes: Nodes, mesh: Mesh, hist: History, law: SolidLaw, dt: floa
     down, before the line search; None: no limit). Where elements flow plastically the tangent is soft, and a node
     on the tool (sliding, or frictionless) can get a correction of ten spacings from a residual that a few tenths
     of one remove; the line search alone then crawls (chapter 12). ``du0``: the first guess of du where the
-    predictor is off (default zeros). Raises :class:`NewtonFailed`."""
+    predictor is off (default zeros). ``pattern``: a dict kept between the solves of one mesh and one set of held
+    dofs (the Newton matrix's sparsity pattern and ordering, :class:`FreeMatrix`, :func:`solve_linear`; found
+    again where the mesh or the held dofs differ). Raises :class:`NewtonFailed`."""
     n = nodes.n
     if max_move is not None:
         a = np.repeat(np.abs(signed_areas(nodes.x, mesh.tri)), 3)
@@ -430,7 +433,11 @@ def newton_step(nodes: Nodes, mesh: Mesh, hist: History, law: SolidLaw, dt: floa
     fix = np.concatenate([fixed.ravel(), ~meshed])
     f_ext = np.zeros(2 * n) if loads.f_ext is None else np.asarray(loads.f_ext, dtype=float).ravel()
     history = []
-    free = FreeMatrix(_element_dofs(mesh.tri, n), n, fix)
+    if pattern is None or not np.array_equal(pattern.get("fix", ()), fix) or pattern.get("tri") is not mesh.tri:
+        pattern = {} if pattern is None else pattern               # one sparsity pattern and ordering per mesh
+        pattern.clear()
+        pattern.update(fix=fix, tri=mesh.tri, free=FreeMatrix(_element_dofs(mesh.tri, n), n, fix), ordering={})
+    free, ordering = pattern["free"], pattern["ordering"]
 
     def evaluate(du, p, tangent, known=None):
         return _residual(nodes, mesh, hist, law, du, p, dt, dynamic, f_ext, loads.contact, tangent, known)
@@ -458,7 +465,7 @@ def newton_step(nodes: Nodes, mesh: Mesh, hist: History, law: SolidLaw, dt: floa
         if not np.all(np.isfinite(R)):
             break
         rhs = -R_free - (np.where(fix, 0.0, Kg.sparse() @ lift) if np.any(lift) else 0.0)
-        step = solve_linear(free(Kg), rhs) + lift
+        step = solve_linear(free(Kg), rhs, ordering) + lift
         if not np.all(np.isfinite(step)):
             break
         s = 1.0 if max_move is None else min(1.0, max_move / max(float(np.max(
@@ -480,13 +487,24 @@ def newton_step(nodes: Nodes, mesh: Mesh, hist: History, law: SolidLaw, dt: floa
                        history, (du, p))
 
 
-def solve_linear(A, b: np.ndarray) -> np.ndarray:
+def solve_linear(A, b: np.ndarray, ordering: dict | None = None) -> np.ndarray:
     """x with A x = b (module text, "Linear solve"): SuperLU with the minimum-degree ordering of A^T + A and
     diagonal pivots; where that fails or leaves a relative residual above 1e-8, scipy's spsolve (partial
-    pivoting)."""
+    pivoting). ``ordering``: a dict kept between solves on one sparsity pattern; the first solve stores its
+    ordering there, and later ones permute A by it and factor in that order (the same factors, without computing
+    the ordering again)."""
     A = sp.csc_matrix(A)
+    opts = dict(diag_pivot_thresh=0.0, options=dict(SymmetricMode=True))
     try:
-        x = splu(A, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0, options=dict(SymmetricMode=True)).solve(b)
+        if ordering is not None and "inverse" in ordering:
+            inv = ordering["inverse"]
+            x = np.empty_like(b)
+            x[inv] = splu(A[inv][:, inv].tocsc(), permc_spec="NATURAL", **opts).solve(b[inv])
+        else:
+            lu = splu(A, permc_spec="MMD_AT_PLUS_A", **opts)
+            x = lu.solve(b)
+            if ordering is not None:
+                ordering["inverse"] = np.argsort(lu.perm_c)
         if np.all(np.isfinite(x)) and np.linalg.norm(A @ x - b) <= 1e-8 * np.linalg.norm(b):
             return x
     except RuntimeError:                                           # an exactly zero pivot

@@ -399,6 +399,25 @@ def assemble(nodes: Nodes, mesh: Mesh, hist: History, law: SolidLaw, du: np.ndar
     return R, None if parts is None else parts.sparse(), resp, scale
 
 
+def _node_sizes(nodes: Nodes, mesh: Mesh) -> np.ndarray:
+    """Each node's local size sqrt(mean area of its triangles) (inf for a node without one)."""
+    a = np.repeat(np.abs(signed_areas(nodes.x, mesh.tri)), 3)
+    cnt = np.bincount(mesh.tri.ravel(), minlength=nodes.n)
+    size = np.sqrt(np.bincount(mesh.tri.ravel(), a, minlength=nodes.n) / np.maximum(cnt, 1))
+    size[cnt == 0] = np.inf
+    return size
+
+
+def _shared_pattern(pattern: dict | None, mesh: Mesh, n: int, fix: np.ndarray):
+    """(:class:`FreeMatrix`, the ordering dict of :func:`solve_linear`) for this mesh and these held dofs: those
+    kept in ``pattern`` where they match, else found and kept there."""
+    if pattern is None or not np.array_equal(pattern.get("fix", ()), fix) or pattern.get("tri") is not mesh.tri:
+        pattern = {} if pattern is None else pattern
+        pattern.clear()
+        pattern.update(fix=fix, tri=mesh.tri, free=FreeMatrix(_element_dofs(mesh.tri, n), n, fix), ordering={})
+    return pattern["free"], pattern["ordering"]
+
+
 def newton_step(nodes: Nodes, mesh: Mesh, hist: History, law: SolidLaw, dt: float, loads: Loads,
                 dynamic: bool = True, tol: float = 1e-10, max_iter: int = 25, predictor: bool = True,
                 max_move: float | None = None, du0: np.ndarray | None = None,
@@ -415,11 +434,7 @@ def newton_step(nodes: Nodes, mesh: Mesh, hist: History, law: SolidLaw, dt: floa
     dofs (the Newton matrix's sparsity pattern and ordering, :class:`FreeMatrix`, :func:`solve_linear`; found
     again where the mesh or the held dofs differ). Raises :class:`NewtonFailed`."""
     n = nodes.n
-    if max_move is not None:
-        a = np.repeat(np.abs(signed_areas(nodes.x, mesh.tri)), 3)
-        cnt = np.bincount(mesh.tri.ravel(), minlength=n)
-        size = np.sqrt(np.bincount(mesh.tri.ravel(), a, minlength=n) / np.maximum(cnt, 1))
-        size[cnt == 0] = np.inf
+    size = None if max_move is None else _node_sizes(nodes, mesh)
     fixed = np.asarray(loads.fixed, dtype=bool).copy()
     meshed = mesh.meshed
     if not dynamic:
@@ -433,11 +448,7 @@ def newton_step(nodes: Nodes, mesh: Mesh, hist: History, law: SolidLaw, dt: floa
     fix = np.concatenate([fixed.ravel(), ~meshed])
     f_ext = np.zeros(2 * n) if loads.f_ext is None else np.asarray(loads.f_ext, dtype=float).ravel()
     history = []
-    if pattern is None or not np.array_equal(pattern.get("fix", ()), fix) or pattern.get("tri") is not mesh.tri:
-        pattern = {} if pattern is None else pattern               # one sparsity pattern and ordering per mesh
-        pattern.clear()
-        pattern.update(fix=fix, tri=mesh.tri, free=FreeMatrix(_element_dofs(mesh.tri, n), n, fix), ordering={})
-    free, ordering = pattern["free"], pattern["ordering"]
+    free, ordering = _shared_pattern(pattern, mesh, n, fix)
 
     def evaluate(du, p, tangent, known=None):
         return _residual(nodes, mesh, hist, law, du, p, dt, dynamic, f_ext, loads.contact, tangent, known)

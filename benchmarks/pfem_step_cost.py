@@ -10,7 +10,7 @@ same numbers.
 
 A record is keyed by the git commit and the resolution, so running this at an older commit (``git checkout <rev> --
 refsph``, with ``--label``) adds that version's row beside today's (the before-and-after of a change):
-benchmarks/pfem_step_cost.json.
+benchmarks/pfem_step_cost.json and pfem_step_cost_report.md.
 """
 from __future__ import annotations
 
@@ -28,6 +28,7 @@ import study  # noqa: E402
 study.pin_threads()
 
 OUT_JSON = Path(__file__).resolve().parent / "pfem_step_cost.json"
+OUT_MD = Path(__file__).resolve().parent / "pfem_step_cost_report.md"
 PARTS = (("tangent", "_element_tangent"), ("element residuals", "element_residual"), ("factorisation", "gstrf"))
 # (the element residuals: all of them, the tangent's included)
 
@@ -69,7 +70,12 @@ def measure(n_tu: float, steps: int, label: str | None = None) -> dict:
 
 def report(rows: list) -> str:
     """The table of the records, by resolution and then as recorded."""
-    lines = ["| commit | n_tu | steps | nodes | Newton iterations | CPU s | ms per iteration | tangent | "
+    lines = ["# What a PFEM cutting step costs (case 1's short cut, its first steps)", "",
+             "Made by `python benchmarks/pfem_step_cost.py` (module text): CPU seconds of one process (other work ran "
+             "beside it), the split under cProfile as fractions of the step (the element residuals include the "
+             "tangent's), the tool force averaged over the last five steps: versions that agree on it to many "
+             "digits changed the path to the numbers, not the numbers.", "",
+             "| commit | n_tu | steps | nodes | Newton iterations | CPU s | ms per iteration | tangent | "
              "element residuals (all) | factorisation | tool force (x, y) [N/m] |", "|---" * 11 + "|"]
     for r in sorted(rows, key=lambda r: r["n_tu"]):
         s = r["split"]
@@ -77,7 +83,7 @@ def report(rows: list) -> str:
                      f"{r['cpu_s']:.1f} | {r['cpu_per_iteration_ms']:.0f} | {100 * s['tangent']:.0f} % | "
                      f"{100 * s['element residuals']:.0f} % | {100 * s['factorisation']:.0f} % | "
                      f"{r['tool_force_N_per_m'][0]:.6f}, {r['tool_force_N_per_m'][1]:.6f} |")
-    return "\n".join(lines)
+    return "\n".join(lines) + "\n"
 
 
 def main(argv=None) -> int:
@@ -95,6 +101,7 @@ def main(argv=None) -> int:
             rows.append(rec)
             OUT_JSON.write_text(json.dumps(dict(rows=rows), indent=1) + "\n")
             print(f"n_tu {n_tu:g}: {rec['cpu_s']:.1f} s CPU, {rec['iterations']} iterations", flush=True)
+    OUT_MD.write_text(report(rows))
     print(report(rows))
     return 0
 

@@ -55,7 +55,12 @@ residual of 1 before the correction fits in 0.05 of a spacing): ``warm_start`` b
 step's du (scaled by the ratio of the steps; carried through node insertions and merges like the other per-node
 arrays; the contact sets still taken at x_n, since sets taken at x_n + du cost twice the iterations). Steps 28-37
 of the short cut at t_u / 10: 181 iterations against 324; the quick cut at t_u / 5: 1194 against 1335, with the
-same forces and temperatures to 1e-9 (the path changes, not the solution).
+same forces and temperatures to 1e-9 (the path changes, not the solution). The crawl that remains is mostly
+one node, the stagnation node at the edge radius, whose solution moves about half a spacing in a step: the limit
+as a trust region (doubled after each correction it cut short that the line search took whole, back to 0.05
+after a backtrack; capped at 4 or 8 times 0.05, or grown by 1.5 up to 3 times) took 689-728 iterations against
+626 on the quick cut's first 40 steps, and starting each step with the nodes that the tool's move pushed into
+it projected back onto its outline, 628: neither is kept.
 
 The measures are the SPH scene's own functions (:func:`refsph.scenes.thermal_cutting.chip_measures`,
 :func:`~refsph.scenes.thermal_cutting.thermal_cutting_metrics`), so the two methods are measured alike.

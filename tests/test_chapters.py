@@ -13,6 +13,7 @@ import pytest
 
 from refsph.teaching.book import chapter_files, save_executed
 from refsph.teaching.handout import cell_seconds, execute, instructor_notebook, names_from_solutions, student_part
+from refsph.teaching.notebook import shown_figure_problems
 
 CHAPTERS = chapter_files()
 
@@ -24,7 +25,8 @@ def test_chapter_runs_quick(path, tmp_path):
     solution binds (so they run the same without the solutions), and they take under a minute (the run's wall
     time, kernel start included, less the solution cells' own seconds); the stub as handed out fails its grader
     without stopping the notebook, the worked solution passes, and every asserted number of the solutions holds.
-    The student's part, executed, is kept in build/executed/ for the book."""
+    Every figure it shows fits a slide (measured as drawn). The student's part, executed, is kept in build/executed/
+    for the book."""
     pytest.importorskip("jupytext")
     pytest.importorskip("nbclient")
     nb = instructor_notebook(path)
@@ -43,6 +45,8 @@ def test_chapter_runs_quick(path, tmp_path):
     solved = "".join(text(c) for c in nb.cells if "solution" in c.metadata.get("tags", []))
     assert stubs and all("FAIL" in text(c) and "not written yet" in text(c) for c in stubs)
     assert solved.count("PASS") >= len(stubs), "each graded task's worked solution passes its grader"
+    _, bad = shown_figure_problems(nb)                 # every figure shown, measured as drawn (tests/test_figures.py)
+    assert not bad, f"{path.name}: figures that do not fit a slide: {bad}"
     assert any(t > 0 for t in solving), "nbclient recorded no cell timing (the solutions' seconds unknown)"
 
 

@@ -38,6 +38,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 __all__ = ["Chapter", "chapter", "FIELD_CMAP", "repository_root", "show_figure", "show_animation", "animation_gif",
+           "shown_figure_problems",
            "format_warning", "CAPTION_KEY", "MAX_FRAMES"]
 
 FIELD_CMAP = "viridis"
@@ -123,6 +124,19 @@ def _slide_check(fig) -> dict:
 
     box = fig.get_tightbbox(fig.canvas.get_renderer())
     return {"width_in": round(box.width, 2), "height_in": round(box.height, 2), "problems": slide_problems(fig)}
+
+
+def shown_figure_problems(nb) -> tuple[int, list[str]]:
+    """(how many figures and animations an executed notebook showed with their slide check, the problems of those
+    that break the size rule), read from the outputs' metadata that :func:`show_figure` writes."""
+    measured, bad = 0, []
+    for cell in nb["cells"]:
+        for out in cell.get("outputs", []):
+            meta = out.get("metadata", {}).get(CAPTION_KEY, {})
+            if "caption" in meta and "slide" in meta:
+                measured += 1
+                bad += [f"{meta['caption'][:50]}...: {p}" for p in meta["slide"].get("problems", [])]
+    return measured, bad
 
 
 def _display(mime: str, data: bytes, caption: str, slide: dict) -> None:

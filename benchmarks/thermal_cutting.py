@@ -85,7 +85,7 @@ def _s(case: int) -> float:
 STUDY_NAMES = ("cases", "coarse", "pfem", "detector", "scaling", "scatter", "resolution", "tool", "contact")
 COARSE = " n_tu 5"                         # the key suffix of the 'coarse' study: all 18 cases at dx = t_u / 5
 PFEM = " pfem n_tu 5"                      # the key suffix of the 'pfem' study: the 18 cases with the PFEM at t_u / 5
-PFEM_OPTIONS = ("case", "n_tu", "travel", "length")     # the sweep's options the PFEM cut takes (its tool is TOOL)
+PFEM_OPTIONS = ("case", "n_tu", "travel", "length", "gamma")   # the sweep's options the PFEM cut takes (tool: TOOL)
 
 
 def jobs(studies=STUDY_NAMES, only=None) -> dict:
@@ -114,6 +114,7 @@ def jobs(studies=STUDY_NAMES, only=None) -> dict:
                 add("pfem", f"case 1 pfem short n_tu {k}", converged(1, n_tu=float(k), travel=4.0, length=1.2e-3),
                     dict(method="pfem"))
             add("pfem", "case 1 pfem", converged(1, n_tu=10.0), dict(method="pfem"))
+    add("pfem", "case 16 pfem gamma 0.6", dict(converged(16, n_tu=5.0), gamma=0.6), dict(method="pfem"))  # damped
     add("scaling", "case 1 s/2", converged(1, mass_scale=_s(1) / 2))
     add("cases", "case 10", converged(10))
     add("cases", "case 10 courant 0.15", converged(10), dict(courant=0.15))   # past the inverted particle at 1.1 ms?

@@ -393,3 +393,15 @@ def test_free_matrix_is_the_masked_tangent():
     got = solid.FreeMatrix(dofs, n, fix)(parts)
     assert got.format == "csc"
     np.testing.assert_allclose(got.toarray(), expected, rtol=1e-14, atol=1e-14)
+
+
+def test_cut_takes_the_damped_newmark_rule_as_an_option():
+    """pfem_cut(gamma=...): 0.5 is the paper's trapezoidal rule, above it the damped rule with beta = (gamma + 1/2)^2
+    / 4 (case 16 rings with the first), outside [1/2, 1] a ValueError."""
+    from refsph.pfem.cutting import pfem_cut
+
+    assert pfem_cut(1, n_tu=3.0, travel=2.0, length=1e-3).newmark == solid.TRAPEZOIDAL
+    cut = pfem_cut(1, n_tu=3.0, travel=2.0, length=1e-3, gamma=0.6)
+    assert cut.newmark == solid.Newmark(0.3025, 0.6) and cut.info["newmark_gamma"] == 0.6
+    with pytest.raises(ValueError, match="gamma"):
+        pfem_cut(1, n_tu=3.0, travel=2.0, length=1e-3, gamma=0.4)

@@ -616,8 +616,8 @@ for case in (1, 10):
               f"T_FCS {c[f'TFCS_{t}_K']:.0f} K")
 
 # %% [markdown]
-# **Where it stands.** Mind chapter 11's scatter (Fc 17 % at t_u/5). With node removal and insertion
-# (`refsph.pfem.refine`) the full case 1 at t_u/5 runs to the end (34 min); 10-20 nodes across t_u are to come.
+# **Where it stands.** Mind chapter 11's scatter (Fc 17 % at t_u/5). 17 of the 18 cuts run; case 16's chip rings
+# under the trapezoidal rule (pressures jump by GPa a step) until Newton stalls: `pfem_cut(gamma=0.6)` damps it.
 
 # %% [markdown]
 # ## Your turn

@@ -39,7 +39,9 @@ stiffness, the return map and the strain-rate dependence without deriving them (
 Newton then converges quadratically down to the tolerance (``tests/test_pfem.py`` prints the residual norms); a
 tangent wrong in its eighth digit only shows below it. Central differences (12 evaluations, step 1e-7: ~1e-10)
 gave the quick cut's first 40 steps the same forces to 2e-13 in 633 iterations against 626, at 1.13 times the
-time. The line search's accepted point is not evaluated again for the tangent (its element response is reused).
+time. The line search's accepted point is not evaluated again (its residual and element response are kept), and
+the tangent is computed only where a correction follows: a solve's converged point (one a step, often its last
+solve's only point) needs none.
 
 **Linear solve.** Each Newton correction solves K delta = -R with SuperLU (:func:`solve_linear`): a symmetric
 fill-reducing ordering (minimum degree on K^T + K) and the diagonal as pivots, since K's diagonal never vanishes
@@ -458,7 +460,7 @@ def newton_step(nodes: Nodes, mesh: Mesh, hist: History, law: SolidLaw, dt: floa
         return R_free, (float(np.linalg.norm(R_free[:2 * n])) / scale[0], float(np.linalg.norm(R_free[2 * n:]))
                         / scale[1])
 
-    R, Kg, resp, scale, fc = evaluate(du, p, True)
+    R, Kg, resp, scale, fc = evaluate(du, p, False)                  # the matrix only where a correction is needed
     for _ in range(max_iter + 1):
         lift = np.zeros(3 * n)
         lift[:2 * n] = target - du.ravel()                        # the prescribed part of the correction
@@ -475,6 +477,7 @@ def newton_step(nodes: Nodes, mesh: Mesh, hist: History, law: SolidLaw, dt: floa
                               contact_force=fc)
         if not np.all(np.isfinite(R)):
             break
+        Kg = evaluate(du, p, True, resp)[1]                       # the tangent at this point (its residual known)
         rhs = -R_free - (np.where(fix, 0.0, Kg.sparse() @ lift) if np.any(lift) else 0.0)
         step = solve_linear(free(Kg), rhs, ordering) + lift
         if not np.all(np.isfinite(step)):
@@ -493,7 +496,7 @@ def newton_step(nodes: Nodes, mesh: Mesh, hist: History, law: SolidLaw, dt: floa
         else:
             trial = None                                          # no trial taken: the point is new
         du, p = du + s * step[:2 * n].reshape(n, 2), p + s * step[2 * n:]
-        R, Kg, resp, scale, fc = evaluate(du, p, True, None if trial is None else trial[2])
+        R, Kg, resp, scale, fc = trial if trial is not None else evaluate(du, p, False)   # the accepted trial
     raise NewtonFailed(f"Newton-Raphson did not converge in {max_iter} iterations (residuals {history[-3:]})",
                        history, (du, p))
 

@@ -33,6 +33,14 @@ PARTS = (("tangent", "_element_tangent"), ("element residuals", "element_residua
 # (the element residuals: all of them, the tangent's included)
 
 
+def version() -> str:
+    """refsph's git commit, short, with '(dirty)' where its tracked files differ from it."""
+    from refsph.simulate import provenance
+
+    commit = provenance(1)["git_commit"] or "unknown"
+    return commit[:7] + (" (dirty)" if "dirty" in commit else "")
+
+
 def measure(n_tu: float, steps: int, label: str | None = None) -> dict:
     """CPU and wall seconds of ``steps`` steps of the short cut at t_u / n_tu (case 1), then the same steps again
     under cProfile for the split; the Newton iterations and the tool force averaged over the last five steps."""
@@ -58,11 +66,7 @@ def measure(n_tu: float, steps: int, label: str | None = None) -> dict:
     split = {name: sum(v[3] for k, v in stats.items() if k[2] == func or k[2].endswith(f".{func}>")) / total
              for name, func in PARTS}
     F = np.mean(np.array(run.reaction["tool"][-5:]), axis=0)
-    from refsph.simulate import provenance
-
-    commit = provenance(1)["git_commit"] or "unknown"
-    commit = commit[:7] + (" (dirty)" if "dirty" in commit else "")
-    return dict(commit=label or commit, n_tu=n_tu, steps=steps, nodes=int(run.nodes.n), cpu_s=round(cpu, 2),
+    return dict(commit=label or version(), n_tu=n_tu, steps=steps, nodes=int(run.nodes.n), cpu_s=round(cpu, 2),
                 wall_s=round(wall, 2), iterations=int(sum(run.iterations)),
                 cpu_per_iteration_ms=round(1e3 * cpu / max(sum(run.iterations), 1), 1),
                 split={k: round(v, 3) for k, v in split.items()}, tool_force_N_per_m=[float(f) for f in F])
@@ -95,6 +99,7 @@ def main(argv=None) -> int:
     args = ap.parse_args(argv)
     rows = json.loads(OUT_JSON.read_text())["rows"] if OUT_JSON.exists() else []
     if not args.report:
+        args.label = args.label or version()          # before this script writes its JSON (a tracked file)
         for n_tu in args.n_tu:
             rec = measure(n_tu, args.steps, args.label)
             rows = [r for r in rows if (r["commit"], r["n_tu"], r["steps"]) != (rec["commit"], n_tu, args.steps)]

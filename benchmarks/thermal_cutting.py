@@ -440,6 +440,10 @@ STUDIES = (
     ("Case 10 (Ti6Al4V) at t_u/10 and its time step: at courant 0.3 a particle on the torn surface under the edge "
      "inverts at 1.1 ms (a local explicit instability); at half the step?",
      ("case 10 n_tu 5", "case 10", "case 10 courant 0.15"), BASIC),
+    ("The PFEM's time rule (case 16, Ti6Al4V, 60 m/min, 0.10 mm, t_u/5): the paper's trapezoidal rule rings in the "
+     "chip and Newton stalls at 0.85 ms; the damped Newmark rule gamma = 0.6 (a departure from the paper)",
+     ("case 16 pfem n_tu 5", "case 16 pfem gamma 0.6"),
+     BASIC + (("steps", "n_steps", "d"), ("wall [s]", "wall", ".0f"))),
     ("Contact and heat split (case 1: penalty contact, half the frictional heat into the chip)",
      ("case 1", "case 1 pinball", "case 1 all friction heat to the chip"),
      BASIC + (("friction heat [% of work]", "friction_of_work", ".1f"),

@@ -329,9 +329,13 @@ class TangentParts:
         i = np.arange(2 * n).reshape(n, 2)
         rows = np.concatenate([np.repeat(dofs, 9, axis=1).ravel(), np.repeat(i, 2, axis=1).ravel(), np.arange(3 * n)])
         cols = np.concatenate([np.tile(dofs, (1, 9)).ravel(), np.tile(i, (1, 2)).ravel(), np.arange(3 * n)])
-        vals = np.concatenate([self.Ke.ravel(), np.zeros(4 * n) if self.kc is None else -self.kc.ravel(),
+        return rows, cols, self.values()
+
+    def values(self) -> np.ndarray:
+        """The values of :meth:`entries` alone (its rows and columns depend on the mesh only)."""
+        n = self.n
+        return np.concatenate([self.Ke.ravel(), np.zeros(4 * n) if self.kc is None else -self.kc.ravel(),
                                np.zeros(3 * n) if self.diag is None else self.diag])
-        return rows, cols, vals
 
     def sparse(self):
         """The matrix, sparse (3N, 3N) CSR."""
@@ -341,7 +345,7 @@ class TangentParts:
 
 class FreeMatrix:
     """The matrix of a Newton correction: the tangent with the held dofs' rows and columns replaced by the identity,
-    as CSC on a sparsity pattern found once per solve (the mesh and the held dofs do not change within it), so each
+    as CSC on a sparsity pattern found once per mesh and set of held dofs (:func:`_shared_pattern`), so each
     iteration only sums its entries into place (np.bincount) instead of building and masking a sparse matrix."""
 
     def __init__(self, dofs: np.ndarray, n: int, fix: np.ndarray):
@@ -354,7 +358,7 @@ class FreeMatrix:
         self.fix_diag = np.flatnonzero(fix)
 
     def __call__(self, parts: TangentParts):
-        _, _, vals = parts.entries()
+        vals = parts.values()
         vals[len(vals) - self.n3 + self.fix_diag] = 1.0
         data = np.bincount(self.where, vals[self.valid], minlength=len(self.indices))
         return sp.csc_matrix((data, self.indices, self.indptr), shape=(self.n3, self.n3))

@@ -9,6 +9,7 @@ that say which digits of them mean something (issue 22).
     python benchmarks/thermal_cutting.py --scheduler tcp://HOST:8786     # the same on a dask.distributed cluster
     python benchmarks/thermal_cutting.py --redo "case 3"     # run one again (a failed record is kept until then)
     python benchmarks/thermal_cutting.py --report            # page and figures from the committed JSON only
+    python benchmarks/thermal_cutting.py --status --study cases   # what is recorded, how far each run has got
     python benchmarks/thermal_cutting.py --quick --json /tmp/q.json --only 1 2   # a try-out (quick cuts)
 
 Each run is ``refsph run thermal_cutting --case N`` with the sweep's numerics (:func:`converged`: dx = t_u / 10, 16
@@ -143,7 +144,7 @@ def run_case(key: str, options: dict, numerics: dict, quick: bool = False) -> di
     method 'pfem': the PFEM cut (:mod:`refsph.pfem_run`) with the options it takes (PFEM_OPTIONS; its tool is the
     sweep's, TOOL)."""
     from refsph.simulate import SimulationError, run
-    out = RUNS / (key.replace(" ", "_").replace("/", "") + ("_quick" if quick else ""))
+    out = run_folder(key, quick)
     restart = (out / "snapshots" / "restart.npz").exists()
     t0 = time.perf_counter()
     rec = dict(key=key, options=options, numerics=numerics, quick=quick)
@@ -518,10 +519,46 @@ def figures(res: dict) -> None:
     plt.close(fig)
 
 
+def run_folder(key: str, quick: bool = False) -> Path:
+    """The run folder of a job (``runs/thermal_cutting/<key>``)."""
+    return RUNS / (key.replace(" ", "_").replace("/", "") + ("_quick" if quick else ""))
+
+
+def status_lines(records: dict, todo: dict, quick: bool = False) -> list[str]:
+    """One line per job of ``todo``: its record's status, or how far its run folder has got (the simulated time
+    of its last snapshot's summary against the run's end, steps, wall time so far: a run in progress, or one that
+    was killed and continues from there), or 'to run'."""
+    lines = []
+    for key in todo:
+        rec = records.get(key)
+        if rec is not None:
+            wall = rec.get("wall_time_s")
+            lines.append(f"{key:40s} recorded: {rec.get('status')}"
+                         + ("" if wall is None else f" ({wall / 60:.0f} min)"))
+            continue
+        path = run_folder(key, quick) / "summary.json"
+        try:
+            s = json.loads(path.read_text())
+        except (OSError, ValueError):
+            lines.append(f"{key:40s} to run")
+            continue
+        t, t_end, wall = s.get("t_final") or 0.0, s.get("t_end") or float("nan"), s.get("wall_time_s") or 0.0
+        left = wall * (t_end / t - 1.0) if t > 0 else float("nan")
+        age = (time.time() - path.stat().st_mtime) / 60
+        lines.append(f"{key:40s} {s.get('status')}: t = {t * 1e3:.3f} of {t_end * 1e3:.3f} ms "
+                     f"({100 * t / t_end:.0f} %), {s.get('n_steps')} steps, {wall / 60:.0f} min so far, "
+                     f"about {left / 60:.0f} min to go; summary written {age:.0f} min ago")
+    return lines
+
+
 def main(argv=None) -> int:
     args = _parser().parse_args(argv)
     if args.quick and args.json == OUT_JSON:
         _parser().error("--quick writes try-out records: give them their own --json file")
+    if args.status:
+        todo = jobs(args.study or STUDY_NAMES, args.only)
+        print("\n".join(status_lines(store(args.json).records(), todo, args.quick)))
+        return 0
     if not args.report:
         if not sweep(store(args.json), jobs(args.study or STUDY_NAMES, args.only), args):
             print("nothing ran: every run asked for is recorded; the JSON, the page and the figures are unchanged "
@@ -548,6 +585,8 @@ def _parser():
     study.add_flags(ap, "report", "quick", report=dict(help="table and figures from the committed JSON only"),
                     quick=dict(help="quick short cuts (a try-out; give --json elsewhere)"))
     ap.add_argument("--json", type=Path, default=OUT_JSON, help="the records (default: the committed JSON)")
+    ap.add_argument("--status", action="store_true",
+                    help="no runs: each job's record, or how far its run folder has got, or 'to run'")
     return ap
 
 

@@ -97,3 +97,19 @@ def test_pfem_step_cost_report_is_generated_from_the_json_and_the_versions_agree
         forces = [r["tool_force_N_per_m"] for r in rows if r["n_tu"] == n_tu]
         for f in forces[1:]:
             assert f == pytest.approx(forces[0], rel=1e-6), (n_tu, forces)
+
+
+def test_thermal_cutting_status_reads_records_and_run_folders(tmp_path, monkeypatch):
+    """thermal_cutting --status: a recorded job shows its record's status, a job whose run folder has a summary
+    shows how far it got (simulated time against the end), any other is 'to run'."""
+    mod = _script("thermal_cutting")
+    monkeypatch.setattr(mod, "RUNS", tmp_path)
+    folder = mod.run_folder("case 2")
+    folder.mkdir()
+    (folder / "summary.json").write_text(json.dumps(dict(status="running", t_final=6e-4, t_end=2.4e-3, n_steps=10,
+                                                         wall_time_s=600.0)))
+    todo = {"case 1": None, "case 2": None, "case 1 s/2": None}
+    lines = mod.status_lines({"case 1": dict(status="ok", wall_time_s=1920.0)}, todo)
+    assert lines[0].split() == ["case", "1", "recorded:", "ok", "(32", "min)"]
+    assert "t = 0.600 of 2.400 ms (25 %)" in lines[1] and "about 30 min to go" in lines[1]
+    assert lines[2].endswith("to run") and mod.run_folder("case 1 s/2").name == "case_1_s2"

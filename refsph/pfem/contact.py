@@ -144,22 +144,24 @@ def solve_with_active_set(nodes, mesh, hist, law, dt, loads, max_outer: int = 8,
     the trapezoidal rule's velocities ring at an impact, and the predictor would drive the contact nodes deep into
     the tool; sets taken at x_n + du0 instead cost twice the iterations on case 1's short cut at t_u / 10), solved,
     set again from the solution, until the sets stop changing (the active-set strategy, Wriggers 2006, Section
-    6.3); then a last solve with the sets free checks that the solution satisfies the contact law itself. Each
-    solve after the first starts from the one before. Sets still changing after ``max_outer`` solves cycle (a node
+    6.3); then a last solve with the sets free checks that the solution satisfies the contact law itself. Sets
+    still changing after ``max_outer`` solves cycle (a node
     grazing the tool or at the friction cap, in and out on alternate solves): up to ``max_outer`` more solves let
     the sets only grow (:meth:`StepContact.freeze` with ``grow``), which ends the cycle, before the last solve with
-    the sets free. The result's ``iterations`` counts those of every solve."""
+    the sets free. Each solve after the first starts from the one before's du and p (with p from t_n instead, a
+    solve whose sets had not changed took an iteration to find the pressures again). The result's ``iterations``
+    counts those of every solve."""
     c = loads.contact
     c.freeze(nodes.x)
-    total, pattern = 0, {}                                        # the solves share the mesh's sparsity pattern
+    total, pattern, p0 = 0, {}, None                              # the solves share the mesh's sparsity pattern
     for k in range(2 * max_outer):
         r = newton_step(nodes, mesh, hist, law, dt, loads, dynamic=dynamic, predictor=False, max_iter=max_iter,
-                        max_move=max_move, du0=du0, pattern=pattern)
-        du0, total = r.du, total + r.iterations
+                        max_move=max_move, du0=du0, p0=p0, pattern=pattern)
+        du0, p0, total = r.du, r.p, total + r.iterations
         if not c.freeze(nodes.x + r.du, grow=k >= max_outer - 1):
             c.active = c.slip = None
             last = newton_step(nodes, mesh, hist, law, dt, loads, dynamic=dynamic, predictor=False,
-                               max_iter=max_iter, max_move=max_move, du0=r.du, pattern=pattern)  # sets free
+                               max_iter=max_iter, max_move=max_move, du0=r.du, p0=r.p, pattern=pattern)  # sets free
             last.solves_iterations = total + last.iterations
             return last
     raise NewtonFailed(f"the contact's active set kept changing over {2 * max_outer} solves", [])

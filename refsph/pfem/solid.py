@@ -426,7 +426,7 @@ def _shared_pattern(pattern: dict | None, mesh: Mesh, n: int, fix: np.ndarray):
 
 def newton_step(nodes: Nodes, mesh: Mesh, hist: History, law: SolidLaw, dt: float, loads: Loads,
                 dynamic: bool = True, tol: float = 1e-10, max_iter: int = 25, predictor: bool = True,
-                max_move: float | None = None, du0: np.ndarray | None = None,
+                max_move: float | None = None, du0: np.ndarray | None = None, p0: np.ndarray | None = None,
                 pattern: dict | None = None) -> StepResult:
     """Solve Eqs. (19)-(20) for the step's du and p by Newton-Raphson. Converged when the residual of the free
     displacement rows and that of the pressure rows are below ``tol`` times their scales (:func:`assemble`), or
@@ -436,9 +436,10 @@ def newton_step(nodes: Nodes, mesh: Mesh, hist: History, law: SolidLaw, dt: floa
     down, before the line search; None: no limit). Where elements flow plastically the tangent is soft, and a node
     on the tool (sliding, or frictionless) can get a correction of ten spacings from a residual that a few tenths
     of one remove; the line search alone then crawls (chapter 12). ``du0``: the first guess of du where the
-    predictor is off (default zeros). ``pattern``: a dict kept between the solves of one mesh and one set of held
-    dofs (the Newton matrix's sparsity pattern and ordering, :class:`FreeMatrix`, :func:`solve_linear`; found
-    again where the mesh or the held dofs differ). Raises :class:`NewtonFailed`."""
+    predictor is off (default zeros); ``p0``: the first guess of p (default the nodes' p at t_n). ``pattern``: a
+    dict kept between the solves of one mesh and one set of held dofs (the Newton matrix's sparsity pattern and
+    ordering, :class:`FreeMatrix`, :func:`solve_linear`; found again where the mesh or the held dofs differ).
+    Raises :class:`NewtonFailed`."""
     n = nodes.n
     size = None if max_move is None else _node_sizes(nodes, mesh)
     fixed = np.asarray(loads.fixed, dtype=bool).copy()
@@ -449,7 +450,7 @@ def newton_step(nodes: Nodes, mesh: Mesh, hist: History, law: SolidLaw, dt: floa
     if du0 is not None and not predictor:
         du = np.asarray(du0, dtype=float).copy()
     target = np.where(fixed, np.where(meshed[:, None] | bool(dynamic), loads.du_fixed, 0.0), du).ravel()
-    p = nodes.p.copy()
+    p = (nodes.p if p0 is None else np.asarray(p0, dtype=float)).copy()
     p[~meshed] = 0.0
     fix = np.concatenate([fixed.ravel(), ~meshed])
     f_ext = np.zeros(2 * n) if loads.f_ext is None else np.asarray(loads.f_ext, dtype=float).ravel()

@@ -29,7 +29,8 @@ __all__ = ["moment_min_eigenvalue", "surface_sph", "surface_alpha_shape", "circu
 def moment_min_eigenvalue(x: np.ndarray, V: np.ndarray, h: float, kernel: Kernel,
                           pairs: tuple | None = None) -> np.ndarray:
     """lambda_min of M_i = - sum_j V_j x_ij (x) grad_i W_ij (symmetric; about 1 inside, less where the support is
-    cut; 0 for an isolated particle). ``pairs``: the half pairs within the support, if the caller has them."""
+    cut; 0 for an isolated particle). ``pairs``: the half pairs, if the caller has them: those within the support
+    and any beyond it (they add zero: the kernel vanishes there)."""
     n, d = x.shape
     I, J = pairs if pairs is not None else find_pairs(x, kernel.support * h)
     dx = x[I] - x[J]

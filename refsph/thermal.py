@@ -228,7 +228,8 @@ def _step_limit(rho: np.ndarray, k: np.ndarray, c: np.ndarray, h: float, courant
 def free_surface(x: np.ndarray, V: np.ndarray, h: float, kernel: Kernel, loss: SurfaceLoss,
                  pairs: tuple | None = None) -> np.ndarray:
     """The free-surface rows by ``loss.detector`` (every particle of the scene takes part, so that a face in contact
-    with another body is not free). ``pairs``: the half pairs within the support, if the caller has them."""
+    with another body is not free). ``pairs``: the half pairs (at least those within the support), if the caller
+    has them."""
     if loss.detector == "alpha":
         return surface_alpha_shape(x, 1.0, alpha=loss.alpha_radius)
     return surface_sph(x, V, h, kernel, pairs=pairs)
@@ -244,15 +245,17 @@ def conduct(state, model: Conduction, h: float, kernel: Kernel, dt: float, cp: f
 def thermal_step(state, model: Conduction | None, k: np.ndarray, c: np.ndarray, h: float, kernel: Kernel,
                  dt: float, friction_heat: FrictionHeat | None = None, friction_power: np.ndarray | None = None,
                  tool_rows: np.ndarray | None = None, pairs: tuple | None = None,
-                 surface: np.ndarray | None = None) -> tuple[np.ndarray, dict]:
+                 surface: np.ndarray | None = None, pair_sum: PairSum | None = None) -> tuple[np.ndarray, dict]:
     """One explicit step dt of Eq. (29) with the harmonic-mean conductivity between materials (module text; ``k``,
     ``c``: per row, :func:`coefficients`; ``model`` None: no conduction), the frictional heat (``friction_power``:
     (N,) [W] per row, as the tool contact leaves it in ``Rates.friction_power``; split by ``friction_heat``:
     ``chip_fraction`` to the rows not in ``tool_rows``, the rest to the tool rows), the surface loss, then the fixed
     rows reset. Pairs are found in the current configuration, across bodies (heat flows from the chip into a
-    conducting tool); ``pairs``: the half pairs within the support, sorted by I then J, if the caller has them
-    (:class:`HeatFlow` keeps a Verlet list); ``surface``: the free-surface rows, if the caller has them (else found
-    here by ``model.loss.detector``). Returns (T, heat) with heat = {'friction', 'lost', 'removed'} [J; per
+    conducting tool); ``pairs``: the half pairs, sorted by I then J, if the caller has them: all those within the
+    support, and any beyond it, which add exactly nothing (the kernel's gradient is zero there: :class:`HeatFlow`
+    hands over its whole Verlet list, the same sums to the bit); ``pair_sum``: the :class:`PairSum` of ``pairs``,
+    if the caller keeps one; ``surface``: the free-surface rows, if the caller has them (else found here by
+    ``model.loss.detector``). Returns (T, heat) with heat = {'friction', 'lost', 'removed'} [J; per
     metre of thickness in 2D] moved in the step."""
     n, d = state.x.shape
     V = state.m / state.rho
@@ -265,7 +268,7 @@ def thermal_step(state, model: Conduction | None, k: np.ndarray, c: np.ndarray, 
         kk = k[I] + k[J]
         k_ij = np.divide(2.0 * k[I] * k[J], kk, out=np.zeros_like(kk), where=kk > 0)
         q = 2.0 * k_ij * (state.T[I] - state.T[J]) * fr            # antisymmetric pair flux
-        dT = dt * PairSum(I, J, n).antisymmetric(q, V) / (state.rho * c)
+        dT = dt * (PairSum(I, J, n) if pair_sum is None else pair_sum).antisymmetric(q, V) / (state.rho * c)
     if friction_heat is not None and friction_power is not None:
         tool = np.zeros(n, bool) if tool_rows is None else tool_rows
         share = np.where(tool, friction_heat.eta * (1.0 - friction_heat.chip_fraction),
@@ -312,6 +315,7 @@ class HeatFlow:
         self.ledger = {k: 0.0 for k in LEDGER}
         self.k = self.c = self.mc = self.T0 = self.tool_rows = None
         self.pairs = VerletList(kernel.support * h, SKIN * h)   # the heat step's pair search (module text)
+        self.pair_sum = None                                  # the PairSum of the Verlet list's pairs
         self.rho_of_return_map = "start"
 
     def bind(self, state, solver) -> None:
@@ -344,9 +348,9 @@ class HeatFlow:
         after = step.state
         self.ledger["plastic"] += self.plastic_heat(before, after)
         power = step.rates.friction_power if step.rates is not None else None
-        pairs = self.pairs_within_support(after.x)
+        pairs, pair_sum = self.pairs_and_sum(after.x)
         T, moved = thermal_step(after, self.conduction, self.k, self.c, self.h, self.kernel, dt, self.friction_heat,
-                                power, self.tool_rows, pairs, self.surface_rows(after, pairs))
+                                power, self.tool_rows, pairs, self.surface_rows(after, pairs), pair_sum)
         for key, val in moved.items():
             self.ledger[key] += val
         if self.dissipation_heat and step.rates is not None and step.rates.heat_power is not None:
@@ -374,16 +378,20 @@ class HeatFlow:
         self.surface_x = state.x.copy()
         return self.surface
 
-    def pairs_within_support(self, x: np.ndarray) -> tuple | None:
-        """The half pairs within the kernel's support, sorted by I then J: those of a Verlet list (cutoff the
-        support, a skin of ``SKIN`` h, rebuilt when a particle has moved half the skin) that lie within the
-        support now. The same list, in the same order, as a fresh search (:func:`refsph.neighbours.find_pairs`),
-        so the same sums to the bit, without a k-d tree every step. None without conduction (no pairs needed)."""
+    def pairs_and_sum(self, x: np.ndarray) -> tuple:
+        """((I, J), their :class:`PairSum`): the half pairs of a Verlet list (cutoff the support, a skin of
+        ``SKIN`` h, rebuilt when a particle has moved half the skin), sorted by I then J, and the sparse pattern of
+        their sums, both kept until the list is rebuilt. The pairs beyond the support add exactly nothing to the
+        sums (the kernel is zero there), and the pairs within it are those of a fresh search
+        (:func:`refsph.neighbours.find_pairs`) in the same order: the same sums to the bit, without a k-d tree,
+        a distance filter or a new sparse pattern every step. (None, None) without conduction."""
         if self.conduction is None:
-            return None
+            return None, None
+        builds = self.pairs.n_builds
         I, J = self.pairs.update(x)
-        keep = _distance2(x, I, J) <= self.pairs.cutoff ** 2
-        return I[keep], J[keep]
+        if self.pair_sum is None or self.pairs.n_builds != builds:
+            self.pair_sum = PairSum(I, J, len(x))
+        return (I, J), self.pair_sum
 
     def balance(self, state) -> dict:
         """The heat ledger [J; per metre of thickness in 2D]: made (plastic, friction, dissipation), stored

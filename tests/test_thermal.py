@@ -197,3 +197,35 @@ def test_the_surface_is_found_again_once_particles_have_moved_refresh_h():
     assert flow.surface_rows(st, None) is not first
     with pytest.raises(ValueError, match="refresh"):
         SurfaceLoss(h_c=10.0, emissivity=0.0, T_ambient=300.0, refresh=1.0)
+
+
+def test_heat_flow_with_its_verlet_list_gives_the_temperatures_of_a_fresh_search_to_the_bit():
+    """HeatFlow.advance hands thermal_step its whole Verlet list (pairs up to the support plus the skin) and one
+    PairSum kept until the list is rebuilt: the pairs beyond the support add exactly zero, so the temperatures are
+    those of thermal_step with a fresh search of the pairs within the support, bit for bit, also across rebuilds
+    (and with the free surface found from either list)."""
+    import copy
+
+    from refsph.integrate import Step
+    from refsph.scenes import aisi4340_material
+    from refsph.state import make_state
+    from refsph.thermal import Conduction, HeatFlow, SurfaceLoss, thermal_step
+    dp, h = 1e-4, 1.5e-4
+    rng = np.random.default_rng(3)
+    st = make_state(lattice([12 * dp, 8 * dp], dp), [0.0, 0.0], aisi4340_material().rho0, dp * dp, T0=300.0)
+    st.T = 300.0 + 500.0 * np.exp(-np.sum((st.x - 6 * dp) ** 2, axis=1) / (3 * dp) ** 2)
+    cond = Conduction(k=50.0, courant=0.2, loss=SurfaceLoss(h_c=1e4, emissivity=0.5, T_ambient=300.0, refresh=0.0))
+    flow = HeatFlow(cond, None, 480.0, 0.0, h, KERNEL)
+    flow.bind(st, None)
+    k, c = flow.k, flow.c
+    ref = copy.deepcopy(st)
+    dt = 0.5 * flow.step_limit(st)
+    for _ in range(12):                                   # 0.04 h a step: the list (skin 0.3 h) is rebuilt
+        move = 0.04 * h * rng.standard_normal(st.x.shape)
+        before = copy.deepcopy(st)
+        st.x = st.x + move
+        ref.x = ref.x + move
+        st = flow.advance(before, Step(st, None), dt)
+        ref.T = thermal_step(ref, cond, k, c, h, KERNEL, dt)[0]
+        np.testing.assert_array_equal(st.T, ref.T)
+    assert flow.pairs.n_builds >= 2 and np.ptp(st.T) > 100.0

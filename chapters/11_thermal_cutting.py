@@ -262,7 +262,7 @@ for label, cases_run in drawn.items():
 # Steel (cases 1–9) is the easier material: every method is within a few tens of per cent on the temperatures,
 # and every method underestimates the force ratio. Titanium conducts heat seven times worse than steel, so its
 # shear zones stay hot and narrow: both of the paper's methods overestimate its rake-face temperature, by several
-# hundred kelvin, and so does refsph in the titanium case it has run.
+# hundred kelvin, and so does refsph in all nine titanium cases at $t_u/5$.
 
 # %% [markdown]
 # ## 6. What the remedies and choices cost
@@ -287,15 +287,16 @@ for title in ("## Mass scaling", "## Run-to-run scatter", "## Resolution", "## T
 #   $\mu \approx 1.1$, above the law's 0.81: part of the measured thrust comes from the edge and the flank, and a
 #   sticking rake face cannot give more than the chip's shear flow stress times the contact length.
 # * **The pinball carries friction only while a pair approaches** (Eq. (34) makes the normal force zero while the
-#   particles separate): chapter 5 (continued) measures its effective $\mu$ at 0.1–0.5 of the law's on a dragged
-#   block, growing with the mass scale. The penalty contact gives the law's $\mu$ at every mass scale, which is
-#   why it is the default here; the page's contact table shows what the choice does to the cut.
+#   particles separate): on chapter 5's (continued) tilted plane its block slides at 0.07–0.46 of the closed-form
+#   acceleration, and a frictionless pinball plane still drags. The penalty contact gives the law's $\mu$ and the
+#   closed form at every mass scale, which is why it is the default here; the page's contact table shows what the
+#   choice does to the cut.
 #
 # %% [markdown]
 # * **What "rake-face temperature" means.** The paper does not say how its source measured $T_{RF}$ (a radiation
 #   measurement of the rake face "without manipulating the chip flow"): refsph fixed the contact mean as its
-#   definition before the sweep and prints the hottest contact particle beside it. The two differ by 50–300 K, more
-#   than most of the errors compared.
+#   definition before the sweep and prints the hottest contact particle beside it. The two differ by 27 K (case 1
+#   at $t_u/10$) to 340 K (at $t_u/5$), more than most of the errors compared.
 # * **Resolution and steadiness.** Ten particles across $t_u$ still put two to three particles across the
 #   secondary shear zone; the resolution table and the drift columns say which digits hold.
 # * **Mass scaling** changes inertia by the factor $s$; the page shows what halving it changes, to be set against
@@ -383,8 +384,8 @@ print(f"{QUANTITY}, refsph / measured - 1: " + ", ".join(f"case {n} {100 * e:+.0
 # The same sign in every steel case, for all three quantities: the force ratio 35–60 % too low, the free chip
 # surface 7–15 % too cold, the rake face too cold by an error that grows with the cutting speed (0 % at 60 m/min
 # and the thinnest chip, over 30 % at 180 m/min). A systematic error points at the model (friction, the edge and
-# flank forces, heat that the measurement sees and the model does not make), not at noise; the one titanium case
-# is wrong the other way, far too hot.
+# flank forces, heat that the measurement sees and the model does not make), not at noise; the titanium cases
+# are wrong the other way, far too hot.
 # </details>
 
 # %% [markdown]

@@ -436,10 +436,9 @@ def newton_step(nodes: Nodes, mesh: Mesh, hist: History, law: SolidLaw, dt: floa
     down, before the line search; None: no limit). Where elements flow plastically the tangent is soft, and a node
     on the tool (sliding, or frictionless) can get a correction of ten spacings from a residual that a few tenths
     of one remove; the line search alone then crawls (chapter 12). ``du0``: the first guess of du where the
-    predictor is off (default zeros); ``p0``: the first guess of p (default the nodes' p at t_n). ``pattern``: a
-    dict kept between the solves of one mesh and one set of held dofs (the Newton matrix's sparsity pattern and
-    ordering, :class:`FreeMatrix`, :func:`solve_linear`; found again where the mesh or the held dofs differ).
-    Raises :class:`NewtonFailed`."""
+    predictor is off (default zeros); ``p0``: that of p (default p at t_n). ``pattern``: a dict kept between the
+    solves of one mesh and one set of held dofs (the Newton matrix's sparsity pattern and ordering,
+    :class:`FreeMatrix`, :func:`solve_linear`; found again where they differ). Raises :class:`NewtonFailed`."""
     n = nodes.n
     size = None if max_move is None else _node_sizes(nodes, mesh)
     fixed = np.asarray(loads.fixed, dtype=bool).copy()

@@ -14,17 +14,18 @@ that say which digits of them mean something (issue 22).
 
 Each run is ``refsph run thermal_cutting --case N`` with the sweep's numerics (:func:`converged`: dx = t_u / 10, 16
 t_u of cut on a workpiece 28 t_u long, a tool 10 t_u x 6 t_u, the mass-scaling rule s rho vc^2 = 0.01 A, the penalty
-contact, the numerical dissipation turned into heat; means over the last quarter of the cut) in
-``runs/thermal_cutting/<key>/`` on one core (about 40 minutes for a steel case). The studies (``--study``):
-``coarse`` (all 18 cases at t_u/5, keys 'case N n_tu 5': the complete table while the t_u/10 sweep runs, and the
-only Ti6Al4V one so far: case 10 breaks down at t_u/10, see the page), ``scaling`` (s halved: cases 1 and 10),
-``scatter`` (case 1 with its particles jittered by 0.01 dx, three seeds; first at t_u/5), ``resolution`` (t_u/5 and
-t_u/15 for cases 1 and 10), ``tool`` (the first sweep's tool 5 t_u x 3 t_u and 4 t_u left uncut, one change at a
-time, at t_u/5 and t_u/10), ``contact`` (the pinball; all the frictional heat to the chip). Resumable twice over: a
-finished run is a record in ``benchmarks/thermal_cutting.json`` and is skipped; a run that was killed continues from
-its last snapshot (``refsph run --restart``). A run that fails (non-finite state, lost chip) is a record with its
-status and error; it stays in the table until ``--redo`` runs it again, and a failed rerun never replaces a good
-record. A rerun with nothing to do writes nothing.
+contact, the numerical dissipation turned into heat; means over the last quarter of the cut; Ti6Al4V with the step
+at courant 0.15 instead of the scene's 0.3, :func:`sweep_numerics`: at 0.3 case 10 breaks down at 1.1 ms, a particle
+under the edge inverting) in ``runs/thermal_cutting/<key>/`` on one core (40-50 minutes a case beside another run).
+The studies (``--study``): ``coarse`` (all 18 cases at t_u/5, keys 'case N n_tu 5': the complete table while the
+t_u/10 sweep runs), ``scaling`` (s halved: cases 1 and 10), ``scatter`` (case 1 with its particles jittered by 0.01
+dx, three seeds; first at t_u/5), ``resolution`` (t_u/5 and t_u/15 for cases 1 and 10), ``timestep`` (case 10 at the
+scene's step, which fails, and case 1 at Ti6Al4V's), ``tool`` (the first sweep's tool 5 t_u x 3 t_u and 4 t_u left
+uncut, one change at a time, at t_u/5 and t_u/10), ``contact`` (the pinball; all the frictional heat to the chip).
+Resumable twice over: a finished run is a record in ``benchmarks/thermal_cutting.json`` and is skipped; a run that
+was killed continues from its last snapshot (``refsph run --restart``). A run that fails (non-finite state, lost
+chip) is a record with its status and error; it stays in the table until ``--redo`` runs it again, and a failed
+rerun never replaces a good record. A rerun with nothing to do writes nothing.
 
 The experimental values are not printed in the paper: ``refsph.paper_data.RLA_CUTTING_CASES`` recovers them from
 each printed prediction and its printed percent error. The paper does not state the width of cut, so forces are
@@ -83,10 +84,20 @@ def _s(case: int) -> float:
     return mass_scale_for(MATERIALS[row["material"]], row["vc_m_per_min"] / 60.0, INERTIA)
 
 
-STUDY_NAMES = ("cases", "coarse", "pfem", "detector", "scaling", "scatter", "resolution", "tool", "contact")
+STUDY_NAMES = ("cases", "coarse", "pfem", "detector", "scaling", "scatter", "resolution", "timestep", "tool",
+               "contact")
+TI_COURANT = 0.15                          # Ti6Al4V at dx <= t_u / 10: half the scene's step (module text)
 COARSE = " n_tu 5"                         # the key suffix of the 'coarse' study: all 18 cases at dx = t_u / 5
 PFEM = " pfem n_tu 5"                      # the key suffix of the 'pfem' study: the 18 cases with the PFEM at t_u / 5
 PFEM_OPTIONS = ("case", "n_tu", "travel", "length", "gamma")   # the sweep's options the PFEM cut takes (tool: TOOL)
+
+
+def sweep_numerics(case: int, n_tu: float = N_TU, **more) -> dict:
+    """The Numerics overrides of a case's SPH run: Ti6Al4V at dx <= t_u / 10 takes the step at courant TI_COURANT
+    (at the scene's 0.3 case 10 breaks down at 1.1 ms, module text), everything else the scene's."""
+    from refsph.paper_data import rla_cutting_case
+    ti = rla_cutting_case(case)["material"] == "Ti6Al4V" and n_tu >= N_TU
+    return dict(dict(courant=TI_COURANT) if ti else {}, **more)
 
 
 def jobs(studies=STUDY_NAMES, only=None) -> dict:
@@ -117,13 +128,14 @@ def jobs(studies=STUDY_NAMES, only=None) -> dict:
             add("pfem", "case 1 pfem", converged(1, n_tu=10.0), dict(method="pfem"))
     add("pfem", "case 16 pfem gamma 0.6", dict(converged(16, n_tu=5.0), gamma=0.6), dict(method="pfem"))  # damped
     add("scaling", "case 1 s/2", converged(1, mass_scale=_s(1) / 2))
-    add("cases", "case 10", converged(10))
-    add("cases", "case 10 courant 0.15", converged(10), dict(courant=0.15))   # past the inverted particle at 1.1 ms?
-    add("scaling", "case 10 s/2", converged(10, mass_scale=_s(10) / 2))
+    add("timestep", "case 10 courant 0.3", converged(10))        # the scene's step: breaks down at 1.1 ms
+    add("cases", "case 10", converged(10), sweep_numerics(10))
+    add("scaling", "case 10 s/2", converged(10, mass_scale=_s(10) / 2), sweep_numerics(10))
     for seed in (1, 2, 3):
         add("scatter", f"case 1 jitter {seed}", converged(1, jitter=0.01, seed=seed))
     for n in list(range(2, 10)) + list(range(11, 19)):
-        add("cases", f"case {n}", converged(n))
+        add("cases", f"case {n}", converged(n), sweep_numerics(n))
+    add("timestep", "case 1 courant 0.15", converged(1), dict(courant=TI_COURANT))   # what Ti6Al4V's step moves
     # the tool and workpiece checks (the first sweep's tool 5 x 3 t_u and 4 t_u uncut, one change at a time)
     add("tool", "case 1 n_tu 5 tool 5x3, 4 t_u uncut", converged(1, n_tu=5.0, uncut=4.0, **SMALL))
     add("tool", "case 1 n_tu 5 tool 5x3, 8 t_u uncut", converged(1, n_tu=5.0, uncut=8.0, **SMALL))
@@ -132,7 +144,7 @@ def jobs(studies=STUDY_NAMES, only=None) -> dict:
     add("contact", "case 1 pinball", converged(1), dict(contact="pinball"))
     add("contact", "case 1 all friction heat to the chip", converged(1, chip_fraction=1.0))
     add("resolution", "case 1 n_tu 15", converged(1, n_tu=15.0))
-    add("resolution", "case 10 n_tu 15", converged(10, n_tu=15.0))
+    add("resolution", "case 10 n_tu 15", converged(10, n_tu=15.0), sweep_numerics(10, 15.0))
     return todo
 
 
@@ -438,9 +450,11 @@ STUDIES = (
      ("case 1 pfem short n_tu 5", "case 1 pfem short n_tu 10", "case 1 pfem n_tu 5", "case 1 pfem"),
      (("across t_u", "across", ".0f"), ("dx [um]", "dx_um", ".1f"), ("nodes", "n_particles", "d")) + BASIC
      + (("steps", "n_steps", "d"), ("wall [s]", "wall", ".0f"))),
-    ("Case 10 (Ti6Al4V) at t_u/10 and its time step: at courant 0.3 a particle on the torn surface under the edge "
-     "inverts at 1.1 ms (a local explicit instability); at half the step?",
-     ("case 10 n_tu 5", "case 10", "case 10 courant 0.15"), BASIC),
+    ("The time step (Ti6Al4V at t_u/10 runs at courant 0.15: at the scene's 0.3 a particle on the torn surface under "
+     "case 10's edge inverts at 1.1 ms, a local explicit instability; case 1 at 0.15 says what half the step moves "
+     "in a case that runs at 0.3)",
+     ("case 10 n_tu 5", "case 10 courant 0.3", "case 10", "case 1", "case 1 courant 0.15"),
+     BASIC + (("steps", "n_steps", "d"), ("wall [s]", "wall", ".0f"))),
     ("The PFEM's time rule (case 16, Ti6Al4V, 60 m/min, 0.10 mm, t_u/5): the paper's trapezoidal rule rings in the "
      "chip and Newton stalls at 0.85 ms; the damped Newmark rule gamma = 0.6 (a departure from the paper)",
      ("case 16 pfem n_tu 5", "case 16 pfem gamma 0.6"),

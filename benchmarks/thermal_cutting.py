@@ -10,6 +10,7 @@ that say which digits of them mean something (issue 22).
     python benchmarks/thermal_cutting.py --redo "case 3"     # run one again (a failed record is kept until then)
     python benchmarks/thermal_cutting.py --report            # page and figures from the committed JSON only
     python benchmarks/thermal_cutting.py --status --study cases   # what is recorded, how far each run has got
+    python benchmarks/thermal_cutting.py --keys "case 1 s/2" "case 11"   # these runs, in this order
     python benchmarks/thermal_cutting.py --quick --json /tmp/q.json --only 1 2   # a try-out (quick cuts)
 
 Each run is ``refsph run thermal_cutting --case N`` with the sweep's numerics (:func:`converged`: dx = t_u / 10, 16
@@ -569,12 +570,17 @@ def main(argv=None) -> int:
     args = _parser().parse_args(argv)
     if args.quick and args.json == OUT_JSON:
         _parser().error("--quick writes try-out records: give them their own --json file")
+    todo = jobs(args.study or STUDY_NAMES, args.only)
+    if args.keys is not None:
+        unknown = [k for k in args.keys if k not in todo]
+        if unknown:
+            _parser().error(f"--keys: no such run in the studies asked for: {unknown}")
+        todo = {k: todo[k] for k in args.keys}
     if args.status:
-        todo = jobs(args.study or STUDY_NAMES, args.only)
         print("\n".join(status_lines(store(args.json).records(), todo, args.quick)))
         return 0
     if not args.report:
-        if not sweep(store(args.json), jobs(args.study or STUDY_NAMES, args.only), args):
+        if not sweep(store(args.json), todo, args):
             print("nothing ran: every run asked for is recorded; the JSON, the page and the figures are unchanged "
                   "(--redo KEY runs one again, --report rewrites the page)")
             return 0
@@ -596,6 +602,8 @@ def _parser():
                     help="which runs: the 18 cases, the mass-scaling, scatter, resolution, tool-size and contact "
                          "checks (default: all, in the order jobs() gives)")
     ap.add_argument("--redo", nargs="*", default=(), help="keys to run again (e.g. 'case 3')")
+    ap.add_argument("--keys", nargs="*", default=None,
+                    help="only these runs, by key, in this order (e.g. 'case 1 s/2' 'case 11'; keys of --study)")
     study.add_flags(ap, "report", "quick", report=dict(help="table and figures from the committed JSON only"),
                     quick=dict(help="quick short cuts (a try-out; give --json elsewhere)"))
     ap.add_argument("--json", type=Path, default=OUT_JSON, help="the records (default: the committed JSON)")

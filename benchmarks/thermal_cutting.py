@@ -139,6 +139,9 @@ def jobs(studies=STUDY_NAMES, only=None) -> dict:
         add("cases", f"case {n}", converged(n), sweep_numerics(n))
     add("timestep", "case 1 courant 0.15", converged(1), dict(courant=TI_COURANT))   # what Ti6Al4V's step moves
     add("timestep", f"case 10{COARSE} courant 0.15", converged(10, n_tu=5.0), dict(courant=TI_COURANT))
+    add("timestep", f"case 1{COARSE} courant 0.15", converged(1, n_tu=5.0), dict(courant=0.15))
+    add("timestep", f"case 10{COARSE} courant 0.075", converged(10, n_tu=5.0), dict(courant=0.075))
+    add("timestep", f"case 1{COARSE} courant 0.075", converged(1, n_tu=5.0), dict(courant=0.075))
     # the tool and workpiece checks (the first sweep's tool 5 x 3 t_u and 4 t_u uncut, one change at a time)
     add("tool", "case 1 n_tu 5 tool 5x3, 4 t_u uncut", converged(1, n_tu=5.0, uncut=4.0, **SMALL))
     add("tool", "case 1 n_tu 5 tool 5x3, 8 t_u uncut", converged(1, n_tu=5.0, uncut=8.0, **SMALL))
@@ -456,7 +459,8 @@ STUDIES = (
     ("The time step (Ti6Al4V at t_u/10 runs at courant 0.15: at the scene's 0.3 a particle on the torn surface under "
      "case 10's edge inverts at 1.1 ms, a local explicit instability; case 1 at 0.15 says what half the step moves "
      "in a case that runs at 0.3)",
-     ("case 10 n_tu 5", "case 10 n_tu 5 courant 0.15", "case 10 courant 0.3", "case 10", "case 1",
+     ("case 10 n_tu 5", "case 10 n_tu 5 courant 0.15", "case 10 n_tu 5 courant 0.075", "case 10 courant 0.3",
+      "case 10", "case 1 n_tu 5", "case 1 n_tu 5 courant 0.15", "case 1 n_tu 5 courant 0.075", "case 1",
       "case 1 courant 0.15"),
      BASIC + (("steps", "n_steps", "d"), ("wall [s]", "wall", ".0f"))),
     ("The PFEM's time rule (case 16, Ti6Al4V, 60 m/min, 0.10 mm, t_u/5): the paper's trapezoidal rule rings in the "

@@ -153,3 +153,36 @@ def test_scene_options_and_refusals():
         scene.setup(case=19)
     with pytest.raises(ValueError, match="friction"):
         run("thermal_cutting", "esph", quick=True, progress=False, options=dict(length=0.6e-3, travel=1.0))
+
+
+def test_metrics_flag_a_temperature_blow_up_and_the_sweep_does_not_count_it(monkeypatch, tmp_path):
+    """thermal_cutting_metrics: a particle hotter than BLOW_UP times T_melt adds 'blow_up' (when, and why the numbers
+    after it mean nothing), a sane run has no such key (its metrics as before); the sweep records such a run as
+    'blow-up', not 'ok'."""
+    import importlib.util
+    from pathlib import Path
+    from types import SimpleNamespace
+
+    from refsph.scenes.thermal_cutting import BLOW_UP, MATERIALS, thermal_cutting_metrics
+    t = np.linspace(0.0, 1e-3, 41)
+    T_melt = MATERIALS["AISI1045"]["T_melt_K"]
+    hist = dict(t=t, T_RF=600 + 0 * t, T_RF_max=650 + 0 * t, T_FCS=500 + 0 * t, chip_mm=0.3 + 0 * t,
+                contact_mm=0.3 + 0 * t, max_T=700 + 0 * t, max_eps_p=2 + 0 * t,
+                reaction=dict(t=t, dt=np.full(41, 2.5e-5), tool=np.tile([4e5, 1.7e5], (41, 1))))
+    info = dict(vc_m_s=1.0, mass_scale=100.0, inertia_ratio=0.01, material="AISI1045")
+    assert "blow_up" not in thermal_cutting_metrics(hist, info, 1e-3)
+    hist["max_T"] = np.where(t > 0.8e-3, 1.01 * BLOW_UP * T_melt, 700.0)
+    m = thermal_cutting_metrics(hist, info, 1e-3)
+    assert "blow_up" in m and f"t = {t[t > 0.8e-3][0]:.4e} s" in m["blow_up"]
+    spec = importlib.util.spec_from_file_location(
+        "bench_tc", Path(__file__).resolve().parent.parent / "benchmarks" / "thermal_cutting.py")
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    import refsph.simulate
+    for metrics, status in ((dict(m), "blow-up"), ({k: v for k, v in m.items() if k != "blow_up"}, "ok")):
+        summary = dict(status="ok", metrics=metrics, n_particles=10, n_steps=41, wall_time_s=1.0, dp=1e-5,
+                       scene_info={}, heat_balance={})
+        monkeypatch.setattr(refsph.simulate, "run", lambda *a, **k: SimpleNamespace(summary=summary))
+        monkeypatch.setattr(mod, "RUNS", tmp_path)
+        rec = mod.run_case("case 1", dict(case=1), {})
+        assert rec["status"] == status and (status == "ok" or rec["error"].startswith("a particle at"))

@@ -81,6 +81,7 @@ __all__ = ["SCENE", "MATERIALS", "tool_particles", "tool_shape", "mass_scale_for
            "drift", "thermal_cutting_metrics", "thermal_cutting_table", "STEADY_FROM"]
 
 STEADY_FROM = 0.75              # means over the last quarter of the cut
+BLOW_UP = 2.0                   # a particle above this multiple of T_melt [K] is a numerical blow-up (metrics)
 RAKE_DEG, CLEARANCE_DEG, EDGE_RADIUS = 10.0, 10.0, 10e-6
 MATERIALS = {"AISI1045": AISI1045_RLA, "Ti6Al4V": TI6AL4V_RLA}
 OPTIONS = {
@@ -297,7 +298,11 @@ def drift(t, v, t_from: float, t_end: float, weights=None) -> float:
 
 def thermal_cutting_metrics(hist: dict, info: dict, t_end: float) -> dict:
     """The ``metrics`` of a run from its history (the recorded measures and the tool's reaction): means over the
-    last quarter of the cut (``STEADY_FROM``) and the drift of each over that quarter (:func:`drift`)."""
+    last quarter of the cut (``STEADY_FROM``) and the drift of each over that quarter (:func:`drift`); and, only
+    where a particle got hotter than ``BLOW_UP`` times the melting temperature, ``blow_up``: when, and that the
+    numbers after it are not to be trusted (no material model of refsph means anything there; such a particle is
+    a local numerical instability, e.g. two particles of the chip's free surface closing to half a spacing and
+    oscillating against each other, their artificial viscosity heating them)."""
     r = hist["reaction"]
     t_r, dt, F = np.asarray(r["t"]), np.asarray(r["dt"]), np.asarray(r["tool"])
     t_from = STEADY_FROM * t_end
@@ -324,6 +329,12 @@ def thermal_cutting_metrics(hist: dict, info: dict, t_end: float) -> dict:
         cutting_force_history=np.stack([tb, cb], axis=1), passive_force_history=np.stack([tb, pb], axis=1),
         temperature_history=np.stack([np.asarray(hist["t"]), np.asarray(hist["T_RF"], dtype=float),
                                       np.asarray(hist["T_FCS"], dtype=float)], axis=1))
+    blow_up = np.flatnonzero(np.asarray(hist["max_T"]) > BLOW_UP * MATERIALS[info["material"]]["T_melt_K"])
+    if len(blow_up):                                 # only then: a run that stayed sane keeps its metrics as they were
+        k = int(blow_up[0])
+        out["blow_up"] = (f"a particle at {hist['max_T'][k]:.0f} K at t = {hist['t'][k]:.4e} s, over {BLOW_UP:g} times "
+                          f"the melting temperature: a local numerical blow-up; the temperatures after it (and the "
+                          f"forces, through the softening) are not the material's")
     row = info.get("measured")
     if row:
         out["measured"] = dict(Fc_N=row["Fc_exp_N"], Fp_N=row["Fp_exp_N"], T_RF_K=row["TRF_exp_K"],

@@ -132,6 +132,8 @@ def jobs(studies=STUDY_NAMES, only=None) -> dict:
             add("pfem", "case 1 pfem", converged(1, n_tu=10.0), dict(method="pfem"))
     add("pfem", "case 16 pfem gamma 0.6", dict(converged(16, n_tu=5.0), gamma=0.6), dict(method="pfem"))  # damped
     add("scaling", "case 1 s/2", converged(1, mass_scale=_s(1) / 2))
+    add("scaling", f"case 1{COARSE} s/2", converged(1, n_tu=5.0, mass_scale=_s(1) / 2))   # beside the t_u/5 scatter
+    add("scaling", f"case 10{COARSE} s/2", converged(10, n_tu=5.0, mass_scale=_s(10) / 2))
     add("timestep", "case 10 courant 0.3", converged(10))        # the scene's step: breaks down at 1.1 ms
     add("cases", "case 10", converged(10), sweep_numerics(10))
     add("scaling", "case 10 s/2", converged(10, mass_scale=_s(10) / 2), sweep_numerics(10))
@@ -433,7 +435,8 @@ BASIC = (("Fc [N/mm]", "Fc", ".1f"), ("Fp [N/mm]", "Fp", ".1f"), ("Fp/Fc", "forc
          ("contact [mm]", "contact_length_mm", ".3f"))
 STUDIES = (
     ("Mass scaling: s halved (the rule's factor 0.01 A in s rho vc^2 = 0.01 A halved to 0.005 A)",
-     ("case 1", "case 1 s/2", "case 10", "case 10 s/2"),
+     ("case 1", "case 1 s/2", "case 10", "case 10 s/2", "case 1 n_tu 5", "case 1 n_tu 5 s/2", "case 10 n_tu 5",
+      "case 10 n_tu 5 s/2"),
      (("s", "mass_scale", ".0f"), ("s rho vc^2 / A", "inertia_ratio", ".4f")) + BASIC
      + (("viscosity + damping heat [% of work]", "dissipation_of_work", ".1f"), ("steps", "n_steps", "d"),
         ("wall [s]", "wall", ".0f"))),

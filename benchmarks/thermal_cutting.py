@@ -88,18 +88,17 @@ def _s(case: int) -> float:
 
 STUDY_NAMES = ("cases", "coarse", "pfem", "detector", "scaling", "scatter", "resolution", "timestep", "tool",
                "contact")
-TI_COURANT = 0.15                          # Ti6Al4V at dx <= t_u / 10: half the scene's step (module text)
+COURANT = 0.15                             # every run at dx <= t_u / 10: half the scene's step (module text)
 COARSE = " n_tu 5"                         # the key suffix of the 'coarse' study: all 18 cases at dx = t_u / 5
 PFEM = " pfem n_tu 5"                      # the key suffix of the 'pfem' study: the 18 cases with the PFEM at t_u / 5
 PFEM_OPTIONS = ("case", "n_tu", "travel", "length", "gamma")   # the sweep's options the PFEM cut takes (tool: TOOL)
 
 
-def sweep_numerics(case: int, n_tu: float = N_TU, **more) -> dict:
-    """The Numerics overrides of a case's SPH run: Ti6Al4V at dx <= t_u / 10 takes the step at courant TI_COURANT
-    (at the scene's 0.3 case 10 breaks down at 1.1 ms, module text), everything else the scene's."""
-    from refsph.paper_data import rla_cutting_case
-    ti = rla_cutting_case(case)["material"] == "Ti6Al4V" and n_tu >= N_TU
-    return dict(dict(courant=TI_COURANT) if ti else {}, **more)
+def sweep_numerics(n_tu: float = N_TU, **more) -> dict:
+    """The Numerics overrides of an SPH run of the sweep: at dx <= t_u / 10 the step at courant COURANT (at the
+    scene's 0.3 case 10 breaks down at 1.1 ms and case 2 blows up at 2.25 ms, module text); at t_u / 5 the
+    scene's."""
+    return dict(dict(courant=COURANT) if n_tu >= N_TU else {}, **more)
 
 
 def jobs(studies=STUDY_NAMES, only=None) -> dict:
@@ -112,7 +111,7 @@ def jobs(studies=STUDY_NAMES, only=None) -> dict:
         if study_name in studies and (study_name not in ("cases", "coarse", "pfem") or only is None
                                       or options["case"] in only):
             todo[key] = (options, dict(numerics or {}))
-    add("cases", "case 1", converged(1))
+    add("cases", "case 1", converged(1), sweep_numerics())
     for seed in (1, 2, 3):                                   # the scatter: first at t_u/5 (an eighth of the cost)
         add("scatter", f"case 1 n_tu 5 jitter {seed}", converged(1, n_tu=5.0, jitter=0.01, seed=seed))
     for seed in (1, 2, 3):                                   # Ti6Al4V's scatter (its time-step runs differ by more)
@@ -131,18 +130,19 @@ def jobs(studies=STUDY_NAMES, only=None) -> dict:
                     dict(method="pfem"))
             add("pfem", "case 1 pfem", converged(1, n_tu=10.0), dict(method="pfem"))
     add("pfem", "case 16 pfem gamma 0.6", dict(converged(16, n_tu=5.0), gamma=0.6), dict(method="pfem"))  # damped
-    add("scaling", "case 1 s/2", converged(1, mass_scale=_s(1) / 2))
+    add("scaling", "case 1 s/2", converged(1, mass_scale=_s(1) / 2), sweep_numerics())
     add("scaling", f"case 1{COARSE} s/2", converged(1, n_tu=5.0, mass_scale=_s(1) / 2))   # beside the t_u/5 scatter
     add("scaling", f"case 10{COARSE} s/2", converged(10, n_tu=5.0, mass_scale=_s(10) / 2))
     add("timestep", "case 10 courant 0.3", converged(10))        # the scene's step: breaks down at 1.1 ms
-    add("cases", "case 10", converged(10), sweep_numerics(10))
-    add("scaling", "case 10 s/2", converged(10, mass_scale=_s(10) / 2), sweep_numerics(10))
+    add("cases", "case 10", converged(10), sweep_numerics())
+    add("scaling", "case 10 s/2", converged(10, mass_scale=_s(10) / 2), sweep_numerics())
     for seed in (1, 2, 3):
-        add("scatter", f"case 1 jitter {seed}", converged(1, jitter=0.01, seed=seed))
+        add("scatter", f"case 1 jitter {seed}", converged(1, jitter=0.01, seed=seed), sweep_numerics())
     for n in list(range(2, 10)) + list(range(11, 19)):
-        add("cases", f"case {n}", converged(n), sweep_numerics(n))
-    add("timestep", "case 1 courant 0.15", converged(1), dict(courant=TI_COURANT))   # what Ti6Al4V's step moves
-    add("timestep", f"case 10{COARSE} courant 0.15", converged(10, n_tu=5.0), dict(courant=TI_COURANT))
+        add("cases", f"case {n}", converged(n), sweep_numerics())
+    for n in (1, 2):                                          # the scene's step at t_u/10 (the first runs)
+        add("timestep", f"case {n} courant 0.3", converged(n))
+    add("timestep", f"case 10{COARSE} courant 0.15", converged(10, n_tu=5.0), dict(courant=COURANT))
     add("timestep", f"case 1{COARSE} courant 0.15", converged(1, n_tu=5.0), dict(courant=0.15))
     add("timestep", f"case 2{COARSE} courant 0.15", converged(2, n_tu=5.0), dict(courant=0.15))
     add("timestep", f"case 10{COARSE} courant 0.075", converged(10, n_tu=5.0), dict(courant=0.075))
@@ -151,11 +151,11 @@ def jobs(studies=STUDY_NAMES, only=None) -> dict:
     add("tool", "case 1 n_tu 5 tool 5x3, 4 t_u uncut", converged(1, n_tu=5.0, uncut=4.0, **SMALL))
     add("tool", "case 1 n_tu 5 tool 5x3, 8 t_u uncut", converged(1, n_tu=5.0, uncut=8.0, **SMALL))
     add("tool", "case 1 n_tu 5 4 t_u uncut", converged(1, n_tu=5.0, uncut=4.0))
-    add("tool", "case 1 tool 5x3, 4 t_u uncut", converged(1, uncut=4.0, **SMALL))
-    add("contact", "case 1 pinball", converged(1), dict(contact="pinball"))
-    add("contact", "case 1 all friction heat to the chip", converged(1, chip_fraction=1.0))
-    add("resolution", "case 1 n_tu 15", converged(1, n_tu=15.0))
-    add("resolution", "case 10 n_tu 15", converged(10, n_tu=15.0), sweep_numerics(10, 15.0))
+    add("tool", "case 1 tool 5x3, 4 t_u uncut", converged(1, uncut=4.0, **SMALL))      # (at the scene's step)
+    add("contact", "case 1 pinball", converged(1), sweep_numerics(contact="pinball"))
+    add("contact", "case 1 all friction heat to the chip", converged(1, chip_fraction=1.0), sweep_numerics())
+    add("resolution", "case 1 n_tu 15", converged(1, n_tu=15.0), sweep_numerics(15.0))
+    add("resolution", "case 10 n_tu 15", converged(10, n_tu=15.0), sweep_numerics(15.0))
     return todo
 
 
@@ -446,15 +446,16 @@ STUDIES = (
      ("case 1 n_tu 5", "case 1 n_tu 5 jitter 1", "case 1 n_tu 5 jitter 2", "case 1 n_tu 5 jitter 3"), BASIC),
     ("Run-to-run scatter of Ti6Al4V at t_u/5 (case 10, the same perturbation)",
      ("case 10 n_tu 5", "case 10 n_tu 5 jitter 1", "case 10 n_tu 5 jitter 2", "case 10 n_tu 5 jitter 3"), BASIC),
-    ("Resolution (particles across t_u)",
-     ("case 1 n_tu 5", "case 1", "case 1 n_tu 15", "case 10 n_tu 5", "case 10", "case 10 n_tu 15"),
+    ("Resolution (particles across t_u; at courant 0.15)",
+     ("case 1 n_tu 5 courant 0.15", "case 1", "case 1 n_tu 15", "case 10 n_tu 5 courant 0.15", "case 10",
+      "case 10 n_tu 15"),
      (("across t_u", "across", ".0f"), ("dx [um]", "dx_um", ".1f"), ("particles", "n_particles", "d")) + BASIC
      + (("steps", "n_steps", "d"), ("wall [s]", "wall", ".0f"))),
     ("Tool and workpiece size (the sweep: the tool 10 t_u x 6 t_u, 12 t_u left uncut at the end of the cut; the "
      "first sweep's tool 5 t_u x 3 t_u, whose back face the chip's contact (4 t_u) nearly reached, and 4 t_u "
      "uncut, one change at a time; at t_u/5, where a run costs an eighth, and at t_u/10)",
      ("case 1 n_tu 5 tool 5x3, 4 t_u uncut", "case 1 n_tu 5 tool 5x3, 8 t_u uncut", "case 1 n_tu 5 4 t_u uncut",
-      "case 1 n_tu 5", "case 1 tool 5x3, 4 t_u uncut", "case 1"),
+      "case 1 n_tu 5", "case 1 tool 5x3, 4 t_u uncut", "case 1 courant 0.3"),
      BASIC + (("removed at held faces [% of work]", "removed_of_work", ".1f"), ("Fc drift [%]", "Fc_drift_pct", ".1f"),
               ("T_RF drift [K]", "TRF_drift", ".0f"))),
     ("Free-surface detector of the heat losses (the paper's future work: the alpha-shape instead of the SPH "
@@ -466,12 +467,13 @@ STUDIES = (
      ("case 1 pfem short n_tu 5", "case 1 pfem short n_tu 10", "case 1 pfem n_tu 5", "case 1 pfem"),
      (("across t_u", "across", ".0f"), ("dx [um]", "dx_um", ".1f"), ("nodes", "n_particles", "d")) + BASIC
      + (("steps", "n_steps", "d"), ("wall [s]", "wall", ".0f"))),
-    ("The time step (Ti6Al4V at t_u/10 runs at courant 0.15: at the scene's 0.3 a particle on the torn surface under "
-     "case 10's edge inverts at 1.1 ms, a local explicit instability; case 1 at 0.15 says what half the step moves "
-     "in a case that runs at 0.3)",
+    ("The time step (the sweep at t_u/10 runs at courant 0.15: at the scene's 0.3 a particle on the torn surface "
+     "under case 10's edge inverts at 1.1 ms, and in case 2 two particles of the chip's free surface oscillate "
+     "against each other from 2.25 ms, heating 54 particles past 1500 K; at t_u/5 the scene's 0.3, whose results "
+     "move with the step by no more than the run-to-run scatter)",
      ("case 10 n_tu 5", "case 10 n_tu 5 courant 0.15", "case 10 n_tu 5 courant 0.075", "case 10 courant 0.3",
-      "case 10", "case 1 n_tu 5", "case 1 n_tu 5 courant 0.15", "case 1 n_tu 5 courant 0.075", "case 1",
-      "case 1 courant 0.15", "case 2 n_tu 5", "case 2 n_tu 5 courant 0.15", "case 2"),
+      "case 10", "case 1 n_tu 5", "case 1 n_tu 5 courant 0.15", "case 1 n_tu 5 courant 0.075", "case 1 courant 0.3",
+      "case 1", "case 2 n_tu 5", "case 2 n_tu 5 courant 0.15", "case 2 courant 0.3", "case 2"),
      BASIC + (("max T [K]", "max_temperature_K", ".0f"), ("steps", "n_steps", "d"), ("wall [s]", "wall", ".0f"))),
     ("The PFEM's time rule (case 16, Ti6Al4V, 60 m/min, 0.10 mm, t_u/5): the paper's trapezoidal rule rings in the "
      "chip and Newton stalls at 0.85 ms; the damped Newmark rule gamma = 0.6 (a departure from the paper)",

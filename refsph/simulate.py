@@ -604,8 +604,25 @@ def run(scene_name: str, method: str, *, dim: int | None = None, dp: float | Non
     that need the scene's own particle layout are then reported as ``metrics_error``. ``overwrite``: see
     :func:`simulate` (``out`` of another scene, method or not a run)."""
     setup, scene, metrics, args = _prepare(scene_name, method, dim, dp, t_end, quick, dt, numerics, options, particles)
+    if restart and out is not None:
+        _check_same_run(Path(out), args)
     return simulate(setup, method, scene=scene, out=out, dt=dt, progress=progress, restart=restart,
                     meta=dict(run_args=args), metrics=metrics, overwrite=overwrite)
+
+
+def _check_same_run(out: Path, args: dict) -> None:
+    """A restart continues the run of ``out`` only with the arguments it was made with (``summary.json``'s
+    ``run_args``): with others (another time step, another option) its checkpoint would be continued under other
+    numerics and the result be neither run's. ValueError naming what differs."""
+    try:
+        made = json.loads((out / "summary.json").read_text()).get("run_args")
+    except (OSError, ValueError):
+        return                                              # no summary: _begin says what is missing
+    asked = json.loads(json.dumps(json_ready(args)))
+    if made is not None and made != asked:
+        diff = {k: (made.get(k), asked.get(k)) for k in sorted(set(made) | set(asked)) if made.get(k) != asked.get(k)}
+        raise ValueError(f"{out} holds a run made with other arguments (made with, asked: {diff}); continue it as "
+                         f"it was made (refsph run --restart {out}) or start the new run in another folder")
 
 
 def _prepare(scene_name, method, dim, dp, t_end, quick, dt, numerics, options, particles):

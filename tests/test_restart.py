@@ -140,3 +140,18 @@ def test_run_from_external_particles(tmp_path, capsys):
     np.savez(f, x=s.x, m=s.m)
     assert main(["run", "pressing", "--quick", "--quiet", "--from", str(f), "--out", str(tmp_path / "q")]) == 2
     assert "missing array(s) v" in capsys.readouterr().err
+
+
+def test_a_restart_with_other_arguments_is_refused(tmp_path, monkeypatch):
+    """run(..., restart=True) continues a run folder only with the arguments it was made with: a killed run asked to
+    go on at another time step (or with another option) is refused with what differs, and nothing is written;
+    with its own arguments it goes on."""
+    kw = dict(dim=2, quick=True, t_end=6e-6)
+    _killed(monkeypatch, "taylor", "tlsph", tmp_path / "cut", kw)
+    before = (tmp_path / "cut" / "summary.json").read_text()
+    with pytest.raises(ValueError, match="other arguments.*courant"):
+        run("taylor", "tlsph", out=tmp_path / "cut", progress=False, restart=True, numerics=dict(courant=0.15), **kw)
+    with pytest.raises(ValueError, match="other arguments.*t_end"):
+        run("taylor", "tlsph", out=tmp_path / "cut", progress=False, restart=True, **dict(kw, t_end=5e-6))
+    assert (tmp_path / "cut" / "summary.json").read_text() == before
+    assert run("taylor", "tlsph", out=tmp_path / "cut", progress=False, restart=True, **kw).summary["status"] == "ok"

@@ -299,6 +299,8 @@ for title in ("## Mass scaling", "## Run-to-run scatter", "## Resolution", "## T
 #   at $t_u/10$) to 340 K (at $t_u/5$), more than most of the errors compared.
 # * **Resolution and steadiness.** Ten particles across $t_u$ still put two to three particles across the
 #   secondary shear zone; the resolution table and the drift columns say which digits hold.
+#
+# %% [markdown]
 # * **Mass scaling** changes inertia by the factor $s$; the page shows what halving it changes, to be set against
 #   the run-to-run scatter.
 # * **The time step.** At $t_u/10$ the scene's step (Courant 0.3) broke two of three runs: a particle of case 10

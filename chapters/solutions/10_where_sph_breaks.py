@@ -44,7 +44,7 @@ assert round(tl, 2) == round(es3, 2) == 0.94 and round(es0, 2) == 0.78
 # 2543): the step is the CFL step of the elastic wave speed, which the penalty does not enter (at a very large
 # $\alpha$ it would stiffen the particle-scale modes beyond it). The restitution moves from 0.71 to 0.74, a little
 # *more* bounce: without control, some of the impact's energy went into the collapsing zig-zag mode instead of the
-# rebound. The closest pair goes from 0.001 to 0.79 dp. The cost is one more pair sum per force evaluation (the
+# rebound. The closest pair goes from a few thousandths of dp to 0.79 dp. The cost is one more pair sum per force evaluation (the
 # wall times are printed; on a loaded machine they scatter). $\alpha$ = 10, LAMMPS's default, keeps the lattice
 # too, at the same steps; 0.1 does not stop the collapse (about 10 s a run, not rerun here).
 
@@ -54,8 +54,10 @@ print(f"steps {r1.summary['n_steps']} / {r0.summary['n_steps']}, restitution {m1
       f"{m0['min_pair_distance_over_dp']:.3f} dp, wall {wall1:.1f} / {wall0:.1f} s  (alpha = {ALPHA:g} / none)")
 a1 = quick("rings", "tlsph", dict(hourglass=1.0), t_end=45e-6)
 assert abs(a1[2].summary["n_steps"] - 2546) < 10 and abs(r0.summary["n_steps"] - 2543) < 10
-assert round(a1[0]["restitution"], 2) == 0.74 and round(m0["restitution"], 2) == 0.71
-assert m0["min_pair_distance_over_dp"] < 0.002 and round(a1[0]["min_pair_distance_over_dp"], 2) == 0.79
+assert abs(a1[0]["restitution"] - 0.74) < 0.01 and abs(m0["restitution"] - 0.71) < 0.01
+assert m0["min_pair_distance_over_dp"] < 0.01 and abs(a1[0]["min_pair_distance_over_dp"] - 0.79) < 0.02
+# (a collapsed pair's distance is a few thousandths of dp, its digits round-off: 0.0012 or 0.0023 from one NumPy
+# or SciPy release to the next)
 
 # %% [markdown]
 # ### Solution 3 — Spin faster

@@ -44,11 +44,12 @@ for key in ("rake_face_temperature_K", "rake_face_temperature_max_K", "max_tempe
             "free_chip_surface_temperature_K", "force_ratio", "cutting_force_N_per_m"):
     print(f"{key:33s} with heat flow {on[key]:10.2f}, adiabatic {off[key]:10.2f}")
 assert adiabatic.summary.get("heat_balance") is None                    # no heat flow, no ledger
-assert [round(on[k]) for k in ("rake_face_temperature_K", "rake_face_temperature_max_K", "max_temperature_K")] == \
-    [531, 621, 648]
-assert [round(off[k]) for k in ("rake_face_temperature_K", "rake_face_temperature_max_K", "max_temperature_K")] == \
-    [573, 993, 1069]
-assert round(on["free_chip_surface_temperature_K"] - off["free_chip_surface_temperature_K"]) == 27
+# the numbers of the text to 2 K: the contact's stick/slip switches carry round-off from one NumPy or SciPy release
+# to the next into the hottest particles (the adiabatic T_RF max: 992.5 K with one, 992.49 K with the next)
+keys = ("rake_face_temperature_K", "rake_face_temperature_max_K", "max_temperature_K")
+assert np.allclose([on[k] for k in keys], [531, 621, 648], rtol=0, atol=2)
+assert np.allclose([off[k] for k in keys], [573, 993, 1069], rtol=0, atol=2)
+assert abs(on["free_chip_surface_temperature_K"] - off["free_chip_surface_temperature_K"] - 27) < 2
 assert abs(off["force_ratio"] / on["force_ratio"] - 1) < 0.1 and abs(
     off["cutting_force_N_per_m"] / on["cutting_force_N_per_m"] - 1) < 0.05
 assert 55e-6 < np.sqrt(steel["k_W_mK"] * res.setup.t_end / (steel["rho"] * steel["cp_J_kgK"])) < 65e-6

@@ -45,7 +45,7 @@ class ReferenceConfiguration:
         self.constant: tuple | None = None                 # (whole m, X, V0) -> their deformable rows (views)
         self.n_updates = 0
         self.cache_counts = [0, 0]                         # momentum-sum cache hits, misses of dropped operators
-        self.F_after_step: tuple | None = None             # (operator, x, F) of the last end_step (a cache)
+        self.F_known: tuple | None = None                  # (operator, x, F) of the last F computed (a cache)
 
     def rows(self, state: State, n: int) -> State:
         """The deformable rows [0, n) as a state of views (the whole state if there is no tool). The views of the
@@ -91,17 +91,28 @@ class ReferenceConfiguration:
         return F
 
     def gradient_for_rates(self, body: State, ext: State, op: ReferenceOperator) -> np.ndarray:
-        """F for a rate evaluation: the one :meth:`end_step` computed if it belongs to this operator and these
-        positions (used once), else Eq. (18) anew."""
-        known, self.F_after_step = self.F_after_step, None
+        """F for a rate evaluation: the last one computed (by :meth:`end_step` or by a rate evaluation) if it belongs
+        to this operator and these positions, else Eq. (18) anew (then kept for :meth:`end_step`)."""
+        F = self._known_gradient(body, op)
+        if F is None:
+            F = self.deformation_gradient(ext, op)
+            self.F_known = (op, body.x.copy(), F)
+        return F
+
+    def _known_gradient(self, body: State, op: ReferenceOperator) -> np.ndarray | None:
+        """The kept F if it was computed on ``op`` at exactly these positions (element by element), else None.
+        The stepper's last rate evaluation of a step and :meth:`end_step` see the same x (the leapfrog's closing
+        force), and so do :meth:`end_step` and the next step's first evaluation (the predictor-corrector)."""
+        known = self.F_known
         if known is not None and known[0] is op and np.array_equal(known[1], body.x):
             return known[2]
-        return self.deformation_gradient(ext, op)
+        return None
 
     def end_step(self, state: State, n: int, several_bodies: bool) -> State:
         """rho = m / (J V0) (Eq. (2)) on the deformable rows; a reference update when max |E| >
         ``ref_update_strain``. The F computed here is kept for the first rate evaluation of the next step, which
-        starts from this very configuration (it is used only if x is unchanged, checked element by element).
+        starts from this very configuration; it is the rate evaluation's own F where that one saw the same x (the
+        check is element by element, so the result is the same bits either way).
 
         A particle with J <= 0 is inverted (the motion is no longer one-to-one there; Eq. (2) would give it a
         negative density and volume): ValueError naming it, which fails the step (a Lagrangian code's 'negative
@@ -109,7 +120,9 @@ class ReferenceConfiguration:
         non-finite check."""
         body = self.rows(state, n)
         op = self.operator(body, several_bodies)
-        F_ext = self.deformation_gradient(self.extended(body, op), op)
+        F_ext = self._known_gradient(body, op)
+        if F_ext is None:
+            F_ext = self.deformation_gradient(self.extended(body, op), op)
         F = F_ext[:body.n]
         J = det(F)
         inverted = np.flatnonzero(J <= 0.0)
@@ -127,9 +140,9 @@ class ReferenceConfiguration:
             self.drop()
             self.operator(self.rows(state, n), several_bodies)
             self.n_updates += 1
-            self.F_after_step = None
+            self.F_known = None
         else:
-            self.F_after_step = (op, body.x.copy(), F_ext)
+            self.F_known = (op, body.x.copy(), F_ext)
         return state
 
     def drop(self) -> None:

@@ -131,6 +131,8 @@ class State:
         """(field, particle index) of the first NaN/inf in an evolving field, or None."""
         for name in ("x", "v", "rho", "S", "S_zz") + (PLASTIC_FIELDS if self.plastic else ()):
             a = getattr(self, name)
+            if np.isfinite(np.sum(a)):              # a NaN or inf anywhere makes the sum NaN or inf: the fast check
+                continue                            # (a sum that overflows from finite values falls through)
             bad = ~np.isfinite(a.reshape(a.shape[0], -1)).all(axis=1)
             if bad.any():
                 return name, int(np.flatnonzero(bad)[0])

@@ -65,8 +65,8 @@ from .neighbours import PairSum, VerletList, find_pairs
 from .surface import surface_alpha_shape, surface_sph
 
 __all__ = ["laplacian", "conduction_rate", "thermal_time_step", "advance_at_rest", "Conduction", "SurfaceLoss",
-           "FrictionHeat", "HeatFlow", "coefficients", "conduct", "thermal_step", "thermal_step_limit",
-           "free_surface", "STEFAN_BOLTZMANN"]
+           "FrictionHeat", "HeatFlow", "coefficients", "pair_conductivity", "conduct", "thermal_step",
+           "thermal_step_limit", "free_surface", "STEFAN_BOLTZMANN"]
 
 
 def laplacian(f: np.ndarray, x: np.ndarray, V: np.ndarray, h: float, kernel: Kernel,
@@ -235,6 +235,13 @@ def free_surface(x: np.ndarray, V: np.ndarray, h: float, kernel: Kernel, loss: S
     return surface_sph(x, V, h, kernel, pairs=pairs)
 
 
+def pair_conductivity(k: np.ndarray, I: np.ndarray, J: np.ndarray) -> np.ndarray:
+    """2 k_ij per half pair, k_ij = 2 k_i k_j / (k_i + k_j) the harmonic mean (module text; 0 where both are 0): the
+    factor of Eq. (29)'s pair flux 2 k_ij (T_i - T_j) (dW/dr) / r, fixed while the pairs and k are."""
+    kk = k[I] + k[J]
+    return 2.0 * np.divide(2.0 * k[I] * k[J], kk, out=np.zeros_like(kk), where=kk > 0)
+
+
 def conduct(state, model: Conduction, h: float, kernel: Kernel, dt: float, cp: float, rigid_ids=()) -> np.ndarray:
     """The temperatures after an explicit conduction step of dt (module text), fixed particles reset: the
     temperatures of :func:`thermal_step` without frictional heat."""
@@ -245,7 +252,8 @@ def conduct(state, model: Conduction, h: float, kernel: Kernel, dt: float, cp: f
 def thermal_step(state, model: Conduction | None, k: np.ndarray, c: np.ndarray, h: float, kernel: Kernel,
                  dt: float, friction_heat: FrictionHeat | None = None, friction_power: np.ndarray | None = None,
                  tool_rows: np.ndarray | None = None, pairs: tuple | None = None,
-                 surface: np.ndarray | None = None, pair_sum: PairSum | None = None) -> tuple[np.ndarray, dict]:
+                 surface: np.ndarray | None = None, pair_sum: PairSum | None = None,
+                 k_pair: np.ndarray | None = None) -> tuple[np.ndarray, dict]:
     """One explicit step dt of Eq. (29) with the harmonic-mean conductivity between materials (module text; ``k``,
     ``c``: per row, :func:`coefficients`; ``model`` None: no conduction), the frictional heat (``friction_power``:
     (N,) [W] per row, as the tool contact leaves it in ``Rates.friction_power``; split by ``friction_heat``:
@@ -254,7 +262,8 @@ def thermal_step(state, model: Conduction | None, k: np.ndarray, c: np.ndarray, 
     conducting tool); ``pairs``: the half pairs, sorted by I then J, if the caller has them: all those within the
     support, and any beyond it, which add exactly nothing (the kernel's gradient is zero there: :class:`HeatFlow`
     hands over its whole Verlet list, the same sums to the bit); ``pair_sum``: the :class:`PairSum` of ``pairs``,
-    if the caller keeps one; ``surface``: the free-surface rows, if the caller has them (else found here by
+    if the caller keeps one; ``k_pair``: 2 k_ij of every pair of ``pairs`` (:func:`pair_conductivity`), if the
+    caller keeps it; ``surface``: the free-surface rows, if the caller has them (else found here by
     ``model.loss.detector``). Returns (T, heat) with heat = {'friction', 'lost', 'removed'} [J; per
     metre of thickness in 2D] moved in the step."""
     n, d = state.x.shape
@@ -265,9 +274,9 @@ def thermal_step(state, model: Conduction | None, k: np.ndarray, c: np.ndarray, 
     if model is not None:
         I, J, fr = _pairs_and_fr(state.x, h, kernel, pairs)
         pairs = (I, J)
-        kk = k[I] + k[J]
-        k_ij = np.divide(2.0 * k[I] * k[J], kk, out=np.zeros_like(kk), where=kk > 0)
-        q = 2.0 * k_ij * (state.T[I] - state.T[J]) * fr            # antisymmetric pair flux
+        if k_pair is None:
+            k_pair = pair_conductivity(k, I, J)
+        q = k_pair * (np.take(state.T, I) - np.take(state.T, J)) * fr      # antisymmetric pair flux
         dT = dt * (PairSum(I, J, n) if pair_sum is None else pair_sum).antisymmetric(q, V) / (state.rho * c)
     if friction_heat is not None and friction_power is not None:
         tool = np.zeros(n, bool) if tool_rows is None else tool_rows
@@ -316,6 +325,7 @@ class HeatFlow:
         self.k = self.c = self.mc = self.T0 = self.tool_rows = None
         self.pairs = VerletList(kernel.support * h, SKIN * h)   # the heat step's pair search (module text)
         self.pair_sum = None                                  # the PairSum of the Verlet list's pairs
+        self.k_pair = None                                    # and their 2 k_ij (pair_conductivity)
         self.rho_of_return_map = "start"
 
     def bind(self, state, solver) -> None:
@@ -350,7 +360,7 @@ class HeatFlow:
         power = step.rates.friction_power if step.rates is not None else None
         pairs, pair_sum = self.pairs_and_sum(after.x)
         T, moved = thermal_step(after, self.conduction, self.k, self.c, self.h, self.kernel, dt, self.friction_heat,
-                                power, self.tool_rows, pairs, self.surface_rows(after, pairs), pair_sum)
+                                power, self.tool_rows, pairs, self.surface_rows(after, pairs), pair_sum, self.k_pair)
         for key, val in moved.items():
             self.ledger[key] += val
         if self.dissipation_heat and step.rates is not None and step.rates.heat_power is not None:
@@ -381,16 +391,17 @@ class HeatFlow:
     def pairs_and_sum(self, x: np.ndarray) -> tuple:
         """((I, J), their :class:`PairSum`): the half pairs of a Verlet list (cutoff the support, a skin of
         ``SKIN`` h, rebuilt when a particle has moved half the skin), sorted by I then J, and the sparse pattern of
-        their sums, both kept until the list is rebuilt. The pairs beyond the support add exactly nothing to the
-        sums (the kernel is zero there), and the pairs within it are those of a fresh search
-        (:func:`refsph.neighbours.find_pairs`) in the same order: the same sums to the bit, without a k-d tree,
-        a distance filter or a new sparse pattern every step. (None, None) without conduction."""
+        their sums, both kept until the list is rebuilt, and with them the pairs' 2 k_ij (``k_pair``). The pairs
+        beyond the support add exactly nothing to the sums (the kernel is zero there), and the pairs within it are
+        those of a fresh search (:func:`refsph.neighbours.find_pairs`) in the same order: the same sums to the bit,
+        without a k-d tree, a distance filter or a new sparse pattern every step. (None, None) without conduction."""
         if self.conduction is None:
             return None, None
         builds = self.pairs.n_builds
         I, J = self.pairs.update(x)
         if self.pair_sum is None or self.pairs.n_builds != builds:
             self.pair_sum = PairSum(I, J, len(x))
+            self.k_pair = pair_conductivity(self.k, I, J)
         return (I, J), self.pair_sum
 
     def balance(self, state) -> dict:

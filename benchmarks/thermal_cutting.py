@@ -122,6 +122,10 @@ def jobs(studies=STUDY_NAMES, only=None) -> dict:
         add("coarse", f"case {n}{COARSE}", converged(n, n_tu=5.0))
     for n in (1, 10):                                        # the paper's future work: alpha-shape vs SPH detector
         add("detector", f"case {n}{COARSE} alpha detector", converged(n, n_tu=5.0, detector="alpha"))
+    # case 10's alpha-shape run inverted a particle at 3.9 ms at the scene's step: again at courant 0.15, beside
+    # 'case 10 n_tu 5 courant 0.15' (the 'timestep' study)
+    add("detector", f"case 10{COARSE} alpha detector courant 0.15", converged(10, n_tu=5.0, detector="alpha"),
+        dict(courant=0.15))
     for n in [1, 10] + [k for k in range(2, 19) if k != 10]:   # the PFEM: cases 1 and 10 first
         add("pfem", f"case {n}{PFEM}", converged(n, n_tu=5.0), dict(method="pfem"))
         if n == 10:                                          # the PFEM's resolution, on the short cut of --quick,
@@ -459,8 +463,10 @@ STUDIES = (
      BASIC + (("removed at held faces [% of work]", "removed_of_work", ".1f"), ("Fc drift [%]", "Fc_drift_pct", ".1f"),
               ("T_RF drift [K]", "TRF_drift", ".0f"))),
     ("Free-surface detector of the heat losses (the paper's future work: the alpha-shape instead of the SPH "
-     "detector; t_u/5)",
-     ("case 1 n_tu 5", "case 1 n_tu 5 alpha detector", "case 10 n_tu 5", "case 10 n_tu 5 alpha detector"),
+     "detector; t_u/5; case 10's alpha-shape run at the scene's courant 0.3 inverted a particle, so the pair is "
+     "also run at 0.15)",
+     ("case 1 n_tu 5", "case 1 n_tu 5 alpha detector", "case 10 n_tu 5", "case 10 n_tu 5 alpha detector",
+      "case 10 n_tu 5 courant 0.15", "case 10 n_tu 5 alpha detector courant 0.15"),
      BASIC + (("lost at the surface [% of work]", "lost_of_work", ".3f"),)),
     ("The PFEM's resolution (case 1: the short cut of --quick, 4 t_u on a workpiece 1.2 mm long, and the full cut "
      "of 16 t_u)",

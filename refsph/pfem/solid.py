@@ -48,10 +48,17 @@ fill-reducing ordering (minimum degree on K^T + K) and the diagonal as pivots, s
 (mass / (beta dt^2) plus stiffness in the displacement rows, M_p / K + S / G in the pressure rows). That fills a
 third less than SciPy's default (column ordering with partial pivoting) and halves the time of a solve (8538
 unknowns: 0.057 against 0.113 s on one core); the result is checked (relative residual below 1e-8) and solved the
-default way where the check fails. The matrix is summed into a sparsity pattern found once per solve
+default way where the check fails. The matrix is summed into a sparsity pattern found once per mesh
 (:class:`FreeMatrix`: the held dofs' rows and columns already the identity), not built, masked and converted at
 every iteration. With the forward-difference tangent: the quick cut's first 40 steps take 20-23 s of CPU against
 38 s before both changes (timed back to back on a loaded machine), the forces the same to 1e-12.
+Tried on a Newton matrix of the t_u/10 short cut (8538 unknowns, 171,200 entries; one core) and left: the other
+orderings SuperLU offers (COLAMD 41 ms, minimum degree on K^T K 39 ms, against 28 ms, and a third to a half more
+fill), a nested dissection by breadth-first level sets (27-44 ms with the factor's 1.2-1.7 million entries against
+the minimum degree's 0.97 million and 17-20 ms with the ordering reused), SuperLU's panel size and relaxation (within
+10 %), and GMRES preconditioned by the last factorisation instead of a new one (the next Newton iteration's matrix,
+2 % away from the factored one: 29 GMRES iterations, 103 ms against a factorisation's 26 ms; a matrix 100 iterations
+later does not converge). The factorisation (about 40 % of a step) stays.
 
 **History.** Between remeshings each triangle keeps its own history (s, s_zz, eps_p, W_p, J); at a remeshing
 (Algorithm 1) a triangle that the new mesh keeps (the same three nodes) keeps its history, and a new triangle

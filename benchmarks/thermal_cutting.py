@@ -137,6 +137,12 @@ def jobs(studies=STUDY_NAMES, only=None) -> dict:
     add("scaling", "case 1 s/2", converged(1, mass_scale=_s(1) / 2), sweep_numerics())
     add("scaling", f"case 1{COARSE} s/2", converged(1, n_tu=5.0, mass_scale=_s(1) / 2))   # beside the t_u/5 scatter
     add("scaling", f"case 10{COARSE} s/2", converged(10, n_tu=5.0, mass_scale=_s(10) / 2))
+    # at t_u/5 s/2 moved case 1's temperatures by 3-7 of the scatter's standard deviations: the scatter at s/2
+    # (the same three seeds), then s/4, so that the temperatures' dependence on s is measured, not one run's
+    for seed in (1, 2, 3):
+        add("scaling", f"case 1{COARSE} s/2 jitter {seed}",
+            converged(1, n_tu=5.0, mass_scale=_s(1) / 2, jitter=0.01, seed=seed))
+    add("scaling", f"case 1{COARSE} s/4", converged(1, n_tu=5.0, mass_scale=_s(1) / 4))
     add("timestep", "case 10 courant 0.3", converged(10))        # the scene's step: breaks down at 1.1 ms
     add("cases", "case 10", converged(10), sweep_numerics())
     add("scaling", "case 10 s/2", converged(10, mass_scale=_s(10) / 2), sweep_numerics())
@@ -437,6 +443,7 @@ BASIC = (("Fc [N/mm]", "Fc", ".1f"), ("Fp [N/mm]", "Fp", ".1f"), ("Fp/Fc", "forc
          ("T_RF [K]", "rake_face_temperature_K", ".0f"), ("T_RF max [K]", "rake_face_temperature_max_K", ".0f"),
          ("T_FCS [K]", "free_chip_surface_temperature_K", ".0f"), ("chip [mm]", "chip_thickness_mm", ".3f"),
          ("contact [mm]", "contact_length_mm", ".3f"))
+SCATTER_KEYS = ("case 1", "case 1 jitter 1", "case 1 jitter 2", "case 1 jitter 3")   # the scatter at t_u/10
 STUDIES = (
     ("Mass scaling: s halved (the rule's factor 0.01 A in s rho vc^2 = 0.01 A halved to 0.005 A)",
      ("case 1", "case 1 s/2", "case 10", "case 10 s/2", "case 1 n_tu 5", "case 1 n_tu 5 s/2", "case 10 n_tu 5",
@@ -444,8 +451,17 @@ STUDIES = (
      (("s", "mass_scale", ".0f"), ("s rho vc^2 / A", "inertia_ratio", ".4f")) + BASIC
      + (("viscosity + damping heat [% of work]", "dissipation_of_work", ".1f"), ("steps", "n_steps", "d"),
         ("wall [s]", "wall", ".0f"))),
+    ("Run-to-run scatter at s/2 (t_u/5; the same three seeds): whether the mass scale moves the results by more "
+     "than the scatter, two groups of four runs",
+     ("case 1 n_tu 5 s/2", "case 1 n_tu 5 s/2 jitter 1", "case 1 n_tu 5 s/2 jitter 2", "case 1 n_tu 5 s/2 jitter 3"),
+     BASIC),
+    ("The mass scale at t_u/5: s, s/2 and s/4 (case 1, one run each; read with the two scatter tables)",
+     ("case 1 n_tu 5", "case 1 n_tu 5 s/2", "case 1 n_tu 5 s/4"),
+     (("s", "mass_scale", ".0f"),) + BASIC + (("friction heat [% of work]", "friction_of_work", ".1f"),
+                                             ("viscosity + damping heat [% of work]", "dissipation_of_work", ".1f"),
+                                             ("steps", "n_steps", "d"), ("wall [s]", "wall", ".0f"))),
     ("Run-to-run scatter: case 1 and three runs with the workpiece's particles moved at random by up to 0.01 dx",
-     ("case 1", "case 1 jitter 1", "case 1 jitter 2", "case 1 jitter 3"), BASIC),
+     SCATTER_KEYS, BASIC),
     ("Run-to-run scatter at t_u/5 (the same, where a run costs an eighth)",
      ("case 1 n_tu 5", "case 1 n_tu 5 jitter 1", "case 1 n_tu 5 jitter 2", "case 1 n_tu 5 jitter 3"), BASIC),
     ("Run-to-run scatter of Ti6Al4V at t_u/5 (case 10, the same perturbation)",
@@ -495,7 +511,7 @@ STUDIES = (
 def scatter(res: dict, keys=None) -> dict:
     """Mean and sample standard deviation (percent of the mean) of each basic quantity over case 1 and its jittered
     runs (``keys``: the runs of a scatter study; default the first), those recorded ok."""
-    keys = STUDIES[1][1] if keys is None else keys
+    keys = SCATTER_KEYS if keys is None else keys
     runs = [res["runs"][k] for k in keys if k in res["runs"] and res["runs"][k]["status"] == "ok"]
     out = {}
     for _, key, _ in BASIC:
@@ -525,7 +541,42 @@ def _study_lines(res: dict) -> list[str]:
                 lines += ["", "Spread (sample standard deviation over the runs, percent of their mean): " + ", ".join(
                     f"{name} {sc[key]['std_pct']:.1f} %" for name, key, _ in BASIC if key in sc)
                     + f" ({next(iter(sc.values()))['n']} runs)."]
+            other = COMPARED.get(keys)
+            if other is not None:
+                lines += ["", _difference_line(res, keys, other)]
     return lines
+
+
+COMPARED = {("case 1 n_tu 5 s/2", "case 1 n_tu 5 s/2 jitter 1", "case 1 n_tu 5 s/2 jitter 2",
+             "case 1 n_tu 5 s/2 jitter 3"):
+            ("case 1 n_tu 5", "case 1 n_tu 5 jitter 1", "case 1 n_tu 5 jitter 2", "case 1 n_tu 5 jitter 3")}
+# a scatter group -> the group it is compared with (_difference_line)
+
+
+def _groups(res: dict, keys) -> dict:
+    """{basic quantity: its values over the runs ``keys`` recorded ok}."""
+    runs = [res["runs"][k] for k in keys if k in res["runs"] and res["runs"][k]["status"] == "ok"]
+    return {key: np.array([_values(r)[key] for r in runs], dtype=float) for _, key, _ in BASIC}
+
+
+def _difference_line(res: dict, keys, other) -> str:
+    """The mean of each basic quantity over ``keys`` less its mean over ``other``, in percent of the latter, and
+    that difference in units of its standard error (Welch's t: the difference of the means over sqrt(s1^2 / n1 +
+    s2^2 / n2)); |t| above about 3 with four runs a side is a difference the scatter does not explain."""
+    a, b = _groups(res, keys), _groups(res, other)
+    parts = []
+    for name, key, _ in BASIC:
+        x, y = a[key], b[key]
+        if len(x) < 2 or len(y) < 2:
+            continue
+        se = np.sqrt(x.var(ddof=1) / len(x) + y.var(ddof=1) / len(y))
+        d = x.mean() - y.mean()
+        parts.append(f"{name} {100 * d / abs(y.mean()):+.1f} % (t = {d / se:+.1f})" if se > 0 else
+                     f"{name} {100 * d / abs(y.mean()):+.1f} %")
+    if not parts:
+        return f"Against {other[0]!r} and its jittered runs: not enough runs recorded yet."
+    return (f"Mean of these runs less the mean of {other[0]!r} and its jittered runs, percent of the latter (t: "
+            "the difference over its standard error): " + ", ".join(parts) + ".")
 
 
 def figures(res: dict) -> None:

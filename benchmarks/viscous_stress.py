@@ -1,0 +1,168 @@
+"""How large the artificial viscosity's stress is against the flow stress, in the last snapshot of thermal-cutting
+runs (issue 22, part 3: the mass-scaling rule chosen from the numerical stress it adds, stated).
+
+    python benchmarks/viscous_stress.py                      # every finished SPH run folder of the sweep
+    python benchmarks/viscous_stress.py --run DIR [DIR ..]   # these
+
+TLSPH's artificial viscosity (Eq. (17) with Eqs. (12)-(13), :func:`refsph.tlsph.reference_viscosity`) adds to a
+particle's acceleration -sum_j m_j pi_ij (B_i + B_j)/2 grad_0 W_ij, where the stress adds
+sum_j m_j (P_i / rho0_i^2 + P_j / rho0_j^2) grad_0 W_ij; a pressure q on both particles (P = -q B) gives the same
+term with pi_ij = 2 q / rho0^2. So a pair's viscous pressure is
+
+    q_ij = rho0^2 pi_ij / 2 = (rho0^2 / rho_bar) (beta1 c |mu_ij| + beta2 mu_ij^2) / 2,
+    mu_ij = h v_ij . x_ij / (|x_ij|^2 + eps h^2)   (approaching pairs, v_ij . x_ij < 0; else q_ij = 0)
+
+with c = sqrt(E / (s rho)) the (mass-scaled) sound speed of the viscosity. Each workpiece particle's viscous stress is
+the kernel-weighted mean over its reference pairs (those of the operator: |X_ij| <= 2h in the snapshot's reference
+configuration X), q_i = sum_j V_j q_ij W_ij / sum_j V_j W_ij, set against its von Mises stress (the flow stress
+where it flows), over the shear zones (the particles whose plastic strain rate is at least a quarter of the 99th
+percentile of the flowing particles'): its median and 90th percentile. Beside it the power the viscosity dissipates
+(:func:`~refsph.tlsph.reference_viscosity` on the snapshot's state, as the run computes it) against the plastic power
+sum_i V_i sigma_vm,i eps_dot_p,i, and where it is dissipated: in the layer on the tool (within 1.5 dx of the rake
+face, from 2 dx below the edge), in the shear zones, in the workpiece below the cut line (the machined surface's
+layer), elsewhere (the chip's body); and the viscosity's and the contact damping's share
+of the tool's work over the whole run, from its heat ledger. How these move with s (c ~ 1/sqrt(s)) is what the
+mass-scaling rule trades against the cost. Needs the sweep's run folders (``benchmarks/thermal_cutting.py``,
+git-ignored); writes viscous_stress.json next to this file (merged with the runs already recorded there).
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))      # benchmarks/study.py, however this file is loaded
+import study  # noqa: E402
+
+study.pin_threads()
+
+import numpy as np  # noqa: E402
+
+ROOT = Path(__file__).resolve().parents[1]
+RUNS = ROOT / "runs" / "thermal_cutting"
+OUT_JSON = Path(__file__).resolve().parent / "viscous_stress.json"
+
+
+def viscous_pressure(X, x, v, rho, V0, m, h, kernel, beta1, beta2, eps, c) -> np.ndarray:
+    """q_i (module text) [Pa] of each row from its reference pairs (|X_ij| <= support h)."""
+    from refsph.neighbours import PairSum, find_pairs
+    n, d = x.shape
+    I, J = find_pairs(X, kernel.support * h)
+    xij, vij = x[I] - x[J], v[I] - v[J]
+    vr = np.einsum("pd,pd->p", vij, xij)
+    mu = h * np.minimum(vr, 0.0) / (np.einsum("pd,pd->p", xij, xij) + eps * h * h)
+    rho0 = m / V0
+    rho0_bar, rho_bar = 0.5 * (rho0[I] + rho0[J]), 0.5 * (rho[I] + rho[J])
+    q = rho0_bar**2 / rho_bar * (beta1 * c * np.abs(mu) + beta2 * mu * mu) / 2.0
+    W = kernel.w(np.sqrt(np.einsum("pd,pd->p", X[I] - X[J], X[I] - X[J])), h, d)
+    sums = PairSum(I, J, n)
+    weight = sums.symmetric(W, V0) + V0 * kernel.w(np.zeros(1), h, d)[0]       # the particle itself: q_ii = 0
+    return sums.symmetric(q * W, V0) / weight
+
+
+def measure(run_dir: Path) -> dict:
+    """The viscous stress against the flow stress, and the viscosity's power against the plastic power, in the
+    run's last snapshot (module text)."""
+    from refsph.io import load_snapshot
+    from refsph.kernels import get_kernel
+    from refsph.scenes.thermal_cutting import rake_frame
+    from refsph.tensor import det, inv, transpose
+    from refsph.tlsph import ReferenceOperator, TLSPHParams, reference_viscosity
+    s = json.loads((run_dir / "summary.json").read_text())
+    if s.get("method") != "tlsph":
+        raise ValueError(f"{run_dir}: a TLSPH run folder is needed (method {s.get('method')!r})")
+    info, num, mat = s["scene_info"], s["numerics"], s["material"]
+    z = load_snapshot(run_dir / "snapshots" / s["snapshots"][-1])
+    w = slice(0, info["n_work"])
+    X, x, v, m, V0 = (np.asarray(z[k][w], dtype=float) for k in ("X", "x", "v", "m", "V0"))
+    kernel, h = get_kernel(num["kernel"]), float(s["h"])
+    c = float(np.sqrt(mat["E"] / mat["rho0"]))                      # material.c0 of the (mass-scaled) material
+    rho = np.asarray(z["rho"][w], dtype=float)
+    q = viscous_pressure(X, x, v, rho, V0, m, h, kernel, num["beta1"], num["beta2"], num["eps"], c)
+    # the viscosity's power per particle, as the run computes it (Rates.heat_power), on the snapshot's operator
+    prm = TLSPHParams(h=h, beta1=num["beta1"], beta2=num["beta2"], eps=num["eps"], kernel=kernel,
+                      corrected=num["corrected"], ref_update_strain=None, viscous_heat=True,
+                      max_condition=num.get("max_condition"))
+    op = ReferenceOperator(X, V0, h, kernel, num["corrected"], max_condition=num.get("max_condition"))
+    F = op.deformation_gradient(x)
+    J = det(F)
+    _, power_visc = reference_viscosity(x, v, m, m / (V0 * J), J[:, None, None] * transpose(inv(F, J)), op, c, prm)
+    svm, rate = np.asarray(z["sigma_vm"][w], dtype=float), np.asarray(z["eps_dot_p"][w], dtype=float)
+    power_plastic = m / rho * svm * rate                            # sigma : eps_dot_p = sigma_vm eps_dot_p (J2)
+    u, n = rake_frame(x, float(z["t"]), info)
+    dx = float(info["dx"])
+    at_tool = (n < 1.5 * dx) & (u > -2.0 * dx)                      # the layer on the rake face and round the edge
+    below = x[:, 1] < info["y0"]                                    # the machined workpiece under the cut line
+    flowing = rate > 0.0
+    zone = flowing & (rate >= 0.25 * np.quantile(rate[flowing], 0.99)) if flowing.any() else flowing
+    ratio = q / np.maximum(svm, 1e-9 * mat["E"])
+    hb = s.get("heat_balance") or {}
+    work = (s.get("metrics") or {}).get("tool_work_J_per_m")
+    total = float(power_visc.sum())
+
+    def share(sel):
+        return float(power_visc[sel].sum() / total) if total > 0 else None
+
+    def stats(sel):
+        r = ratio[sel]
+        return dict(n=int(sel.sum()), median=float(np.median(r)), p90=float(np.quantile(r, 0.9)),
+                    q_median_MPa=float(np.median(q[sel]) / 1e6), sigma_vm_median_MPa=float(np.median(svm[sel]) / 1e6))
+
+    return dict(run=run_dir.name, t_s=float(z["t"]), mass_scale=float(info["mass_scale"]), dx_m=dx, c_m_s=c,
+                beta1=num["beta1"], beta2=num["beta2"], shear_zones=stats(zone),
+                viscous_over_plastic_power=total / float(power_plastic.sum()),
+                viscous_power_share=dict(at_tool=share(at_tool), shear_zones=share(zone & ~at_tool),
+                                         below_cut=share(below & ~zone & ~at_tool),
+                                         elsewhere=share(~below & ~zone & ~at_tool)),
+                dissipation_of_work=(hb["dissipation_J"] / work if work and "dissipation_J" in hb else None))
+
+
+def report(rows: list) -> str:
+    head = ("run", "s", "dx [um]", "c [m/s]", "shear zones: q / sigma_vm median", "p90", "q median [MPa]",
+            "viscous / plastic power", "viscous power at the tool [%]", "in the shear zones [%]",
+            "below the cut line [%]", "elsewhere [%]",
+            "viscosity + damping heat, whole run [% of work]")
+    body = []
+    for r in rows:
+        sh = r["viscous_power_share"]
+        shares = [study.fmt(sh[k], ".0f", 100.0) for k in ("at_tool", "shear_zones", "below_cut", "elsewhere")]
+        body.append((r["run"], f"{r['mass_scale']:.0f}", f"{1e6 * r['dx_m']:.0f}", f"{r['c_m_s']:.0f}",
+                     f"{r['shear_zones']['median']:.3f}", f"{r['shear_zones']['p90']:.3f}",
+                     f"{r['shear_zones']['q_median_MPa']:.1f}", f"{r['viscous_over_plastic_power']:.3f}", *shares,
+                     study.fmt(r["dissipation_of_work"], ".1f", 100.0)))
+    return study.md_table(head, body)
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--run", nargs="*", type=Path, default=None, help="run folders (default: the sweep's finished "
+                    "SPH runs)")
+    args = ap.parse_args(argv)
+    if args.run:
+        runs = [Path(d).resolve() for d in args.run]
+        missing = [str(d) for d in runs if not (d / "summary.json").is_file()]
+        if missing:
+            print(f"not a run folder (no summary.json): {', '.join(missing)}", file=sys.stderr)
+            return 2
+    else:
+        runs = sorted(d for d in RUNS.glob("*") if study.run_status(d) == "ok"
+                      and json.loads((d / "summary.json").read_text()).get("method") == "tlsph")
+        if not runs:
+            print(f"no finished SPH run folder under {RUNS}: run benchmarks/thermal_cutting.py first",
+                  file=sys.stderr)
+            return 2
+    try:
+        fresh = [measure(d) for d in runs]
+    except (ValueError, KeyError, OSError) as e:
+        print(f"cannot measure: {e}", file=sys.stderr)
+        return 2
+    old = json.loads(OUT_JSON.read_text())["runs"] if OUT_JSON.is_file() else []
+    rows = study.merge_records(old, fresh, key="run")
+    study.write_json(OUT_JSON, dict(runs=rows, made_by="python benchmarks/viscous_stress.py"))
+    print(report(rows))
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -17,13 +17,14 @@ the kernel-weighted mean over its reference pairs (those of the operator: |X_ij|
 configuration X), q_i = sum_j V_j q_ij W_ij / sum_j V_j W_ij, set against its von Mises stress (the flow stress
 where it flows), over the shear zones (the particles whose plastic strain rate is at least a quarter of the 99th
 percentile of the flowing particles'): its median and 90th percentile. Beside it the power the viscosity dissipates
-(:func:`~refsph.tlsph.reference_viscosity` on the snapshot's state, as the run computes it) against the plastic power
-sum_i V_i sigma_vm,i eps_dot_p,i, and where it is dissipated: in the layer on the tool (within 1.5 dx of the rake
-face, from 2 dx below the edge), in the shear zones, in the workpiece below the cut line (the machined surface's
-layer), elsewhere (the chip's body); and the viscosity's and the contact damping's share
-of the tool's work over the whole run, from its heat ledger. How these move with s (c ~ 1/sqrt(s)) is what the
-mass-scaling rule trades against the cost. Needs the sweep's run folders (``benchmarks/thermal_cutting.py``,
-git-ignored); writes viscous_stress.json next to this file (merged with the runs already recorded there).
+(:func:`~refsph.tlsph.reference_viscosity` on the snapshot's state, as the run computes it but with the velocities
+of the snapshot, not of the half step) against the plastic power sum_i V_i sigma_vm,i eps_dot_p,i, and where it is
+dissipated: in the layer on the tool (within 1.5 dx of the rake face, from 2 dx below the edge), in the shear
+zones, under the cut line ahead of the edge (where the material is pressed down before it is cut) and behind it
+(the machined layer), elsewhere (the chip's body); and the viscosity's and the contact damping's share of the tool's
+work over the whole run, from its heat ledger. How these move with s (c ~ 1/sqrt(s)) is what the mass-scaling rule
+trades against the cost. Needs the sweep's run folders (``benchmarks/thermal_cutting.py``, git-ignored); writes
+viscous_stress.json next to this file (merged with the runs already recorded there).
 """
 from __future__ import annotations
 
@@ -73,6 +74,8 @@ def measure(run_dir: Path) -> dict:
     if s.get("method") != "tlsph":
         raise ValueError(f"{run_dir}: a TLSPH run folder is needed (method {s.get('method')!r})")
     info, num, mat = s["scene_info"], s["numerics"], s["material"]
+    if not s.get("snapshots"):
+        raise ValueError(f"{run_dir}: the run wrote no snapshot")
     z = load_snapshot(run_dir / "snapshots" / s["snapshots"][-1])
     w = slice(0, info["n_work"])
     X, x, v, m, V0 = (np.asarray(z[k][w], dtype=float) for k in ("X", "x", "v", "m", "V0"))
@@ -92,8 +95,9 @@ def measure(run_dir: Path) -> dict:
     power_plastic = m / rho * svm * rate                            # sigma : eps_dot_p = sigma_vm eps_dot_p (J2)
     u, n = rake_frame(x, float(z["t"]), info)
     dx = float(info["dx"])
-    at_tool = (n < 1.5 * dx) & (u > -2.0 * dx)                      # the layer on the rake face and round the edge
-    below = x[:, 1] < info["y0"]                                    # the machined workpiece under the cut line
+    at_tool = (np.abs(n) < 1.5 * dx) & (u > -2.0 * dx)              # the layer on the rake face and round the edge
+    below = x[:, 1] < info["y0"]                                    # under the cut line:
+    behind = x[:, 0] > info["apex0"][0] - info["vc_m_s"] * float(z["t"])   # the tool moves to -x: machined
     flowing = rate > 0.0
     zone = flowing & (rate >= 0.25 * np.quantile(rate[flowing], 0.99)) if flowing.any() else flowing
     ratio = q / np.maximum(svm, 1e-9 * mat["E"])
@@ -105,15 +109,18 @@ def measure(run_dir: Path) -> dict:
         return float(power_visc[sel].sum() / total) if total > 0 else None
 
     def stats(sel):
+        if not sel.any():
+            return dict(n=0, median=None, p90=None, q_median_MPa=None, sigma_vm_median_MPa=None)
         r = ratio[sel]
         return dict(n=int(sel.sum()), median=float(np.median(r)), p90=float(np.quantile(r, 0.9)),
                     q_median_MPa=float(np.median(q[sel]) / 1e6), sigma_vm_median_MPa=float(np.median(svm[sel]) / 1e6))
 
     return dict(run=run_dir.name, t_s=float(z["t"]), mass_scale=float(info["mass_scale"]), dx_m=dx, c_m_s=c,
                 beta1=num["beta1"], beta2=num["beta2"], shear_zones=stats(zone),
-                viscous_over_plastic_power=total / float(power_plastic.sum()),
+                viscous_over_plastic_power=total / float(power_plastic.sum()) if power_plastic.sum() > 0 else None,
                 viscous_power_share=dict(at_tool=share(at_tool), shear_zones=share(zone & ~at_tool),
-                                         below_cut=share(below & ~zone & ~at_tool),
+                                         ahead_below_cut=share(below & ~behind & ~zone & ~at_tool),
+                                         machined=share(below & behind & ~zone & ~at_tool),
                                          elsewhere=share(~below & ~zone & ~at_tool)),
                 dissipation_of_work=(hb["dissipation_J"] / work if work and "dissipation_J" in hb else None))
 
@@ -121,17 +128,26 @@ def measure(run_dir: Path) -> dict:
 def report(rows: list) -> str:
     head = ("run", "s", "dx [um]", "c [m/s]", "shear zones: q / sigma_vm median", "p90", "q median [MPa]",
             "viscous / plastic power", "viscous power at the tool [%]", "in the shear zones [%]",
-            "below the cut line [%]", "elsewhere [%]",
+            "ahead of the edge, under the cut line [%]", "machined layer [%]", "elsewhere [%]",
             "viscosity + damping heat, whole run [% of work]")
     body = []
     for r in rows:
-        sh = r["viscous_power_share"]
-        shares = [study.fmt(sh[k], ".0f", 100.0) for k in ("at_tool", "shear_zones", "below_cut", "elsewhere")]
+        sh, z = r["viscous_power_share"], r["shear_zones"]
+        shares = [study.fmt(sh[k], ".0f", 100.0)
+                  for k in ("at_tool", "shear_zones", "ahead_below_cut", "machined", "elsewhere")]
         body.append((r["run"], f"{r['mass_scale']:.0f}", f"{1e6 * r['dx_m']:.0f}", f"{r['c_m_s']:.0f}",
-                     f"{r['shear_zones']['median']:.3f}", f"{r['shear_zones']['p90']:.3f}",
-                     f"{r['shear_zones']['q_median_MPa']:.1f}", f"{r['viscous_over_plastic_power']:.3f}", *shares,
+                     study.fmt(z["median"], ".3f"), study.fmt(z["p90"], ".3f"), study.fmt(z["q_median_MPa"], ".1f"),
+                     study.fmt(r["viscous_over_plastic_power"], ".3f"), *shares,
                      study.fmt(r["dissipation_of_work"], ".1f", 100.0)))
     return study.md_table(head, body)
+
+
+def _method(run_dir: Path) -> str | None:
+    """The method in a run folder's summary.json (None if it cannot be read)."""
+    try:
+        return json.loads((run_dir / "summary.json").read_text()).get("method")
+    except (OSError, ValueError):
+        return None
 
 
 def main(argv=None) -> int:
@@ -146,15 +162,14 @@ def main(argv=None) -> int:
             print(f"not a run folder (no summary.json): {', '.join(missing)}", file=sys.stderr)
             return 2
     else:
-        runs = sorted(d for d in RUNS.glob("*") if study.run_status(d) == "ok"
-                      and json.loads((d / "summary.json").read_text()).get("method") == "tlsph")
+        runs = sorted(d for d in RUNS.glob("*") if study.run_status(d) == "ok" and _method(d) == "tlsph")
         if not runs:
             print(f"no finished SPH run folder under {RUNS}: run benchmarks/thermal_cutting.py first",
                   file=sys.stderr)
             return 2
     try:
         fresh = [measure(d) for d in runs]
-    except (ValueError, KeyError, OSError) as e:
+    except (ValueError, KeyError, IndexError, OSError) as e:
         print(f"cannot measure: {e}", file=sys.stderr)
         return 2
     old = json.loads(OUT_JSON.read_text())["runs"] if OUT_JSON.is_file() else []

@@ -131,8 +131,10 @@ class State:
         """(field, particle index) of the first NaN/inf in an evolving field, or None."""
         for name in ("x", "v", "rho", "S", "S_zz") + (PLASTIC_FIELDS if self.plastic else ()):
             a = getattr(self, name)
-            if np.isfinite(np.sum(a)):              # a NaN or inf anywhere makes the sum NaN or inf: the fast check
-                continue                            # (a sum that overflows from finite values falls through)
+            with np.errstate(invalid="ignore", over="ignore"):
+                fine = np.isfinite(np.sum(a))       # a NaN or inf anywhere makes the sum NaN or inf: the fast check
+            if fine:                                # (a sum that overflows from finite values falls through)
+                continue
             bad = ~np.isfinite(a.reshape(a.shape[0], -1)).all(axis=1)
             if bad.any():
                 return name, int(np.flatnonzero(bad)[0])

@@ -272,6 +272,10 @@ def thermal_step(state, model: Conduction | None, k: np.ndarray, c: np.ndarray, 
     heat = dict(friction=0.0, lost=0.0, removed=0.0)
     dT = np.zeros(n)
     if model is not None:
+        if k_pair is not None and (pairs is None or len(k_pair) != len(pairs[0])):
+            raise ValueError("thermal_step: k_pair is one value per pair of the pairs it was made for; pass those "
+                             f"pairs too (got {len(k_pair)} values and "
+                             f"{'no pairs' if pairs is None else f'{len(pairs[0])} pairs'})")
         I, J, fr = _pairs_and_fr(state.x, h, kernel, pairs)
         pairs = (I, J)
         if k_pair is None:
@@ -338,6 +342,7 @@ class HeatFlow:
         self.T0 = state.T.copy()
         self.tool_rows = None if state.body is None else np.isin(state.body, self.rigid_ids)
         self.rho_of_return_map = "end" if "rho" in getattr(solver, "evolved", ()) else "start"
+        self.pair_sum = self.k_pair = None                    # made again from this run's pairs and k
 
     def step_limit(self, state) -> float:
         if self.conduction is None:

@@ -116,8 +116,9 @@ def test_thermal_cutting_status_reads_records_and_run_folders(tmp_path, monkeypa
 
 
 def test_viscous_pressure_is_the_pair_pressure_of_the_artificial_viscosity(tmp_path, capsys):
-    """benchmarks/viscous_stress.py: on a lattice squeezed uniformly (v = -gamma x: every pair approaches) a pair's
-    viscous pressure is rho0^2 pi_ij / 2, pi_ij of Eqs. (12)-(13) (refsph.esph.artificial_viscosity), averaged over
+    """benchmarks/viscous_stress.py: on a lattice squeezed uniformly (x = 0.98 X, v = -gamma x: every pair
+    approaches) a pair's viscous pressure is rho0^2 pi_ij / 2 (rho0 the reference density; pi_ij of Eqs. (12)-(13),
+    refsph.esph.artificial_viscosity, with the current one), averaged over
     each particle's neighbours with the kernel (the particle itself counted with q = 0); a rigid motion gives none;
     a folder that is not a run is refused with a message, not a traceback."""
     from refsph.esph import artificial_viscosity
@@ -125,20 +126,22 @@ def test_viscous_pressure_is_the_pair_pressure_of_the_artificial_viscosity(tmp_p
     from refsph.neighbours import find_pairs
     from refsph.scenes import lattice
     mod = _script("viscous_stress")
-    dp, rho, c, b1, b2, eps = 1e-4, 7850.0, 5000.0, 0.5, 0.5, 0.01
+    dp, rho0, c, b1, b2, eps = 1e-4, 7850.0, 5000.0, 0.5, 0.5, 0.01
     h, kernel = 1.3 * dp, get_kernel("wendland")
     X = lattice([10 * dp, 10 * dp], dp)
-    n = len(X)
-    V0, m = np.full(n, dp * dp), np.full(n, rho * dp * dp)
-    v = -50.0 * X
-    q = mod.viscous_pressure(X, X, v, np.full(n, rho), V0, m, h, kernel, b1, b2, eps, c)
+    x = 0.98 * X                                                             # squeezed: rho = rho0 / J, J = 0.98^2
+    n, rho = len(X), rho0 / 0.98**2
+    V0, m = np.full(n, dp * dp), np.full(n, rho0 * dp * dp)
+    v = -50.0 * x
+    q = mod.viscous_pressure(X, x, v, np.full(n, rho), V0, m, h, kernel, b1, b2, eps, c)
     i = int(np.argmin(np.sum((X - X.mean(axis=0)) ** 2, axis=1)))           # an interior particle
     I, J = find_pairs(X, 2 * h)
     mine = np.flatnonzero((I == i) | (J == i))
-    xij, vij = X[I[mine]] - X[J[mine]], v[I[mine]] - v[J[mine]]
+    xij, vij = x[I[mine]] - x[J[mine]], v[I[mine]] - v[J[mine]]
     pi = artificial_viscosity(np.sum(vij * xij, axis=1), np.sum(xij * xij, axis=1), rho, c, h, b1, b2, eps)
-    W = kernel.w(np.sqrt(np.sum(xij * xij, axis=1)), h, 2)
-    expected = np.sum(W * rho**2 * pi / 2) / (np.sum(W) + kernel.w(np.zeros(1), h, 2)[0])
+    Xij = X[I[mine]] - X[J[mine]]
+    W = kernel.w(np.sqrt(np.sum(Xij * Xij, axis=1)), h, 2)                  # weights of the reference pairs
+    expected = np.sum(W * rho0**2 * pi / 2) / (np.sum(W) + kernel.w(np.zeros(1), h, 2)[0])
     assert np.all(pi > 0) and q[i] == pytest.approx(expected, rel=1e-12)
     assert np.all(mod.viscous_pressure(X, X + 1e-5, np.tile([3.0, -1.0], (n, 1)), np.full(n, rho), V0, m, h,
                                        kernel, b1, b2, eps, c) == 0.0)

@@ -205,6 +205,8 @@ def run_case(key: str, options: dict, numerics: dict, quick: bool = False) -> di
                metrics={k: m[k] for k in KEEP if k in m},
                histories={k: _thin(m[k]) for k in ("cutting_force_history", "passive_force_history",
                                                      "temperature_history") if k in m})
+    if s.get("heat_dissipation"):                                    # the ledger's dissipation split (newer runs)
+        rec["heat_dissipation"] = s["heat_dissipation"]
     rec["script_wall_s"] = time.perf_counter() - t0
     return rec
 
@@ -429,6 +431,8 @@ def _values(r: dict) -> dict:
     for key in ("plastic_J", "friction_J", "dissipation_J", "removed_J", "lost_J"):
         out[f"{key[:-2]}_of_work"] = 100.0 * hb.get(key, math.nan) / work
     out["made_of_work"] = 100.0 * out["made"] / work
+    damping = (r.get("heat_dissipation") or {}).get("contact_damping_J")
+    out["damping_of_work"] = math.nan if damping is None else 100.0 * damping / work
     return out
 
 
@@ -459,6 +463,7 @@ STUDIES = (
      ("case 1 n_tu 5", "case 1 n_tu 5 s/2", "case 1 n_tu 5 s/4"),
      (("s", "mass_scale", ".0f"),) + BASIC + (("friction heat [% of work]", "friction_of_work", ".1f"),
                                              ("viscosity + damping heat [% of work]", "dissipation_of_work", ".1f"),
+                                             ("of which contact damping [% of work]", "damping_of_work", ".1f"),
                                              ("steps", "n_steps", "d"), ("wall [s]", "wall", ".0f"))),
     ("Run-to-run scatter: case 1 and three runs with the workpiece's particles moved at random by up to 0.01 dx",
      SCATTER_KEYS, BASIC),

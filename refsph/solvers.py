@@ -293,11 +293,12 @@ class TLSPHSolver(SolverBase):
         """Rates of all rows: the deformable ones plus the pinball contact (``contact``), the rigid ones carrying
         the reaction (dv/dt = contact force / m, turned into the recorded force and then zeroed by the
         constraints), the contact's friction power on both sides (``Rates.friction_power``) and, where the rates
-        carry the viscous heat, the contact's damping power added to it (``Rates.heat_power``)."""
+        carry the viscous heat, the contact's damping power added to it (``Rates.heat_power``; that part alone in
+        ``Rates.damping_power``)."""
         n, N, d = self.constraints.n_deformable, state.n, state.dim
         v = np.zeros((N, d))
         v[:n] = r.v
-        power = heat = None
+        power = heat = damping = None
         if r.heat_power is not None:
             heat = np.zeros(N)
             heat[:n] = r.heat_power
@@ -309,6 +310,8 @@ class TLSPHSolver(SolverBase):
                 power = np.concatenate([c.friction_power_a, c.friction_power_b])
             if heat is not None and c.heat_power_a is not None:
                 heat[:n] += c.heat_power_a
+                damping = np.zeros(N)
+                damping[:n] = c.heat_power_a
         S = np.zeros((N, d, d))
         S[:n] = r.S
         S_zz = np.zeros(N)
@@ -317,7 +320,8 @@ class TLSPHSolver(SolverBase):
         if r.l is not None:
             l = np.zeros((N, d, d))
             l[:n] = r.l
-        return Rates(x=state.v.copy(), v=v, rho=None, S=S, S_zz=S_zz, l=l, friction_power=power, heat_power=heat)
+        return Rates(x=state.v.copy(), v=v, rho=None, S=S, S_zz=S_zz, l=l, friction_power=power, heat_power=heat,
+                     damping_power=damping)
 
     def deformation_gradient(self, state: State) -> np.ndarray:
         """Eq. (18) for every row (rigid rows: I)."""

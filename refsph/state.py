@@ -150,7 +150,8 @@ class Rates:
     frictional heat (:class:`refsph.thermal.HeatFlow`). ``heat_power``: (N,) the power [W; 2D: W/m] the numerical
     dissipation (artificial viscosity, :func:`refsph.tlsph.reference_viscosity`; the penalty contact's normal
     damping, :mod:`refsph.penalty`) takes out of the motion in each row (None: not computed), the heat a run with
-    ``Setup.dissipation_heat`` puts back."""
+    ``Setup.dissipation_heat`` puts back; ``damping_power``: (N,) the contact damping's part of it (None: no tool
+    contact in it), which the heat ledger reports apart."""
 
     x: np.ndarray
     v: np.ndarray
@@ -160,13 +161,15 @@ class Rates:
     l: np.ndarray | None = None
     friction_power: np.ndarray | None = None
     heat_power: np.ndarray | None = None
+    damping_power: np.ndarray | None = None
 
     def rows(self, n: int) -> "Rates":
         """The rates of the first n rows (the real particles of a real + ghost evaluation)."""
         def first(a):
             return None if a is None else a[:n]
         return Rates(x=self.x[:n], v=self.v[:n], rho=first(self.rho), S=self.S[:n], S_zz=self.S_zz[:n],
-                     l=first(self.l), friction_power=first(self.friction_power), heat_power=first(self.heat_power))
+                     l=first(self.l), friction_power=first(self.friction_power), heat_power=first(self.heat_power),
+                     damping_power=first(self.damping_power))
 
 
 def make_state(x: np.ndarray, v: np.ndarray, rho0: float, volume: np.ndarray | float,

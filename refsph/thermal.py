@@ -326,6 +326,7 @@ class HeatFlow:
         self.dissipation_heat = bool(dissipation_heat)
         self.surface = self.surface_x = None               # the free-surface rows and where they were found
         self.ledger = {k: 0.0 for k in LEDGER}
+        self.damping: float | None = 0.0                      # the contact damping's part of 'dissipation' [J]
         self.k = self.c = self.mc = self.T0 = self.tool_rows = None
         self.pairs = VerletList(kernel.support * h, SKIN * h)   # the heat step's pair search (module text)
         self.pair_sum = None                                  # the PairSum of the Verlet list's pairs
@@ -372,6 +373,8 @@ class HeatFlow:
             Q = dt * step.rates.heat_power                             # [J] per row, taken from the motion
             T = T + Q / self.mc
             self.ledger["dissipation"] += float(Q.sum())
+            if self.damping is not None and step.rates.damping_power is not None:
+                self.damping += dt * float(step.rates.damping_power.sum())
             if self.conduction is not None and len(self.conduction.fixed):
                 fixed = np.asarray(self.conduction.fixed)
                 self.ledger["removed"] += float(np.sum(self.mc[fixed] * (T[fixed] - self.conduction.T_fixed)))
@@ -425,7 +428,15 @@ class HeatFlow:
         return {f"heat_{k}": v for k, v in self.balance(state).items()}
 
     def summary(self, state) -> dict:
-        return dict(heat_balance=self.balance(state))
+        """The ledger (:meth:`balance`) and, apart, the two sources of its 'dissipation' [J; per metre in 2D]: the
+        tool contact's damping and the artificial viscosity (the rest); None where the run was continued from a
+        checkpoint that did not keep them apart."""
+        out = dict(heat_balance=self.balance(state))
+        if self.dissipation_heat:
+            d = self.damping
+            out["heat_dissipation"] = dict(contact_damping_J=d,
+                                           viscosity_J=None if d is None else self.ledger["dissipation"] - d)
+        return out
 
     def describe(self) -> dict:
         """What summary.json says of the heat model (JSON-ready)."""
@@ -445,11 +456,15 @@ class HeatFlow:
 
     def checkpoint(self) -> dict:
         ck = {k: np.float64(v) for k, v in self.ledger.items()}
+        if self.damping is not None:
+            ck["damping"] = np.float64(self.damping)
         if self.surface is not None:
             ck.update(surface=self.surface.copy(), surface_x=self.surface_x.copy())
         return ck
 
     def restore(self, arrays: dict) -> None:
         self.ledger = {k: float(arrays[k]) if k in arrays else 0.0 for k in LEDGER}   # (older: no 'dissipation')
+        self.damping = float(arrays["damping"]) if "damping" in arrays else (          # (older: not kept apart)
+            None if self.ledger["dissipation"] > 0.0 else 0.0)
         if "surface" in arrays:
             self.surface, self.surface_x = np.array(arrays["surface"], dtype=bool), np.array(arrays["surface_x"])

@@ -186,3 +186,16 @@ def test_metrics_flag_a_temperature_blow_up_and_the_sweep_does_not_count_it(monk
         monkeypatch.setattr(mod, "RUNS", tmp_path)
         rec = mod.run_case("case 1", dict(case=1), {})
         assert rec["status"] == status and (status == "ok" or rec["error"].startswith("a particle at"))
+
+
+def test_the_dissipation_heat_is_split_into_contact_damping_and_viscosity(short_cut):
+    """The ledger's 'dissipation' is the artificial viscosity's heat plus the penalty contact's damping; the summary
+    gives the two apart (summing to it), and the damping's part is what the contact's damping power makes over the
+    run: zero without damping (penalty_damping 0: the normal force is the spring's alone)."""
+    hb, hd = short_cut.summary["heat_balance"], short_cut.summary["heat_dissipation"]
+    assert hd["contact_damping_J"] > 0 and hd["viscosity_J"] > 0
+    assert hd["contact_damping_J"] + hd["viscosity_J"] == pytest.approx(hb["dissipation_J"], rel=1e-12)
+    undamped = run("thermal_cutting", "tlsph", quick=True, progress=False,
+                   options=dict(case=1, length=0.5e-3, travel=0.25), numerics=dict(threads=1, penalty_damping=0.0))
+    assert undamped.summary["heat_dissipation"]["contact_damping_J"] == 0.0
+    assert undamped.summary["heat_dissipation"]["viscosity_J"] > 0

@@ -66,7 +66,7 @@ from .surface import surface_alpha_shape, surface_sph
 
 __all__ = ["laplacian", "conduction_rate", "thermal_time_step", "advance_at_rest", "Conduction", "SurfaceLoss",
            "FrictionHeat", "HeatFlow", "coefficients", "pair_conductivity", "conduct", "thermal_step",
-           "thermal_step_limit", "free_surface", "STEFAN_BOLTZMANN"]
+           "thermal_step_limit", "free_surface", "describe_heat_flow", "STEFAN_BOLTZMANN"]
 
 
 def laplacian(f: np.ndarray, x: np.ndarray, V: np.ndarray, h: float, kernel: Kernel,
@@ -329,8 +329,7 @@ class HeatFlow:
         self.damping: float | None = 0.0                      # the contact damping's part of 'dissipation' [J]
         self.k = self.c = self.mc = self.T0 = self.tool_rows = None
         self.pairs = VerletList(kernel.support * h, SKIN * h)   # the heat step's pair search (module text)
-        self.pair_sum = None                                  # the PairSum of the Verlet list's pairs
-        self.k_pair = None                                    # and their 2 k_ij (pair_conductivity)
+        self.pair_sum = self.k_pair = None                    # the Verlet list's PairSum and its pairs' 2 k_ij
         self.rho_of_return_map = "start"
 
     def bind(self, state, solver) -> None:
@@ -439,20 +438,8 @@ class HeatFlow:
         return out
 
     def describe(self) -> dict:
-        """What summary.json says of the heat model (JSON-ready)."""
-        out = dict(cp=self.cp, chi=self.chi)
-        if self.conduction is not None:
-            c = self.conduction
-            out["conduction"] = dict(k=c.k, courant=c.courant, tools={str(b): list(v) for b, v in c.tools.items()},
-                                     n_fixed=len(c.fixed), T_fixed=c.T_fixed,
-                                     loss=None if c.loss is None else {f: getattr(c.loss, f) for f in
-                                                                       ("h_c", "emissivity", "T_ambient", "detector",
-                                                                        "alpha_radius")})
-        if self.friction_heat is not None:
-            out["friction_heat"] = dict(eta=self.friction_heat.eta, chip_fraction=self.friction_heat.chip_fraction)
-        if self.dissipation_heat:
-            out["dissipation_heat"] = True
-        return out
+        """What summary.json says of the heat model (JSON-ready): :func:`describe_heat_flow`."""
+        return describe_heat_flow(self)
 
     def checkpoint(self) -> dict:
         ck = {k: np.float64(v) for k, v in self.ledger.items()}
@@ -468,3 +455,20 @@ class HeatFlow:
             None if self.ledger["dissipation"] > 0.0 else 0.0)
         if "surface" in arrays:
             self.surface, self.surface_x = np.array(arrays["surface"], dtype=bool), np.array(arrays["surface_x"])
+
+
+def describe_heat_flow(flow: HeatFlow) -> dict:
+    """What summary.json says of a :class:`HeatFlow`'s heat model (JSON-ready)."""
+    out = dict(cp=flow.cp, chi=flow.chi)
+    if flow.conduction is not None:
+        c = flow.conduction
+        out["conduction"] = dict(k=c.k, courant=c.courant, tools={str(b): list(v) for b, v in c.tools.items()},
+                                 n_fixed=len(c.fixed), T_fixed=c.T_fixed,
+                                 loss=None if c.loss is None else {f: getattr(c.loss, f) for f in
+                                                                   ("h_c", "emissivity", "T_ambient", "detector",
+                                                                    "alpha_radius")})
+    if flow.friction_heat is not None:
+        out["friction_heat"] = dict(eta=flow.friction_heat.eta, chip_fraction=flow.friction_heat.chip_fraction)
+    if flow.dissipation_heat:
+        out["dissipation_heat"] = True
+    return out

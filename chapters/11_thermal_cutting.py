@@ -303,9 +303,9 @@ for title in ("## Mass scaling", "## The mass scale", "## Run-to-run scatter at 
 #
 # %% [markdown]
 # * **Mass scaling** changes inertia by the factor $s$, and with it the artificial viscosity's stress ($\propto
-#   \sqrt{s}$). At $t_u/5$ halving $s$ moves the forces within their run-to-run scatter, but case 1's
-#   temperatures by more than it (the rake face about 90 K cooler, three standard deviations of the scatter): the
-#   page's scatter at $s/2$ and the run at $s/4$ say whether that holds.
+#   \sqrt{s}$). At $t_u/5$, four runs a side, halving $s$ moves neither force (case 1: $F_c$ −0.5 %) but cools
+#   the rake face by 10 % (Welch's $t = -3.8$): the frictional heat halves. The page's run at $s/4$ says whether
+#   that goes on; until then the temperatures carry a mass-scaling bias of that order.
 # * **The time step.** At $t_u/10$ the scene's step (Courant 0.3) broke two of three runs: a particle of case 10
 #   inverts at 1.1 ms, and in case 2 two particles of the chip's free surface oscillate against each other until
 #   their artificial viscosity heats the chip past 1500 K. The step $C h/(c_L + |v|_{max})$ leaves out the

@@ -1,5 +1,6 @@
-"""How large the artificial viscosity's stress is against the flow stress, in the last snapshot of thermal-cutting
-runs (issue 22, part 3: the mass-scaling rule chosen from the numerical stress it adds, stated).
+"""How large the artificial viscosity's stress is against the flow stress, and its power against the plastic power,
+over the last quarter of thermal-cutting runs (issue 22, part 3: the mass-scaling rule chosen from the numerical
+stress it adds, stated).
 
     python benchmarks/viscous_stress.py                      # every finished SPH run folder of the sweep
     python benchmarks/viscous_stress.py --run DIR [DIR ..]   # these
@@ -22,7 +23,9 @@ of the snapshot, not of the half step) against the plastic power sum_i V_i sigma
 dissipated: in the layer on the tool (within 1.5 dx of the rake face, from 2 dx below the edge), in the shear
 zones, under the cut line ahead of the edge (where the material is pressed down before it is cut) and behind it
 (the machined layer), elsewhere (the chip's body); and the viscosity's and the contact damping's share of the tool's
-work over the whole run, from its heat ledger. How these move with s (c ~ 1/sqrt(s)) is what the mass-scaling rule
+work over the whole run, from its heat ledger. The powers are summed over the snapshots of the last quarter of the
+run (the window of the cut's means; each snapshot's ratio is listed too), the stress ratios are the last
+snapshot's. How these move with s (c ~ 1/sqrt(s)) is what the mass-scaling rule
 trades against the cost. Needs the sweep's run folders (``benchmarks/thermal_cutting.py``, git-ignored); writes
 viscous_stress.json next to this file (merged with the runs already recorded there).
 """
@@ -62,26 +65,21 @@ def viscous_pressure(X, x, v, rho, V0, m, h, kernel, beta1, beta2, eps, c) -> np
     return sums.symmetric(q * W, V0) / weight
 
 
-def measure(run_dir: Path) -> dict:
-    """The viscous stress against the flow stress, and the viscosity's power against the plastic power, in the
-    run's last snapshot (module text)."""
-    from refsph.io import load_snapshot
+REGIONS = ("at_tool", "shear_zones", "ahead_below_cut", "machined", "elsewhere")
+
+
+def snapshot_powers(s: dict, z: dict) -> dict:
+    """One snapshot ``z`` of the run with summary ``s``: the viscous pressure's ratio to the von Mises stress over
+    the shear zones, the viscosity's power (total and by region, REGIONS) and the plastic power [W/m]."""
     from refsph.kernels import get_kernel
     from refsph.scenes.thermal_cutting import rake_frame
     from refsph.tensor import det, inv, transpose
     from refsph.tlsph import ReferenceOperator, TLSPHParams, reference_viscosity
-    s = json.loads((run_dir / "summary.json").read_text())
-    if s.get("method") != "tlsph":
-        raise ValueError(f"{run_dir}: a TLSPH run folder is needed (method {s.get('method')!r})")
     info, num, mat = s["scene_info"], s["numerics"], s["material"]
-    if not s.get("snapshots"):
-        raise ValueError(f"{run_dir}: the run wrote no snapshot")
-    z = load_snapshot(run_dir / "snapshots" / s["snapshots"][-1])
     w = slice(0, info["n_work"])
-    X, x, v, m, V0 = (np.asarray(z[k][w], dtype=float) for k in ("X", "x", "v", "m", "V0"))
+    X, x, v, m, V0, rho = (np.asarray(z[k][w], dtype=float) for k in ("X", "x", "v", "m", "V0", "rho"))
     kernel, h = get_kernel(num["kernel"]), float(s["h"])
     c = float(np.sqrt(mat["E"] / mat["rho0"]))                      # material.c0 of the (mass-scaled) material
-    rho = np.asarray(z["rho"][w], dtype=float)
     q = viscous_pressure(X, x, v, rho, V0, m, h, kernel, num["beta1"], num["beta2"], num["eps"], c)
     # the viscosity's power per particle, as the run computes it (Rates.heat_power), on the snapshot's operator
     prm = TLSPHParams(h=h, beta1=num["beta1"], beta2=num["beta2"], eps=num["eps"], kernel=kernel,
@@ -90,54 +88,66 @@ def measure(run_dir: Path) -> dict:
     op = ReferenceOperator(X, V0, h, kernel, num["corrected"], max_condition=num.get("max_condition"))
     F = op.deformation_gradient(x)
     J = det(F)
-    _, power_visc = reference_viscosity(x, v, m, m / (V0 * J), J[:, None, None] * transpose(inv(F, J)), op, c, prm)
+    _, power = reference_viscosity(x, v, m, m / (V0 * J), J[:, None, None] * transpose(inv(F, J)), op, c, prm)
     svm, rate = np.asarray(z["sigma_vm"][w], dtype=float), np.asarray(z["eps_dot_p"][w], dtype=float)
-    power_plastic = m / rho * svm * rate                            # sigma : eps_dot_p = sigma_vm eps_dot_p (J2)
-    u, n = rake_frame(x, float(z["t"]), info)
-    dx = float(info["dx"])
+    t, dx = float(z["t"]), float(info["dx"])
+    u, n = rake_frame(x, t, info)
     at_tool = (np.abs(n) < 1.5 * dx) & (u > -2.0 * dx)              # the layer on the rake face and round the edge
     below = x[:, 1] < info["y0"]                                    # under the cut line:
-    behind = x[:, 0] > info["apex0"][0] - info["vc_m_s"] * float(z["t"])   # the tool moves to -x: machined
+    behind = x[:, 0] > info["apex0"][0] - info["vc_m_s"] * t        # the tool moves to -x: machined
     flowing = rate > 0.0
     zone = flowing & (rate >= 0.25 * np.quantile(rate[flowing], 0.99)) if flowing.any() else flowing
-    ratio = q / np.maximum(svm, 1e-9 * mat["E"])
-    hb = s.get("heat_balance") or {}
-    work = (s.get("metrics") or {}).get("tool_work_J_per_m")
-    total = float(power_visc.sum())
+    ratio = q[zone] / np.maximum(svm[zone], 1e-9 * mat["E"])
+    regions = dict(at_tool=at_tool, shear_zones=zone & ~at_tool, ahead_below_cut=below & ~behind & ~zone & ~at_tool,
+                   machined=below & behind & ~zone & ~at_tool, elsewhere=~below & ~zone & ~at_tool)
+    return dict(t_s=t, c_m_s=c, n_zone=int(zone.sum()),
+                ratio_median=float(np.median(ratio)) if zone.any() else None,
+                ratio_p90=float(np.quantile(ratio, 0.9)) if zone.any() else None,
+                q_median_MPa=float(np.median(q[zone]) / 1e6) if zone.any() else None,
+                viscous_W=float(power.sum()), plastic_W=float(np.sum(m / rho * svm * rate)),   # sigma_vm eps_dot_p
+                viscous_by_region_W={k: float(power[sel].sum()) for k, sel in regions.items()})
 
-    def share(sel):
-        return float(power_visc[sel].sum() / total) if total > 0 else None
 
-    def stats(sel):
-        if not sel.any():
-            return dict(n=0, median=None, p90=None, q_median_MPa=None, sigma_vm_median_MPa=None)
-        r = ratio[sel]
-        return dict(n=int(sel.sum()), median=float(np.median(r)), p90=float(np.quantile(r, 0.9)),
-                    q_median_MPa=float(np.median(q[sel]) / 1e6), sigma_vm_median_MPa=float(np.median(svm[sel]) / 1e6))
-
-    return dict(run=run_dir.name, t_s=float(z["t"]), mass_scale=float(info["mass_scale"]), dx_m=dx, c_m_s=c,
-                beta1=num["beta1"], beta2=num["beta2"], shear_zones=stats(zone),
-                viscous_over_plastic_power=total / float(power_plastic.sum()) if power_plastic.sum() > 0 else None,
-                viscous_power_share=dict(at_tool=share(at_tool), shear_zones=share(zone & ~at_tool),
-                                         ahead_below_cut=share(below & ~behind & ~zone & ~at_tool),
-                                         machined=share(below & behind & ~zone & ~at_tool),
-                                         elsewhere=share(~below & ~zone & ~at_tool)),
+def measure(run_dir: Path) -> dict:
+    """The viscous stress and power (module text) over the snapshots of the last quarter of the run (the window
+    of the cut's means): the ratios of the summed powers, the shear-zone stress ratios of the last snapshot."""
+    from refsph.io import load_snapshot
+    s = json.loads((run_dir / "summary.json").read_text())
+    if s.get("method") != "tlsph":
+        raise ValueError(f"{run_dir}: a TLSPH run folder is needed (method {s.get('method')!r})")
+    if not s.get("snapshots"):
+        raise ValueError(f"{run_dir}: the run wrote no snapshot")
+    snaps = [load_snapshot(run_dir / "snapshots" / name) for name in s["snapshots"]]
+    t_end = float(snaps[-1]["t"])
+    parts = [snapshot_powers(s, z) for z in snaps if float(z["t"]) >= 0.75 * t_end]
+    last, info = parts[-1], s["scene_info"]
+    visc, plastic = sum(p["viscous_W"] for p in parts), sum(p["plastic_W"] for p in parts)
+    hb, work = s.get("heat_balance") or {}, (s.get("metrics") or {}).get("tool_work_J_per_m")
+    return dict(run=run_dir.name, t_s=[p["t_s"] for p in parts], mass_scale=float(info["mass_scale"]),
+                dx_m=float(info["dx"]), c_m_s=last["c_m_s"],
+                shear_zones=dict(n=last["n_zone"], median=last["ratio_median"], p90=last["ratio_p90"],
+                                 q_median_MPa=last["q_median_MPa"]),
+                viscous_over_plastic_power=visc / plastic if plastic > 0 else None,
+                viscous_over_plastic_each=[p["viscous_W"] / p["plastic_W"] if p["plastic_W"] > 0 else None
+                                           for p in parts],
+                viscous_power_share={k: sum(p["viscous_by_region_W"][k] for p in parts) / visc if visc > 0 else None
+                                     for k in REGIONS},
                 dissipation_of_work=(hb["dissipation_J"] / work if work and "dissipation_J" in hb else None))
 
 
 def report(rows: list) -> str:
     head = ("run", "s", "dx [um]", "c [m/s]", "shear zones: q / sigma_vm median", "p90", "q median [MPa]",
-            "viscous / plastic power", "viscous power at the tool [%]", "in the shear zones [%]",
+            "viscous / plastic power (each snapshot)", "viscous power at the tool [%]", "in the shear zones [%]",
             "ahead of the edge, under the cut line [%]", "machined layer [%]", "elsewhere [%]",
             "viscosity + damping heat, whole run [% of work]")
     body = []
     for r in rows:
         sh, z = r["viscous_power_share"], r["shear_zones"]
-        shares = [study.fmt(sh[k], ".0f", 100.0)
-                  for k in ("at_tool", "shear_zones", "ahead_below_cut", "machined", "elsewhere")]
+        shares = [study.fmt(sh[k], ".0f", 100.0) for k in REGIONS]
         body.append((r["run"], f"{r['mass_scale']:.0f}", f"{1e6 * r['dx_m']:.0f}", f"{r['c_m_s']:.0f}",
                      study.fmt(z["median"], ".3f"), study.fmt(z["p90"], ".3f"), study.fmt(z["q_median_MPa"], ".1f"),
-                     study.fmt(r["viscous_over_plastic_power"], ".3f"), *shares,
+                     study.fmt(r["viscous_over_plastic_power"], ".3f") + " (" + ", ".join(
+                         study.fmt(e, ".2f") for e in r["viscous_over_plastic_each"]) + ")", *shares,
                      study.fmt(r["dissipation_of_work"], ".1f", 100.0)))
     return study.md_table(head, body)
 

@@ -451,6 +451,8 @@ BASIC = (("Fc [N/mm]", "Fc", ".1f"), ("Fp [N/mm]", "Fp", ".1f"), ("Fp/Fc", "forc
          ("T_FCS [K]", "free_chip_surface_temperature_K", ".0f"), ("chip [mm]", "chip_thickness_mm", ".3f"),
          ("contact [mm]", "contact_length_mm", ".3f"))
 SCATTER_KEYS = ("case 1", "case 1 jitter 1", "case 1 jitter 2", "case 1 jitter 3")   # the scatter at t_u/10
+SCATTER_T5 = tuple(k.replace("case 1", "case 1 n_tu 5") for k in SCATTER_KEYS)         # at t_u/5
+SCATTER_S2 = tuple(k.replace("n_tu 5", "n_tu 5 s/2") for k in SCATTER_T5)               # at t_u/5 and s/2
 STUDIES = (
     ("Mass scaling: s halved (the rule's factor 0.01 A in s rho vc^2 = 0.01 A halved to 0.005 A)",
      ("case 1", "case 1 s/2", "case 10", "case 10 s/2", "case 1 n_tu 5", "case 1 n_tu 5 s/2", "case 10 n_tu 5",
@@ -460,8 +462,7 @@ STUDIES = (
         ("wall [s]", "wall", ".0f"))),
     ("Run-to-run scatter at s/2 (t_u/5; the same three seeds): whether the mass scale moves the results by more "
      "than the scatter, two groups of four runs",
-     ("case 1 n_tu 5 s/2", "case 1 n_tu 5 s/2 jitter 1", "case 1 n_tu 5 s/2 jitter 2", "case 1 n_tu 5 s/2 jitter 3"),
-     BASIC),
+     SCATTER_S2, BASIC),
     ("The mass scale at t_u/5: s, s/2 and s/4 (case 1, one run each; read with the two scatter tables; s/4 at the "
      "scene's step inverted a particle, so it runs at courant 0.15 beside s at 0.15)",
      ("case 1 n_tu 5", "case 1 n_tu 5 s/2", "case 1 n_tu 5 s/4", "case 1 n_tu 5 courant 0.15",
@@ -472,8 +473,7 @@ STUDIES = (
                                              ("steps", "n_steps", "d"), ("wall [s]", "wall", ".0f"))),
     ("Run-to-run scatter: case 1 and three runs with the workpiece's particles moved at random by up to 0.01 dx",
      SCATTER_KEYS, BASIC),
-    ("Run-to-run scatter at t_u/5 (the same, where a run costs an eighth)",
-     ("case 1 n_tu 5", "case 1 n_tu 5 jitter 1", "case 1 n_tu 5 jitter 2", "case 1 n_tu 5 jitter 3"), BASIC),
+    ("Run-to-run scatter at t_u/5 (the same, where a run costs an eighth)", SCATTER_T5, BASIC),
     ("Run-to-run scatter of Ti6Al4V at t_u/5 (case 10, the same perturbation)",
      ("case 10 n_tu 5", "case 10 n_tu 5 jitter 1", "case 10 n_tu 5 jitter 2", "case 10 n_tu 5 jitter 3"), BASIC),
     ("Resolution (particles across t_u; at courant 0.15)",
@@ -521,11 +521,8 @@ STUDIES = (
 def scatter(res: dict, keys=None) -> dict:
     """Mean and sample standard deviation (percent of the mean) of each basic quantity over case 1 and its jittered
     runs (``keys``: the runs of a scatter study; default the first), those recorded ok."""
-    keys = SCATTER_KEYS if keys is None else keys
-    runs = [res["runs"][k] for k in keys if k in res["runs"] and res["runs"][k]["status"] == "ok"]
     out = {}
-    for _, key, _ in BASIC:
-        v = np.array([_values(r)[key] for r in runs], dtype=float)
+    for key, v in _groups(res, SCATTER_KEYS if keys is None else keys).items():
         if len(v) >= 2:
             out[key] = dict(n=len(v), mean=float(v.mean()), std_pct=float(100 * v.std(ddof=1) / abs(v.mean())))
     return out
@@ -557,10 +554,7 @@ def _study_lines(res: dict) -> list[str]:
     return lines
 
 
-COMPARED = {("case 1 n_tu 5 s/2", "case 1 n_tu 5 s/2 jitter 1", "case 1 n_tu 5 s/2 jitter 2",
-             "case 1 n_tu 5 s/2 jitter 3"):
-            ("case 1 n_tu 5", "case 1 n_tu 5 jitter 1", "case 1 n_tu 5 jitter 2", "case 1 n_tu 5 jitter 3")}
-# a scatter group -> the group it is compared with (_difference_line)
+COMPARED = {SCATTER_S2: SCATTER_T5}         # a scatter group -> the group it is compared with (_difference_line)
 
 
 def _groups(res: dict, keys) -> dict:

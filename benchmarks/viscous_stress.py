@@ -48,11 +48,12 @@ RUNS = ROOT / "runs" / "thermal_cutting"
 OUT_JSON = Path(__file__).resolve().parent / "viscous_stress.json"
 
 
-def viscous_pressure(X, x, v, rho, V0, m, h, kernel, beta1, beta2, eps, c) -> np.ndarray:
-    """q_i (module text) [Pa] of each row from its reference pairs (|X_ij| <= support h)."""
+def viscous_pressure(X, x, v, rho, V0, m, h, kernel, beta1, beta2, eps, c, pairs=None) -> np.ndarray:
+    """q_i (module text) [Pa] of each row from its reference pairs (|X_ij| <= support h; ``pairs``: those half
+    pairs (I, J) if the caller has them, e.g. a ReferenceOperator's)."""
     from refsph.neighbours import PairSum, find_pairs
     n, d = x.shape
-    I, J = find_pairs(X, kernel.support * h)
+    I, J = find_pairs(X, kernel.support * h) if pairs is None else pairs
     xij, vij = x[I] - x[J], v[I] - v[J]
     vr = np.einsum("pd,pd->p", vij, xij)
     mu = h * np.minimum(vr, 0.0) / (np.einsum("pd,pd->p", xij, xij) + eps * h * h)
@@ -80,12 +81,12 @@ def snapshot_powers(s: dict, z: dict) -> dict:
     X, x, v, m, V0, rho = (np.asarray(z[k][w], dtype=float) for k in ("X", "x", "v", "m", "V0", "rho"))
     kernel, h = get_kernel(num["kernel"]), float(s["h"])
     c = float(np.sqrt(mat["E"] / mat["rho0"]))                      # material.c0 of the (mass-scaled) material
-    q = viscous_pressure(X, x, v, rho, V0, m, h, kernel, num["beta1"], num["beta2"], num["eps"], c)
     # the viscosity's power per particle, as the run computes it (Rates.heat_power), on the snapshot's operator
     prm = TLSPHParams(h=h, beta1=num["beta1"], beta2=num["beta2"], eps=num["eps"], kernel=kernel,
                       corrected=num["corrected"], ref_update_strain=None, viscous_heat=True,
                       max_condition=num.get("max_condition"))
     op = ReferenceOperator(X, V0, h, kernel, num["corrected"], max_condition=num.get("max_condition"))
+    q = viscous_pressure(X, x, v, rho, V0, m, h, kernel, num["beta1"], num["beta2"], num["eps"], c, (op.I, op.J))
     F = op.deformation_gradient(x)
     J = det(F)
     _, power = reference_viscosity(x, v, m, m / (V0 * J), J[:, None, None] * transpose(inv(F, J)), op, c, prm)

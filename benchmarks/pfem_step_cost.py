@@ -7,6 +7,14 @@ same numbers.
     python benchmarks/pfem_step_cost.py                       # both resolutions, about 5 minutes; one record each
     python benchmarks/pfem_step_cost.py --n-tu 10 --steps 30  # one
     python benchmarks/pfem_step_cost.py --report              # the table from the JSON
+    python benchmarks/pfem_step_cost.py --full                # the whole of case 1 at t_u/10 (about half an hour)
+
+``--full`` runs the cut the sweep records as 'case 1 pfem' (benchmarks/thermal_cutting.py: 16 t_u of cut on a
+2.8 mm workpiece at t_u/10, the paper's resolution) from its start, into runs/pfem_cost/ (a fresh folder each
+time: the CPU seconds are those of one uninterrupted run), and keeps its cost (CPU and wall seconds of this
+process, steps, Newton iterations, halved steps, nodes) with its measures beside those of the sweep's record of the
+same cut (made by an older version of the solver: the digits the two share are those the path to the solution
+does not move).
 
 A record is keyed by the git commit and the resolution, so running this at an older commit (``git checkout <rev> --
 refsph``, with ``--label``) adds that version's row beside today's (the before-and-after of a change):
@@ -29,6 +37,12 @@ study.pin_threads()
 
 OUT_JSON = Path(__file__).resolve().parent / "pfem_step_cost.json"
 OUT_MD = Path(__file__).resolve().parent / "pfem_step_cost_report.md"
+SWEEP_JSON = Path(__file__).resolve().parent / "thermal_cutting.json"
+FULL_KEY = "case 1 pfem"                      # the sweep's record of the cut that --full times
+FULL_OPTIONS = dict(case=1, n_tu=10.0, travel=16.0, length=2.8e-3)
+MEASURES = (("Fc [N/mm]", "cutting_force_N_per_m", 1e-3), ("Fp [N/mm]", "passive_force_N_per_m", 1e-3),
+            ("T_RF [K]", "rake_face_temperature_K", 1.0), ("T_FCS [K]", "free_chip_surface_temperature_K", 1.0),
+            ("chip [mm]", "chip_thickness_mm", 1.0))
 PARTS = (("tangent", "_element_tangent"), ("element residuals", "element_residual"), ("factorisation", "gstrf"))
 # (the element residuals: all of them, the tangent's included)
 
@@ -72,7 +86,56 @@ def measure(n_tu: float, steps: int, label: str | None = None) -> dict:
                 split={k: round(v, 3) for k, v in split.items()}, tool_force_N_per_m=[float(f) for f in F])
 
 
-def report(rows: list) -> str:
+def measure_full(label: str | None = None) -> dict:
+    """The whole of case 1 at t_u / 10 (module text): its cost and measures, run from its start."""
+    import shutil
+
+    from refsph.pfem_run import run_pfem
+
+    out = Path(__file__).resolve().parents[1] / "runs" / "pfem_cost" / "case_1_n_tu_10"
+    if out.exists():
+        shutil.rmtree(out)
+    cpu, wall = time.process_time(), time.perf_counter()
+    s = run_pfem("thermal_cutting", out=out, progress=True, options=dict(FULL_OPTIONS)).summary
+    cpu, wall = time.process_time() - cpu, time.perf_counter() - wall
+    m = s["metrics"]
+    return dict(commit=label or version(), options=FULL_OPTIONS, status=s["status"], steps=s["n_steps"],
+                nodes=s["n_particles"], cpu_s=round(cpu, 1), wall_s=round(wall, 1),
+                iterations=s["newton"]["iterations"], halved_steps=s["newton"]["halved_steps"],
+                measures={key: float(m[key]) for _, key, _ in MEASURES})
+
+
+def sweep_record() -> dict | None:
+    """The sweep's record of the cut --full times (None: not recorded)."""
+    if not SWEEP_JSON.exists():
+        return None
+    runs = json.loads(SWEEP_JSON.read_text())["runs"]
+    return next((r for r in (runs.values() if isinstance(runs, dict) else runs) if r.get("key") == FULL_KEY), None)
+
+
+def full_report(full: list, sweep: dict | None) -> list[str]:
+    """The table of the whole cut's records, the sweep's record last."""
+    if not full:
+        return []
+    names = [name for name, _, _ in MEASURES]
+    lines = ["", "# The whole cut: case 1 at t_u/10 (16 t_u of cut, the sweep's 'case 1 pfem'), from its start", "",
+             "Made by `python benchmarks/pfem_step_cost.py --full`: CPU and wall seconds of one uninterrupted run "
+             "(other work ran beside it), its measures beside the sweep's record of the same cut.", "",
+             "| version | steps | halved | nodes | Newton iterations | CPU [min] | wall [min] | " + " | ".join(names)
+             + " |", "|---" * (7 + len(names)) + "|"]
+    for r in full:
+        lines.append(f"| {r['commit']} | {r['steps']} | {r['halved_steps']} | {r['nodes']} | {r['iterations']} | "
+                     f"{r['cpu_s'] / 60:.1f} | {r['wall_s'] / 60:.1f} | "
+                     + " | ".join(f"{r['measures'][key] * f:.4g}" for _, key, f in MEASURES) + " |")
+    if sweep is not None and sweep.get("status") == "ok":
+        m = sweep["metrics"]
+        lines.append(f"| the sweep's record | {sweep['n_steps']} | - | {sweep['n_particles']} | - | - | "
+                     f"{sweep['wall_time_s'] / 60:.1f} | " + " | ".join(f"{m[key] * f:.4g}" for _, key, f in MEASURES)
+                     + " |")
+    return lines
+
+
+def report(rows: list, full: list | None = None, sweep: dict | None = None) -> str:
     """The table of the records, by resolution and then as recorded."""
     lines = ["# What a PFEM cutting step costs (case 1's short cut, its first steps)", "",
              "Made by `python benchmarks/pfem_step_cost.py` (module text): CPU seconds of one process (other work ran "
@@ -87,6 +150,7 @@ def report(rows: list) -> str:
                      f"{r['cpu_s']:.1f} | {r['cpu_per_iteration_ms']:.0f} | {100 * s['tangent']:.0f} % | "
                      f"{100 * s['element residuals']:.0f} % | {100 * s['factorisation']:.0f} % | "
                      f"{r['tool_force_N_per_m'][0]:.6f}, {r['tool_force_N_per_m'][1]:.6f} |")
+    lines += full_report(full or [], sweep)
     return "\n".join(lines) + "\n"
 
 
@@ -96,18 +160,25 @@ def main(argv=None) -> int:
     ap.add_argument("--steps", type=int, default=30, help="steps timed at each (default 30)")
     ap.add_argument("--label", help="the record's name (default: the git commit of refsph)")
     ap.add_argument("--report", action="store_true", help="only print the table of the JSON")
+    ap.add_argument("--full", action="store_true", help="the whole of case 1 at t_u/10 instead (module text)")
     args = ap.parse_args(argv)
-    rows = json.loads(OUT_JSON.read_text())["rows"] if OUT_JSON.exists() else []
-    if not args.report:
+    data = json.loads(OUT_JSON.read_text()) if OUT_JSON.exists() else {}
+    rows, full = data.get("rows", []), data.get("full", [])
+    if args.full and not args.report:
+        rec = measure_full(args.label or version())
+        full = [r for r in full if r["commit"] != rec["commit"]] + [rec]
+        OUT_JSON.write_text(json.dumps(dict(rows=rows, full=full), indent=1) + "\n")
+        print(f"case 1 at t_u/10: {rec['cpu_s'] / 60:.1f} min CPU, {rec['iterations']} iterations", flush=True)
+    elif not args.report:
         args.label = args.label or version()          # before this script writes its JSON (a tracked file)
         for n_tu in args.n_tu:
             rec = measure(n_tu, args.steps, args.label)
             rows = [r for r in rows if (r["commit"], r["n_tu"], r["steps"]) != (rec["commit"], n_tu, args.steps)]
             rows.append(rec)
-            OUT_JSON.write_text(json.dumps(dict(rows=rows), indent=1) + "\n")
+            OUT_JSON.write_text(json.dumps(dict(rows=rows, full=full), indent=1) + "\n")
             print(f"n_tu {n_tu:g}: {rec['cpu_s']:.1f} s CPU, {rec['iterations']} iterations", flush=True)
-    OUT_MD.write_text(report(rows))
-    print(report(rows))
+    OUT_MD.write_text(report(rows, full, sweep_record()))
+    print(report(rows, full, sweep_record()))
     return 0
 
 

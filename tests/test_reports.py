@@ -91,8 +91,10 @@ def test_pfem_step_cost_report_is_generated_from_the_json_and_the_versions_agree
     """benchmarks/pfem_step_cost_report.md is what pfem_step_cost.report writes from the committed JSON; at each
     resolution every recorded version gives the same tool force (to 1e-6), so a speed-up there changed no number."""
     mod = _script("pfem_step_cost")
-    rows = json.loads((ROOT / "benchmarks" / "pfem_step_cost.json").read_text())["rows"]
-    assert mod.report(rows) == (ROOT / "benchmarks" / "pfem_step_cost_report.md").read_text()
+    data = json.loads((ROOT / "benchmarks" / "pfem_step_cost.json").read_text())
+    rows = data["rows"]
+    assert mod.report(rows, data.get("full", []), mod.sweep_record()) == \
+        (ROOT / "benchmarks" / "pfem_step_cost_report.md").read_text()
     for n_tu in {r["n_tu"] for r in rows}:
         forces = [r["tool_force_N_per_m"] for r in rows if r["n_tu"] == n_tu]
         for f in forces[1:]:

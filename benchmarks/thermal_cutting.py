@@ -91,6 +91,7 @@ STUDY_NAMES = ("cases", "coarse", "pfem", "detector", "scaling", "scatter", "res
 COURANT = 0.15                             # every run at dx <= t_u / 10: half the scene's step (module text)
 COARSE = " n_tu 5"                         # the key suffix of the 'coarse' study: all 18 cases at dx = t_u / 5
 PFEM = " pfem n_tu 5"                      # the key suffix of the 'pfem' study: the 18 cases with the PFEM at t_u / 5
+PFEM10 = " pfem"                           # ... and at t_u / 10 (the paper's resolution for t_u = 0.1 mm)
 PFEM_OPTIONS = ("case", "n_tu", "travel", "length", "gamma")   # the sweep's options the PFEM cut takes (tool: TOOL)
 
 
@@ -169,6 +170,8 @@ def jobs(studies=STUDY_NAMES, only=None) -> dict:
     add("contact", "case 1 all friction heat to the chip", converged(1, chip_fraction=1.0), sweep_numerics())
     add("resolution", "case 1 n_tu 15", converged(1, n_tu=15.0), sweep_numerics(15.0))
     add("resolution", "case 10 n_tu 15", converged(10, n_tu=15.0), sweep_numerics(15.0))
+    for n in range(2, 19):                                   # the PFEM's 18 cases at t_u/10 ('case 1 pfem' above)
+        add("pfem", f"case {n}{PFEM10}", converged(n, n_tu=10.0), dict(method="pfem"))
     return todo
 
 
@@ -323,6 +326,9 @@ def report(res: dict, before: dict | None = None) -> str:
     pfem = comparison(res, PFEM)
     lines += ["", P("pfem", done=sum(r["status"] == "ok" for r in pfem))] + [_case_line(r) for r in pfem]
     lines += ["", P("pfem_errors")] + _mean_error_lines(pfem, old)
+    pfem10 = comparison(res, PFEM10)
+    lines += ["", P("pfem10", done=sum(r["status"] == "ok" for r in pfem10))] + [_case_line(r) for r in pfem10]
+    lines += ["", P("pfem10_errors")] + _mean_error_lines(pfem10, old)
     lines += ["", P("pfem_forces")] + [_pfem_force_line(r, res) for r in pfem]
     lines += ["", P("dof")] + _dof_lines(pfem, coarse, res)
     lines += ["", P("forces")]

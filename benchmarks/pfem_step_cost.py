@@ -7,11 +7,12 @@ same numbers.
     python benchmarks/pfem_step_cost.py                       # both resolutions, about 5 minutes; one record each
     python benchmarks/pfem_step_cost.py --n-tu 10 --steps 30  # one
     python benchmarks/pfem_step_cost.py --report              # the table from the JSON
-    python benchmarks/pfem_step_cost.py --full                # the whole of case 1 at t_u/10 (about half an hour)
+    python benchmarks/pfem_step_cost.py --full [--gamma G]    # the whole of case 1 at t_u/10 (about 40 minutes)
 
-``--full`` runs the cut the sweep records as 'case 1 pfem' (benchmarks/thermal_cutting.py: 16 t_u of cut on a
-2.8 mm workpiece at t_u/10, the paper's resolution) from its start, into runs/pfem_cost/ (a fresh folder each
-time: the CPU seconds are those of one uninterrupted run), and keeps its cost (CPU and wall seconds of this
+``--full`` runs the cut the sweep records as 'case 1 pfem' (benchmarks/thermal_cutting.py: 16 t_u of cut on a 2.8
+mm workpiece at t_u/10, the paper's resolution; ``--gamma``: Newmark's gamma, 0.5 the paper's rule) from its start,
+into runs/pfem_cost/ (a fresh folder each time: the CPU seconds are those of one uninterrupted run; a run that
+fails is recorded with how far it got), and keeps its cost (CPU and wall seconds of this
 process, steps, Newton iterations, halved steps, nodes) with its measures beside those of the sweep's record of the
 same cut (made by an older version of the solver: the digits the two share are those the path to the solution
 does not move).
@@ -86,23 +87,45 @@ def measure(n_tu: float, steps: int, label: str | None = None) -> dict:
                 split={k: round(v, 3) for k, v in split.items()}, tool_force_N_per_m=[float(f) for f in F])
 
 
-def measure_full(label: str | None = None) -> dict:
-    """The whole of case 1 at t_u / 10 (module text): its cost and measures, run from its start."""
+def full_folder(gamma: float) -> Path:
+    """The run folder of --full (runs/ is not tracked)."""
+    name = "case_1_n_tu_10" + ("" if gamma == 0.5 else f"_gamma_{gamma:g}")
+    return Path(__file__).resolve().parents[1] / "runs" / "pfem_cost" / name
+
+
+def measure_full(label: str | None = None, gamma: float = 0.5) -> dict:
+    """The whole of case 1 at t_u / 10 (module text) with Newmark's ``gamma`` (0.5: the paper's trapezoidal rule):
+    its cost and measures, run from its start; a run that fails is recorded as failed, with how far it got."""
     import shutil
 
     from refsph.pfem_run import run_pfem
+    from refsph.simulate import SimulationError
 
-    out = Path(__file__).resolve().parents[1] / "runs" / "pfem_cost" / "case_1_n_tu_10"
+    out = full_folder(gamma)
     if out.exists():
         shutil.rmtree(out)
     cpu, wall = time.process_time(), time.perf_counter()
-    s = run_pfem("thermal_cutting", out=out, progress=True, options=dict(FULL_OPTIONS)).summary
-    cpu, wall = time.process_time() - cpu, time.perf_counter() - wall
-    m = s["metrics"]
-    return dict(commit=label or version(), options=FULL_OPTIONS, status=s["status"], steps=s["n_steps"],
-                nodes=s["n_particles"], cpu_s=round(cpu, 1), wall_s=round(wall, 1),
+    try:
+        run_pfem("thermal_cutting", out=out, progress=True, options=dict(FULL_OPTIONS, gamma=gamma))
+    except SimulationError as e:
+        print(f"failed: {e}", file=sys.stderr)
+    return full_record(out, label, time.process_time() - cpu, time.perf_counter() - wall)
+
+
+def full_record(out: Path, label: str | None, cpu: float | None, wall: float | None = None) -> dict:
+    """The record of a --full run from its folder's summary.json: ``cpu`` and ``wall`` [s] as this process
+    measured them (``cpu`` None: a run whose process ended before it could record, ``--record``; its wall time is
+    then the run's own)."""
+    s = json.loads((out / "summary.json").read_text())
+    m = s.get("metrics") or {}
+    ok = s["status"] == "ok"
+    return dict(commit=label or version(), options=dict(s["options"]), status=s["status"],
+                t_final_s=s["t_final"], t_end_s=s["t_end"], steps=s["n_steps"], nodes=s["n_particles"],
+                cpu_s=None if cpu is None else round(cpu, 1),
+                wall_s=round(s["wall_time_s"] if wall is None else wall, 1),
                 iterations=s["newton"]["iterations"], halved_steps=s["newton"]["halved_steps"],
-                measures={key: float(m[key]) for _, key, _ in MEASURES})
+                measures={key: float(m[key]) for _, key, _ in MEASURES} if ok else None,
+                error=s.get("error", "")[:200])
 
 
 def sweep_record() -> dict | None:
@@ -124,9 +147,14 @@ def full_report(full: list, sweep: dict | None) -> list[str]:
              "| version | steps | halved | nodes | Newton iterations | CPU [min] | wall [min] | " + " | ".join(names)
              + " |", "|---" * (7 + len(names)) + "|"]
     for r in full:
-        lines.append(f"| {r['commit']} | {r['steps']} | {r['halved_steps']} | {r['nodes']} | {r['iterations']} | "
-                     f"{r['cpu_s'] / 60:.1f} | {r['wall_s'] / 60:.1f} | "
-                     + " | ".join(f"{r['measures'][key] * f:.4g}" for _, key, f in MEASURES) + " |")
+        gamma = r["options"].get("gamma", 0.5)
+        state = "" if r["status"] == "ok" else \
+            f" ({r['status']} at {1e3 * r['t_final_s']:.3g} of {1e3 * r['t_end_s']:.3g} ms)"
+        lines.append(f"| {r['commit']}{'' if gamma == 0.5 else f', gamma {gamma:g}'}{state} | {r['steps']} | "
+                     f"{r['halved_steps']} | {r['nodes']} | {r['iterations']} | "
+                     f"{'-' if r['cpu_s'] is None else format(r['cpu_s'] / 60, '.1f')} | {r['wall_s'] / 60:.1f} | "
+                     + " | ".join("-" if r["measures"] is None else f"{r['measures'][key] * f:.4g}"
+                                  for _, key, f in MEASURES) + " |")
     if sweep is not None and sweep.get("status") == "ok":
         m = sweep["metrics"]
         lines.append(f"| the sweep's record | {sweep['n_steps']} | - | {sweep['n_particles']} | - | - | "
@@ -161,14 +189,21 @@ def main(argv=None) -> int:
     ap.add_argument("--label", help="the record's name (default: the git commit of refsph)")
     ap.add_argument("--report", action="store_true", help="only print the table of the JSON")
     ap.add_argument("--full", action="store_true", help="the whole of case 1 at t_u/10 instead (module text)")
+    ap.add_argument("--gamma", type=float, default=0.5, help="--full: Newmark's gamma (default 0.5, the paper's)")
+    ap.add_argument("--record", action="store_true",
+                    help="--full: record the run in its folder (one whose process ended before it could) without "
+                         "running it again; its CPU time is then unknown")
     args = ap.parse_args(argv)
     data = json.loads(OUT_JSON.read_text()) if OUT_JSON.exists() else {}
     rows, full = data.get("rows", []), data.get("full", [])
     if args.full and not args.report:
-        rec = measure_full(args.label or version())
-        full = [r for r in full if r["commit"] != rec["commit"]] + [rec]
+        rec = full_record(full_folder(args.gamma), args.label, None) if args.record else \
+            measure_full(args.label or version(), args.gamma)
+        full = [r for r in full if (r["commit"], r["options"].get("gamma", 0.5))
+                != (rec["commit"], rec["options"].get("gamma", 0.5))] + [rec]
         OUT_JSON.write_text(json.dumps(dict(rows=rows, full=full), indent=1) + "\n")
-        print(f"case 1 at t_u/10: {rec['cpu_s'] / 60:.1f} min CPU, {rec['iterations']} iterations", flush=True)
+        print(f"case 1 at t_u/10: {rec['status']}, {rec['wall_s'] / 60:.1f} min, {rec['iterations']} iterations",
+              flush=True)
     elif not args.report:
         args.label = args.label or version()          # before this script writes its JSON (a tracked file)
         for n_tu in args.n_tu:

@@ -300,8 +300,8 @@ class CutRun:
                 dt, self.retries = 0.5 * dt, self.retries + 1
                 failure = e
         else:
-            raise NewtonFailed(f"PFEM cut: Newton failed at t = {nodes.t:.3e} s even at dt = {dt:.2e} s",
-                               *failure.args[1:])
+            raise NewtonFailed(f"PFEM cut: Newton failed at t = {nodes.t:.3e} s even at dt = {2.0 * dt:.2e} s "
+                               f"(the last try: {failure})", *failure.args[1:])     # (dt was halved after it)
         self.iterations.append(r.iterations)
         self.du_prev, self.dt_prev = r.du.copy(), dt
         nodes = commit(nodes, r, dt, cut.newmark)

@@ -85,7 +85,12 @@ __all__ = ["SolidLaw", "Nodes", "History", "Loads", "StepResult", "element_respo
 
 
 class NewtonFailed(RuntimeError):
-    """Newton-Raphson did not converge in the allowed iterations (the step should be cut)."""
+    """Newton-Raphson did not converge in the allowed iterations (the step should be cut). ``args``: the message,
+    then (where given) the residual norms per iteration and the last iterate (du, p); str() is the message alone,
+    so that a run's error (summary.json, the terminal) does not print the arrays."""
+
+    def __str__(self) -> str:
+        return str(self.args[0]) if self.args else ""
 
 
 @dataclass(frozen=True)

@@ -111,3 +111,23 @@ def test_a_spoilt_checkpoint_is_a_clear_error(tmp_path, capsys):
     assert main(["run", "--restart", str(out), "--quiet"]) == 2
     err = capsys.readouterr().err
     assert "nothing to restart from" in err and "restart.npz" in err and "Traceback" not in err
+
+
+def test_a_failed_cut_says_where_and_why_without_the_arrays():
+    """A cut whose Newton-Raphson cannot converge (here: one iteration allowed) fails with the time, the last step
+    it tried (dt / 16 after four halvings) and that try's own reason; the iterate it carries (NewtonFailed's
+    args) is not printed."""
+    from refsph.pfem.cutting import CutRun, pfem_cut
+    from refsph.pfem.solid import NewtonFailed
+
+    cut = pfem_cut(1, n_tu=5.0, travel=0.3, length=1.2e-3)
+    cut.max_iter = 1
+    run = CutRun(cut)
+    with pytest.raises(NewtonFailed) as info:
+        for _ in range(20):
+            run.step()
+    msg = str(info.value)
+    assert msg.startswith("PFEM cut: Newton failed at t = ")
+    assert f"even at dt = {cut.dt / 16:.2e} s" in msg and "(the last try: " in msg
+    assert "array(" not in msg and len(msg) < 600
+    assert len(info.value.args) == 3 and isinstance(info.value.args[2][0], np.ndarray)   # the iterate is kept

@@ -196,6 +196,8 @@ def main(argv=None) -> int:
     args = ap.parse_args(argv)
     data = json.loads(OUT_JSON.read_text()) if OUT_JSON.exists() else {}
     rows, full = data.get("rows", []), data.get("full", [])
+    if args.record and not (full_folder(args.gamma) / "summary.json").exists():
+        ap.error(f"--record: no run in {full_folder(args.gamma)} (run --full first)")
     if args.full and not args.report:
         rec = full_record(full_folder(args.gamma), args.label, None) if args.record else \
             measure_full(args.label or version(), args.gamma)

@@ -5,7 +5,9 @@ The folder (:mod:`refsph.io` documents the common files):
 
     summary.json              scene, method 'pfem', dim 2, dp (the finest spacing dx), n_particles (nodes),
                               n_steps, t_end, status, metrics (the SPH scene's keys), scene_info, heat_balance,
-                              newton (iterations, halved steps, remeshings), run_args, wall_time_s, provenance
+                              newton (iterations, halved steps, remeshings), run_args, wall_time_s, provenance;
+                              written at the start and at each checkpoint with status 'running' (so a killed run
+                              can be continued, and read), at the end with the run's status
     snapshots/snap_NNNNN.npz  the nodes as particles (t, id, x, v, m, rho, p, S, S_zz, sigma_vm, eps_p, eps_dot_p,
                               W_p, T, body) plus the mesh: ``triangles`` (M, 3) and ``boundary_edges`` (K, 2), rows
                               of the node arrays (int64); ``tool_x`` (P, 2) and ``tool_T`` (P,): the tool's nodes
@@ -150,6 +152,12 @@ def run_pfem(scene_name: str = "thermal_cutting", *, out=None, options: dict | N
         _checkpoint(snaps_dir, run, snapshots, next_snap)
     times = np.linspace(0.0, cut.t_end, N_SNAPSHOTS + 1)
     args = dict(scene_name=scene_name, method="pfem", options=dict(options or {}), quick=bool(quick))
+
+    def running_summary():                                  # at each checkpoint: a killed run can be continued
+        write_json(out / "summary.json", _summary(scene_name, run, run.result(), kwargs, args, snapshots, "running",
+                                                  None))
+    if not restart:
+        running_summary()
     status, error, t_start, steps0 = "ok", None, time.perf_counter(), run.steps
     last_print = 0.0
     try:
@@ -164,6 +172,7 @@ def run_pfem(scene_name: str = "thermal_cutting", *, out=None, options: dict | N
                 while next_snap <= N_SNAPSHOTS and run.nodes.t >= times[next_snap] * (1 - 1e-9):
                     next_snap += 1
                 _checkpoint(snaps_dir, run, snapshots, next_snap)
+                running_summary()
             now = time.perf_counter()
             if progress and now - last_print > 2.0:
                 last_print = now

@@ -131,3 +131,28 @@ def test_a_failed_cut_says_where_and_why_without_the_arrays():
     assert f"even at dt = {cut.dt / 16:.2e} s" in msg and "(the last try: " in msg
     assert "array(" not in msg and len(msg) < 600
     assert len(info.value.args) == 3 and isinstance(info.value.args[2][0], np.ndarray)   # the iterate is kept
+
+
+def test_a_killed_run_can_be_continued_from_the_command_line(short_run, tmp_path, monkeypatch):
+    """A run killed between checkpoints (here: an interrupt in its fifth step) has summary.json with status
+    'running' and how far it got, and `refsph run --restart` continues it to the uninterrupted run's numbers."""
+    from refsph.pfem.cutting import CutRun
+
+    step, calls = CutRun.step, []
+
+    def interrupted(self):
+        calls.append(1)
+        if len(calls) == 5:
+            raise KeyboardInterrupt
+        return step(self)
+    monkeypatch.setattr(CutRun, "step", interrupted)
+    out = tmp_path / "killed"
+    with pytest.raises(KeyboardInterrupt):
+        run_pfem("thermal_cutting", out=out, options=SHORT, quick=True, progress=False)
+    s = json.loads((out / "summary.json").read_text())
+    assert s["status"] == "running" and 0 < s["n_steps"] < 5 and s["method"] == "pfem"
+    monkeypatch.setattr(CutRun, "step", step)
+    assert main(["run", "--restart", str(out), "--quiet"]) == 0
+    done = json.loads((out / "summary.json").read_text())
+    assert done["status"] == "ok" and done["n_steps"] == short_run[1].summary["n_steps"]
+    assert done["metrics"]["cutting_force_N_per_m"] == short_run[1].summary["metrics"]["cutting_force_N_per_m"]

@@ -616,11 +616,8 @@ for case in (1, 10):
               f"T_FCS {c[f'TFCS_{t}_K']:.0f} K")
 
 # %% [markdown]
-# **Where it stands.** Mind chapter 11's scatter (Fc 17 % at t_u/5). 17 of the 18 cuts run; case 16's chip rings
-# under the trapezoidal rule (pressures jump by GPa a step) until Newton stalls: `pfem_cut(gamma=0.6)` damps it.
-# At the paper's resolution (t_u/10) case 1 runs 36 minutes on one core and then fails the same way at 87 % of the
-# cut; with gamma = 0.6 it crawls at a quarter step past 93 % (`benchmarks/pfem_step_cost.py --full`). An implicit
-# method has no stability limit, but its Newton-Raphson has a convergence one, and a ringing chip finds it.
+# **Where it stands.** 17 of 18 cuts run at t_u/5 (mind chapter 11's scatter, Fc 17 %); case 16's chip rings under
+# the trapezoidal rule until Newton stalls (`gamma=0.6` damps it). At t_u/10 case 1 fails so at 87 % of the cut.
 
 # %% [markdown]
 # ## Your turn

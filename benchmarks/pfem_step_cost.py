@@ -132,8 +132,7 @@ def sweep_record() -> dict | None:
     """The sweep's record of the cut --full times (None: not recorded)."""
     if not SWEEP_JSON.exists():
         return None
-    runs = json.loads(SWEEP_JSON.read_text())["runs"]
-    return next((r for r in (runs.values() if isinstance(runs, dict) else runs) if r.get("key") == FULL_KEY), None)
+    return json.loads(SWEEP_JSON.read_text())["runs"].get(FULL_KEY)        # the records by key
 
 
 def full_report(full: list, sweep: dict | None) -> list[str]:
@@ -214,8 +213,9 @@ def main(argv=None) -> int:
             rows.append(rec)
             OUT_JSON.write_text(json.dumps(dict(rows=rows, full=full), indent=1) + "\n")
             print(f"n_tu {n_tu:g}: {rec['cpu_s']:.1f} s CPU, {rec['iterations']} iterations", flush=True)
-    OUT_MD.write_text(report(rows, full, sweep_record()))
-    print(report(rows, full, sweep_record()))
+    text = report(rows, full, sweep_record())
+    OUT_MD.write_text(text)
+    print(text)
     return 0
 
 

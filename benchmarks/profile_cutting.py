@@ -40,18 +40,30 @@ def group_of(filename: str) -> str | None:
 
 
 def charged_times(stats: pstats.Stats) -> dict:
-    """Each refsph module's time: its functions' own time plus that of the non-refsph functions they call (each
-    callee's time split among its refsph callers in proportion to the calls)."""
+    """Each refsph module's time: its functions' own time plus that of the non-refsph functions they call, directly
+    or through other non-refsph functions (SciPy's sparse product under ``@``): a non-refsph function's time is
+    split among its callers in proportion to the calls, and passed on up until it reaches refsph functions."""
+    shares: dict = {}
+
+    def share(func, seen=()) -> dict:
+        """{refsph module: fraction} of the time of ``func``."""
+        if group_of(func[0]) is not None:
+            return {group_of(func[0]): 1.0}
+        if func in shares:
+            return shares[func]
+        callers = {k: v for k, v in stats.stats[func][4].items() if k not in seen and k in stats.stats}
+        total = sum(v[0] for v in callers.values())
+        out: dict = {}
+        for caller, v in callers.items():
+            for mod, f in share(caller, seen + (func,)).items():
+                out[mod] = out.get(mod, 0.0) + f * v[0] / total
+        shares[func] = out
+        return out
+
     out: dict[str, float] = {}
-    for (fname, _, _), (_, _, tottime, _, callers) in stats.stats.items():
-        own = group_of(fname)
-        if own is not None:
-            out[own] = out.get(own, 0.0) + tottime
-            continue
-        refsph_callers = {k: v for k, v in callers.items() if group_of(k[0]) is not None}
-        total = sum(v[0] for v in refsph_callers.values())
-        for (cname, _, _), v in refsph_callers.items():
-            out[group_of(cname)] = out.get(group_of(cname), 0.0) + tottime * v[0] / total
+    for func, (_, _, tottime, _, _) in stats.stats.items():
+        for mod, f in share(func).items():
+            out[mod] = out.get(mod, 0.0) + tottime * f
     return out
 
 

@@ -103,6 +103,7 @@ class PenaltyCoupling:
         self.max_penetration = 0.0
         self.n_contacts = 0
         self.rows: list | None = None                      # each body's rows (State.body is fixed in a run)
+        self.trees: dict = {}                              # each body's k-d tree in its own frame (nearest_rows)
 
     def body_rows(self, state: State) -> list:
         """The rows of each rigid body (found once: a run's State.body does not change)."""
@@ -118,6 +119,31 @@ class PenaltyCoupling:
         d = x - centre
         return np.flatnonzero(np.einsum("nd,nd->n", d, d) <= (radius + self.contact.offset) ** 2)
 
+    def nearest_rows(self, i: int, xb: np.ndarray, shift: np.ndarray, points: np.ndarray) -> np.ndarray:
+        """For each of ``points``, the index into ``xb`` (body i's particles, moved by ``shift``) of the particle
+        nearest to it: the answer of a k-d tree of ``xb`` built anew, without building one each step. A rigid body's
+        particles keep their places relative to ``shift`` up to round-off, so the tree is built once in that frame;
+        it names each point's 4 nearest there, and these are measured at their current places. Where the body's
+        particles have moved in its frame by more than the gap between a point's nearest and 4th nearest could hide
+        (a turning body), the tree is built anew."""
+        rel = xb - shift
+        cached = self.trees.get(i)
+        if cached is None or cached[1].shape != rel.shape:
+            cached = self.trees[i] = (cKDTree(rel), rel)
+        tree, rel0 = cached
+        k = min(4, len(xb))
+        dist, cand = tree.query(points - shift, k=k)
+        dist, cand = dist.reshape(len(points), k), cand.reshape(len(points), k)
+        slack = 2.0 * float(np.abs(rel - rel0).max()) + 1e-12 * (1.0 + float(np.abs(points).max()))
+        if k < len(xb) and np.any(dist[:, -1] <= dist[:, 0] + slack):
+            self.trees[i] = (cKDTree(rel), rel)
+            return cKDTree(xb).query(points)[1]
+        gap = xb[cand] - points[:, None, :]
+        r2 = gap[..., 0] * gap[..., 0]
+        for a in range(1, xb.shape[1]):
+            r2 += gap[..., a] * gap[..., a]
+        return cand[np.arange(len(points)), np.argmin(r2, axis=1)]
+
     def with_tools(self, state: State, n: int, dt: float) -> ContactResult:
         """The contact of the deformable rows [0, n) with the rigid bodies for a step dt (a ContactResult: the
         deformable rows' acceleration, the force on each rigid row, the friction power on both sides)."""
@@ -130,8 +156,9 @@ class PenaltyCoupling:
         a, power_a, damping_a = np.zeros((n, d)), np.zeros(n), np.zeros(n)
         force_b, power_b = np.zeros((state.n - n, d)), np.zeros(state.n - n)
         trial, contacts, deepest = np.zeros((n, d)), 0, 0.0
-        for b, rows in zip(self.rigid, self.body_rows(state)):
-            shift = state.x[rows].mean(axis=0)
+        for i, (b, rows) in enumerate(zip(self.rigid, self.body_rows(state))):
+            xb = state.x[rows]
+            shift = xb.mean(axis=0)
             near = self.candidates(x, b.shape, shift)
             c = penalty_contact(x[near], v[near], m[near], None if T is None else T[near], b.shape, shift,
                                 np.asarray(b.velocity), dt, self.contact, self.xi[near])
@@ -143,7 +170,7 @@ class PenaltyCoupling:
             force_b[rows - n] = c.force_on_tool[None, :] * (mb / mb.sum())[:, None]
             hot = np.flatnonzero(c.friction_power > 0)
             if len(hot):
-                _, nearest = cKDTree(state.x[rows]).query(x[near[hot]])
+                nearest = self.nearest_rows(i, xb, shift, x[near[hot]])
                 np.add.at(power_b, rows[nearest] - n, c.friction_power[hot])
             contacts += int(np.count_nonzero(c.gap > 0))
             deepest = max(deepest, float(c.gap.max(initial=0.0)))

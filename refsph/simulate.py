@@ -132,7 +132,7 @@ def step_physics(setup: Setup) -> list[StepPhysics]:
     chi = float(getattr(setup.strength, "chi", 0.0)) if heats(setup.strength) else 0.0
     return [HeatFlow(setup.thermal, setup.friction_heat, heat_capacity(setup.strength), chi, setup.h,
                      get_kernel(setup.numerics.kernel), [b.body for b in setup.rigid],
-                     dissipation_heat=bool(setup.dissipation_heat))]
+                     dissipation_heat=bool(setup.dissipation_heat), every=setup.numerics.heat_every)]
 
 
 def _deformable_bodies(setup: Setup) -> list:

@@ -303,6 +303,77 @@ def thermal_step(state, model: Conduction | None, k: np.ndarray, c: np.ndarray, 
 
 
 LEDGER = ("plastic", "friction", "dissipation", "lost", "removed")
+
+
+def dissipation_heat(T: np.ndarray, Q: np.ndarray, mc: np.ndarray, conduction: Conduction | None,
+                     ledger: dict) -> np.ndarray:
+    """T after the numerical dissipation's heat Q [J per row] goes into the rows it was taken from (ledger
+    'dissipation'), the fixed rows reset (ledger 'removed')."""
+    T = T + Q / mc
+    ledger["dissipation"] += float(Q.sum())
+    if conduction is not None and len(conduction.fixed):
+        fixed = np.asarray(conduction.fixed)
+        ledger["removed"] += float(np.sum(mc[fixed] * (T[fixed] - conduction.T_fixed)))
+        T[fixed] = conduction.T_fixed
+    return T
+
+
+def ledger_balance(h: dict, stored: float) -> dict:
+    """The heat ledger ``h`` [J] with the heat ``stored``: made (plastic, friction, dissipation), stored, lost
+    (surface), removed (at fixed temperatures), and the residual made - stored - lost - removed."""
+    made = h["plastic"] + h["friction"] + h["dissipation"]
+    residual = made - stored - h["lost"] - h["removed"]
+    return dict(plastic_J=h["plastic"], friction_J=h["friction"], dissipation_J=h["dissipation"],
+                stored_J=stored, lost_J=h["lost"],
+                removed_J=h["removed"], residual_J=residual, residual_rel=residual / made if made > 0 else 0.0)
+
+
+class KeptHeat:
+    """The heat made in the steps since the last heat step, when the heat step runs once every ``every`` mechanical
+    steps (``Numerics.heat_every``): the steps' summed dt and, per row, the frictional and dissipated energies
+    (power x dt), and the contact damping's energy (the ledger's part of 'dissipation'). The heat step then runs
+    over the summed step with the mean powers (the same energies), so that its cost is shared by ``every`` steps: an
+    operator split in which conduction lags the mechanics by at most ``every`` - 1 steps (the plastic heat of the
+    return map raises T every step), and whose heat step must be stable over ``every`` steps
+    (:meth:`HeatFlow.step_limit` divides the limit by ``every``)."""
+
+    def __init__(self, every: int):
+        self.every = int(every)
+        self.store: dict | None = None
+
+    def keep(self, dt: float, power, diss, damping, n: int) -> bool:
+        """Keep a step's heat (its powers: None where the step made none); True when the heat step is due."""
+        if self.store is None:
+            self.store = dict(steps=0, dt=0.0, friction=np.zeros(n), dissipation=np.zeros(n), damping=0.0,
+                              has_friction=False, has_dissipation=False, has_damping=False)
+        k = self.store
+        k["steps"] += 1
+        k["dt"] += dt
+        for name, p in (("friction", power), ("dissipation", diss)):
+            if p is not None:
+                k[name] += dt * p
+                k["has_" + name] = True
+        if damping is not None:
+            k["damping"] += dt * float(damping.sum())
+            k["has_damping"] = True
+        return k["steps"] >= self.every
+
+    def take(self) -> tuple:
+        """(dt, friction power, dissipated power, damping power) of the steps kept: their summed step and the mean
+        powers over it (the same energies); the store emptied."""
+        k, self.store = self.store, None
+        dt = k["dt"]
+        return (dt, k["friction"] / dt if k["has_friction"] else None,
+                k["dissipation"] / dt if k["has_dissipation"] else None,
+                np.array([k["damping"] / dt]) if k["has_damping"] else None)
+
+    def checkpoint(self) -> dict:
+        return {} if self.store is None else {f"pending_{k}": np.asarray(v) for k, v in self.store.items()}
+
+    def restore(self, arrays: dict) -> "KeptHeat":
+        kept = {k.removeprefix("pending_"): np.asarray(arrays[k]) for k in arrays if k.startswith("pending_")}
+        self.store = {k: (v.copy() if v.ndim else v.item()) for k, v in kept.items()} or None
+        return self
 SKIN = 0.3                                  # the heat step's Verlet skin, in units of h
 
 
@@ -312,12 +383,13 @@ class HeatFlow:
     ``cp``, ``chi``: the deformable body's heat capacity and Taylor-Quinney coefficient (the strength model's; chi
     0 when the law does not heat); ``rigid_ids``: the rigid bodies' ids; ``h``, ``kernel``: the run's;
     ``dissipation_heat``: the numerical dissipation of the step's rates (``Rates.heat_power``: artificial viscosity,
-    contact damping) heats the row it was taken from (ledger entry 'dissipation')."""
+    contact damping) heats the row it was taken from (ledger entry 'dissipation'); ``every``: the heat step runs
+    once every this many mechanical steps (:class:`KeptHeat`)."""
 
     name = "heat"
 
     def __init__(self, conduction: Conduction | None, friction_heat: FrictionHeat | None, cp: float, chi: float,
-                 h: float, kernel: Kernel, rigid_ids=(), *, dissipation_heat: bool = False):
+                 h: float, kernel: Kernel, rigid_ids=(), *, dissipation_heat: bool = False, every: int = 1):
         if not (cp is not None and np.isfinite(cp) and cp > 0):
             raise ValueError("heat conduction and frictional heat need the body's heat capacity: the strength "
                              f"model's cp (JohnsonCook(cp=...), Elastic(cp=...)), got {cp!r}")
@@ -331,6 +403,8 @@ class HeatFlow:
         self.pairs = VerletList(kernel.support * h, SKIN * h)   # the heat step's pair search (module text)
         self.pair_sum = self.k_pair = None                    # the Verlet list's PairSum and its pairs' 2 k_ij
         self.rho_of_return_map = "start"
+        self.every = int(every)
+        self.kept = KeptHeat(self.every) if self.every > 1 else None   # the heat made since the last heat step
 
     def bind(self, state, solver) -> None:
         """Per-row k and c (constant through a run), the initial temperatures, and which density the solver's
@@ -347,7 +421,7 @@ class HeatFlow:
     def step_limit(self, state) -> float:
         if self.conduction is None:
             return np.inf
-        return _step_limit(state.rho, self.k, self.c, self.h, self.conduction.courant)
+        return _step_limit(state.rho, self.k, self.c, self.h, self.conduction.courant) / self.every
 
     def plastic_heat(self, before, after) -> float:
         """chi sum_i m_i (W_p,i(after) - W_p,i(before)) / rho_i [J]: the plastic heat of a step (Eq. (28) summed),
@@ -359,25 +433,27 @@ class HeatFlow:
 
     def advance(self, before, step, dt: float):
         """The heat step after the mechanical one (``step``: :class:`refsph.integrate.Step`): the ledger takes the
-        plastic heat, then conduction, frictional heat, losses and fixed rows move the temperatures."""
+        plastic heat, then conduction, frictional heat, losses and fixed rows move the temperatures (or, between
+        heat steps, the step's heat is kept: :class:`KeptHeat`)."""
         after = step.state
         self.ledger["plastic"] += self.plastic_heat(before, after)
-        power = step.rates.friction_power if step.rates is not None else None
+        rates = step.rates
+        power = rates.friction_power if rates is not None else None
+        diss = rates.heat_power if self.dissipation_heat and rates is not None else None
+        damping = rates.damping_power if diss is not None and self.damping is not None else None
+        if self.kept is not None:
+            if not self.kept.keep(dt, power, diss, damping, after.n):
+                return after                                # the heat step is not due: T as the mechanics left it
+            dt, power, diss, damping = self.kept.take()
         pairs, pair_sum = self.pairs_and_sum(after.x)
         T, moved = thermal_step(after, self.conduction, self.k, self.c, self.h, self.kernel, dt, self.friction_heat,
                                 power, self.tool_rows, pairs, self.surface_rows(after, pairs), pair_sum, self.k_pair)
         for key, val in moved.items():
             self.ledger[key] += val
-        if self.dissipation_heat and step.rates is not None and step.rates.heat_power is not None:
-            Q = dt * step.rates.heat_power                             # [J] per row, taken from the motion
-            T = T + Q / self.mc
-            self.ledger["dissipation"] += float(Q.sum())
-            if self.damping is not None and step.rates.damping_power is not None:
-                self.damping += dt * float(step.rates.damping_power.sum())
-            if self.conduction is not None and len(self.conduction.fixed):
-                fixed = np.asarray(self.conduction.fixed)
-                self.ledger["removed"] += float(np.sum(self.mc[fixed] * (T[fixed] - self.conduction.T_fixed)))
-                T[fixed] = self.conduction.T_fixed
+        if diss is not None:
+            T = dissipation_heat(T, dt * diss, self.mc, self.conduction, self.ledger)
+            if damping is not None:
+                self.damping += dt * float(damping.sum())
         after.T = T
         return after
 
@@ -415,13 +491,7 @@ class HeatFlow:
         """The heat ledger [J; per metre of thickness in 2D]: made (plastic, friction, dissipation), stored
         (sum m c (T - T0)), lost (surface), removed (at fixed temperatures), and the residual
         made - stored - lost - removed."""
-        stored = float(np.sum(self.mc * (state.T - self.T0)))
-        h = self.ledger
-        made = h["plastic"] + h["friction"] + h["dissipation"]
-        residual = made - stored - h["lost"] - h["removed"]
-        return dict(plastic_J=h["plastic"], friction_J=h["friction"], dissipation_J=h["dissipation"],
-                    stored_J=stored, lost_J=h["lost"],
-                    removed_J=h["removed"], residual_J=residual, residual_rel=residual / made if made > 0 else 0.0)
+        return ledger_balance(self.ledger, float(np.sum(self.mc * (state.T - self.T0))))
 
     def record(self, state) -> dict:
         return {f"heat_{k}": v for k, v in self.balance(state).items()}
@@ -447,6 +517,7 @@ class HeatFlow:
             ck["damping"] = np.float64(self.damping)
         if self.surface is not None:
             ck.update(surface=self.surface.copy(), surface_x=self.surface_x.copy())
+        ck.update(self.kept.checkpoint() if self.kept is not None else {})
         return ck
 
     def restore(self, arrays: dict) -> None:
@@ -455,6 +526,7 @@ class HeatFlow:
             None if self.ledger["dissipation"] > 0.0 else 0.0)
         if "surface" in arrays:
             self.surface, self.surface_x = np.array(arrays["surface"], dtype=bool), np.array(arrays["surface_x"])
+        self.kept = self.kept and self.kept.restore(arrays)
 
 
 def describe_heat_flow(flow: HeatFlow) -> dict:

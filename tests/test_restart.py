@@ -18,7 +18,10 @@ CASES = [("taylor", "tlsph", dict(dim=2, quick=True, t_end=6e-6)),
          ("thermal_cutting", "tlsph", dict(quick=True, t_end=2e-5, numerics=dict(threads=1),     # heat flow, ledger
                                            options=dict(case=1, length=0.5e-3, travel=1.0))),
          ("thermal_cutting", "tlsph", dict(quick=True, t_end=2e-5, numerics=dict(threads=1, contact="penalty"),
-                                           options=dict(case=1, length=0.5e-3, travel=1.0)))]   # friction history
+                                           options=dict(case=1, length=0.5e-3, travel=1.0))),   # friction history
+         ("thermal_cutting", "tlsph", dict(quick=True, t_end=2e-5,                # heat kept between heat steps
+                                           numerics=dict(threads=1, contact="penalty", heat_every=3),
+                                           options=dict(case=1, length=0.5e-3, travel=1.0)))]
 
 
 def _killed(monkeypatch, scene, method, out, kw):
@@ -40,6 +43,7 @@ def _killed(monkeypatch, scene, method, out, kw):
 @pytest.mark.parametrize("scene, method, kw", CASES,
                          ids=[f"{c[0]}-{c[1]}" + ("-leapfrog" if "integrator" in c[2].get("numerics", {}) else "")
                               + ("-penalty" if c[2].get("numerics", {}).get("contact") == "penalty" else "")
+                              + ("-heat_every" if "heat_every" in c[2].get("numerics", {}) else "")
                               for c in CASES])
 def test_restart_is_bit_for_bit(tmp_path, monkeypatch, scene, method, kw):
     whole = run(scene, method, out=tmp_path / "whole", progress=False, **kw)

@@ -38,8 +38,10 @@ class Numerics:
     tools' exact geometry, ``RigidBody.shape``); penalty_alpha: the penalty stiffness alpha m / dt^2 (the fraction of
     the penetration removed per step); penalty_damping: the damping ratio of the penalty's normal spring;
     max_condition: TLSPH's kernel-gradient correction inverts a moment matrix whose condition number exceeds it
-    only up to it (:func:`refsph.kernels.correction_matrix`; None = no limit, as in the paper). The
-    numbers of a run do not depend on ``threads``, only its speed does.
+    only up to it (:func:`refsph.kernels.correction_matrix`; None = no limit, as in the paper); heat_every: the
+    heat step (conduction, frictional heat, losses, :class:`refsph.thermal.HeatFlow`) runs once every this many
+    mechanical steps, over their summed step with the heat they made (1 = every step; the plastic heat of the return
+    map still raises T every step). The numbers of a run do not depend on ``threads``, only its speed does.
     """
 
     h_over_dp: float = 1.5
@@ -63,6 +65,7 @@ class Numerics:
     penalty_alpha: float = 0.1
     penalty_damping: float = 0.5
     max_condition: float | None = None
+    heat_every: int = 1
 
     def __post_init__(self):
         """Every parameter checked when the Numerics is made (a scene's, or ``--set``'s replacement of it), so that
@@ -90,6 +93,8 @@ class Numerics:
         real("max_condition", 1.0, lo_open=True, optional=True)
         if not (isinstance(self.threads, int) and not isinstance(self.threads, bool) and self.threads >= 0):
             raise ValueError(f"numerical parameter threads must be a whole number >= 0, got {self.threads!r}")
+        if not (isinstance(self.heat_every, int) and not isinstance(self.heat_every, bool) and self.heat_every >= 1):
+            raise ValueError(f"numerical parameter heat_every must be a whole number >= 1, got {self.heat_every!r}")
         for name, choices in (("kernel", tuple(KERNELS)), ("contact", ("pinball", "penalty"))):
             if getattr(self, name) not in choices:
                 raise ValueError(f"numerical parameter {name} must be one of {', '.join(choices)}, got "

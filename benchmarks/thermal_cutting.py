@@ -663,6 +663,24 @@ def status_lines(records: dict, todo: dict, quick: bool = False) -> list[str]:
     return lines
 
 
+def backfill_cpu(st) -> list[str]:
+    """Records made before the sweep kept the CPU seconds get them from their run folder's summary.json, where that
+    is the same run (ok, the same number of steps); the keys filled."""
+    filled = []
+
+    def change(doc):
+        for key, rec in doc.get("runs", {}).items():
+            path = run_folder(key, rec.get("quick", False)) / "summary.json"
+            if rec.get("cpu_time_s") is not None or rec.get("status") != "ok" or not path.exists():
+                continue
+            s = json.loads(path.read_text())
+            if s.get("status") == "ok" and s.get("n_steps") == rec.get("n_steps") and s.get("cpu_time_s"):
+                rec["cpu_time_s"] = s["cpu_time_s"]
+                filled.append(key)
+    st.update(change)
+    return filled
+
+
 def main(argv=None) -> int:
     args = _parser().parse_args(argv)
     if args.quick and args.json == OUT_JSON:
@@ -676,6 +694,8 @@ def main(argv=None) -> int:
     if args.status:
         print("\n".join(status_lines(store(args.json).records(), todo, args.quick)))
         return 0
+    if args.backfill_cpu:
+        print(f"CPU seconds from the run folders: {', '.join(backfill_cpu(store(args.json))) or 'none'}")
     if not args.report:
         if not sweep(store(args.json), todo, args):
             print("nothing ran: every run asked for is recorded; the JSON, the page and the figures are unchanged "
@@ -704,6 +724,8 @@ def _parser():
     study.add_flags(ap, "report", "quick", report=dict(help="table and figures from the committed JSON only"),
                     quick=dict(help="quick short cuts (a try-out; give --json elsewhere)"))
     ap.add_argument("--json", type=Path, default=OUT_JSON, help="the records (default: the committed JSON)")
+    ap.add_argument("--backfill-cpu", action="store_true",
+                    help="records without CPU seconds get them from their run folder's summary (then the report)")
     ap.add_argument("--status", action="store_true",
                     help="no runs: each job's record, or how far its run folder has got, or 'to run'")
     return ap

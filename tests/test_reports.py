@@ -117,6 +117,26 @@ def test_thermal_cutting_status_reads_records_and_run_folders(tmp_path, monkeypa
     assert lines[2].endswith("to run") and mod.run_folder("case 1 s/2").name == "case_1_s2"
 
 
+def test_thermal_cutting_backfills_cpu_seconds_only_from_the_same_run(tmp_path, monkeypatch):
+    """--backfill-cpu: a record without CPU seconds takes them from its run folder's summary when that summary is
+    the same run (ok, the same steps); a record that has them, a folder of another run, or none, are left alone."""
+    mod = _script("thermal_cutting")
+    monkeypatch.setattr(mod, "RUNS", tmp_path / "runs")
+    for key, steps, status in (("case 1", 100, "ok"), ("case 2", 99, "ok"), ("case 3", 100, "running"),
+                               ("case 5", 100, "ok")):
+        folder = mod.run_folder(key)
+        folder.mkdir(parents=True)
+        (folder / "summary.json").write_text(json.dumps(dict(status=status, n_steps=steps, cpu_time_s=60.0)))
+    runs = {k: dict(status="ok", n_steps=100) for k in ("case 1", "case 2", "case 3", "case 4")}
+    runs["case 5"] = dict(status="ok", n_steps=100, cpu_time_s=30.0)
+    path = tmp_path / "sweep.json"
+    path.write_text(json.dumps(dict(runs=runs)))
+    assert mod.backfill_cpu(mod.store(path)) == ["case 1"]
+    got = json.loads(path.read_text())["runs"]
+    assert got["case 1"]["cpu_time_s"] == 60.0 and got["case 5"]["cpu_time_s"] == 30.0
+    assert all("cpu_time_s" not in got[k] for k in ("case 2", "case 3", "case 4"))
+
+
 def test_viscous_pressure_is_the_pair_pressure_of_the_artificial_viscosity(tmp_path, capsys):
     """benchmarks/viscous_stress.py: on a lattice squeezed uniformly (x = 0.98 X, v = -gamma x: every pair
     approaches) a pair's viscous pressure is rho0^2 pi_ij / 2 (rho0 the reference density; pi_ij of Eqs. (12)-(13),

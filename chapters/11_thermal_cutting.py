@@ -93,15 +93,19 @@ for name, rows in conv.items():
 # %% [markdown]
 # Between two materials (chip and tool) the pair conductivity is the harmonic mean $2k_ik_j/(k_i+k_j)$ (Cleary &
 # Monaghan 1999). The explicit step must stay below $\rho c_p h^2/k$ times a factor (the paper's CFL 0.25–0.4);
-# refsph takes the smaller of it and the mechanical step. Where the heat step's limit is many mechanical steps (30–60
-# for steel at $t_u/10$), `--set heat_every=8` runs the heat step once every 8 mechanical steps, over their summed
-# step with the frictional and dissipated heat they made (an operator split, `refsph.thermal.KeptHeat`; the plastic
-# heat still raises $T$ every step): case 1 at $t_u/10$ in 36.5 instead of 51.7 min of CPU, its results within the
-# run-to-run scatter measured at $t_u/5$ (`benchmarks/thermal_cutting_report.md`). The tool conducts with the paper's *reduced* heat
+# refsph takes the smaller of it and the mechanical step. The tool conducts with the paper's *reduced* heat
 # capacity, $c_p$ = 15 J/(kg K) instead of about 200: a real tool takes seconds to warm up, the simulated cut lasts
 # a millisecond, and a small $c_p$ brings the tool to its steady temperature within the cut (their reason, after
 # Childs).
-#
+
+# %% [markdown]
+# Even so the heat step's limit is many mechanical steps (30–60 for steel at $t_u/10$), so `--set heat_every=8` runs
+# the heat step once every 8 mechanical steps, over their summed step with the frictional and dissipated heat they
+# made (an operator split, `refsph.thermal.KeptHeat`; the plastic heat still raises $T$ every step): case 1 at
+# $t_u/10$ in 36.5 instead of 51.7 min of CPU, its results within the run-to-run scatter measured at $t_u/5$
+# (`benchmarks/thermal_cutting_report.md`).
+
+# %% [markdown]
 # ## 2. Friction whose coefficient falls with temperature
 #
 # Coulomb friction $f_t \le \mu(T) f_n$ with (their Eqs. (10)–(11))

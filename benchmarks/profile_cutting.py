@@ -46,18 +46,21 @@ def charged_times(stats: pstats.Stats) -> dict:
     shares: dict = {}
 
     def share(func, seen=()) -> dict:
-        """{refsph module: fraction} of the time of ``func``."""
+        """{refsph module: fraction} of the time of ``func``: its callers' shares weighted by their calls, over the
+        callers whose chain reaches refsph (a chain back into ``seen``, a call cycle, does not)."""
         if group_of(func[0]) is not None:
             return {group_of(func[0]): 1.0}
-        if func in shares:
+        if not seen and func in shares:
             return shares[func]
-        callers = {k: v for k, v in stats.stats[func][4].items() if k not in seen and k in stats.stats}
-        total = sum(v[0] for v in callers.values())
+        parts = [(v[0], share(k, seen + (func,))) for k, v in stats.stats[func][4].items()
+                 if k not in seen and k in stats.stats]
+        total = sum(calls for calls, sub in parts if sub)
         out: dict = {}
-        for caller, v in callers.items():
-            for mod, f in share(caller, seen + (func,)).items():
-                out[mod] = out.get(mod, 0.0) + f * v[0] / total
-        shares[func] = out
+        for calls, sub in parts:
+            for mod, f in sub.items():
+                out[mod] = out.get(mod, 0.0) + f * calls / total
+        if not seen:                                        # (a share found with callers left out is not kept)
+            shares[func] = out
         return out
 
     out: dict[str, float] = {}

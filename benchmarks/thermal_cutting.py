@@ -508,7 +508,7 @@ STUDIES = (
     ("The heat step once every 8 mechanical steps (Numerics.heat_every = 8; the heat step's stable step, the "
      "tool's with its reduced c_p, is 30-60 mechanical steps of AISI 1045 at t_u/10, 5 of Ti6Al4V): the cost of a "
      "converged case (issue 22's target: under 40 min of CPU on one core) beside case 1 at every step and its "
-     "run-to-run scatter (CPU: of the run's own process, beside other runs; blank where the record predates it)",
+     "run-to-run scatter (CPU: of the run's own process, beside other runs; '-' where the record predates it)",
      ("case 1 heat every 8",) + SCATTER_KEYS,
      BASIC + (("steps", "n_steps", "d"), ("CPU [min]", "cpu_min", ".1f"), ("wall [s]", "wall", ".0f"))),
     ("The PFEM's resolution (case 1: the short cut of --quick, 4 t_u on a workpiece 1.2 mm long, and the full cut "
@@ -696,6 +696,7 @@ def main(argv=None) -> int:
         return 0
     if args.backfill_cpu:
         print(f"CPU seconds from the run folders: {', '.join(backfill_cpu(store(args.json))) or 'none'}")
+        args.report = True                                  # then the page, not a sweep
     if not args.report:
         if not sweep(store(args.json), todo, args):
             print("nothing ran: every run asked for is recorded; the JSON, the page and the figures are unchanged "

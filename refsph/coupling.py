@@ -134,7 +134,9 @@ class PenaltyCoupling:
         k = min(4, len(xb))
         dist, cand = tree.query(points - shift, k=k)
         dist, cand = dist.reshape(len(points), k), cand.reshape(len(points), k)
-        slack = 2.0 * float(np.abs(rel - rel0).max()) + 1e-12 * (1.0 + float(np.abs(points).max()))
+        moved = rel - rel0
+        slack = 2.0 * float(np.sqrt(np.einsum("nd,nd->n", moved, moved).max())) + 1e-12 * (1.0 + float(
+            np.abs(points).max()))
         if k < len(xb) and np.any(dist[:, -1] <= dist[:, 0] + slack):
             self.trees[i] = (cKDTree(rel), rel)
             return cKDTree(xb).query(points)[1]

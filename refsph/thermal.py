@@ -335,7 +335,10 @@ class KeptHeat:
     over the summed step with the mean powers (the same energies), so that its cost is shared by ``every`` steps: an
     operator split in which conduction lags the mechanics by at most ``every`` - 1 steps (the plastic heat of the
     return map raises T every step), and whose heat step must be stable over ``every`` steps
-    (:meth:`HeatFlow.step_limit` divides the limit by ``every``)."""
+    (:meth:`HeatFlow.step_limit` divides the limit by ``every``, so a value above the heat step's limit in mechanical
+    steps shortens the mechanical step). Snapshots between heat steps show T before the kept heat, and the heat
+    kept when a run ends (at most ``every`` - 1 steps) is not applied: the ledger books heat only when it is applied,
+    so the balance holds."""
 
     def __init__(self, every: int):
         self.every = int(every)

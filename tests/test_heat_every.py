@@ -29,7 +29,7 @@ def _state():
 
 def _flow(every: int, state) -> HeatFlow:
     flow = HeatFlow(Conduction(k=50.0, courant=0.3), FrictionHeat(eta=1.0, chip_fraction=1.0), 500.0, 0.0, H,
-                    get_kernel("wendland"), every=every)
+                    get_kernel("wendland"), every=every, dissipation_heat=True)
     flow.bind(state, SimpleNamespace(evolved=()))
     return flow
 
@@ -40,7 +40,9 @@ def _steps(flow: HeatFlow, state, n: int, t_list=None):
     for i in range(n):
         power = np.zeros(state.n)
         power[30] = 1e3 * (1 + i % 3)                              # [W/m], changing from step to step
-        rates = Rates(x=z2, v=z2, rho=None, S=np.zeros((state.n, 2, 2)), S_zz=z, friction_power=power)
+        diss, damping = 0.5 * power[::-1].copy(), 0.1 * power                # dissipation, of which damping
+        rates = Rates(x=z2, v=z2, rho=None, S=np.zeros((state.n, 2, 2)), S_zz=z, friction_power=power,
+                      heat_power=diss, damping_power=damping)
         after = state.copy()
         after.t = state.t + DT
         state = flow.advance(state, Step(after, rates), DT)
@@ -58,7 +60,9 @@ def test_the_heat_kept_is_the_heat_made_and_the_temperatures_follow_every_step()
     T0 = _state().T
     for k, T in enumerate(seen):                   # between heat steps T stays as the last one left it
         assert np.array_equal(T, seen[k - 1] if k else T0) == ((k + 1) % every != 0)
-    assert kept.ledger["friction"] == pytest.approx(one.ledger["friction"], rel=1e-12)
+    for key in ("friction", "dissipation"):                        # the heat kept is the heat made
+        assert kept.ledger[key] == pytest.approx(one.ledger[key], rel=1e-12) and one.ledger[key] > 0
+    assert kept.damping == pytest.approx(one.damping, rel=1e-12) and one.damping > 0
     assert abs(kept.balance(b)["residual_rel"]) < 1e-9               # (the every-step flow: the same round-off)
     change = np.abs(a.T - T0).max()
     assert change > 0.1                                            # the heat flowed (K)

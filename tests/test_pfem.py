@@ -357,6 +357,29 @@ def test_a_slip_that_reverses_sticks_first():
     assert c.freeze(backwards) and c.slip[0] == -first                  # from sticking, beyond the cap: slips
 
 
+def test_a_frozen_slip_turned_against_its_direction_sticks():
+    """StepContact.stick_reversed: within a frozen solve a node frozen sliding one way whose trial force at the
+    solve's last iterate points the other way is made to stick (its frozen friction would push it the way it goes,
+    and the solve cannot settle: case 1 at t_u/10, 1.393 ms); a node whose trial force still points its way, and a
+    contact with no frozen sets, are left alone."""
+    from refsph.contact import CoulombFriction
+    from refsph.penalty import RoundedPolygon
+    from refsph.pfem.contact import StepContact, ToolContact
+    flat = RoundedPolygon.from_polygon([[-1e-3, -1e-3], [3e-3, -1e-3], [3e-3, 0.0], [-1e-3, 0.0]], 0.0, [0.0, 0.0])
+    params = ToolContact(k_normal=1e12, k_tangent=1e12,
+                         friction=CoulombFriction(mu0=0.3, q=1.0, T_room=293.0, T_melt=1800.0))
+    x_n = np.array([[0.0, -1e-7], [1e-4, -1e-7]])                      # both 1e-7 deep: cap 3 N/m
+    c = StepContact(params, flat, [0.0, 0.0], [0.0, 0.0], x_n, np.zeros(2), np.full(2, 293.0), np.full(2, 1e-4),
+                    np.arange(2))
+    assert not c.stick_reversed(x_n)                                    # no frozen sets: nothing to do
+    c.freeze(x_n + [[1e-7, 0.0], [1e-7, 0.0]])                          # both slide one way (trial -10 N/m)
+    first = c.slip.copy()
+    assert np.all(first != 0)
+    assert c.stick_reversed(x_n + [[-1e-7, 0.0], [2e-7, 0.0]])          # the first turned, the second did not
+    assert c.slip[0] == 0.0 and c.slip[1] == first[1]
+    assert not c.stick_reversed(x_n + [[-1e-7, 0.0], [2e-7, 0.0]])      # once stuck, nothing more
+
+
 def test_solve_linear_fast_path_and_fallback():
     """solve_linear: the diagonal-pivot SuperLU path solves a PFEM-like matrix; a matrix whose diagonal vanishes
     (where diagonal pivots fail) falls back to partial pivoting and is still solved."""

@@ -359,9 +359,9 @@ def test_a_slip_that_reverses_sticks_first():
 
 def test_a_frozen_slip_turned_against_its_direction_sticks():
     """StepContact.stick_reversed: within a frozen solve a node frozen sliding one way whose trial force at the
-    solve's last iterate points the other way is made to stick (its frozen friction would push it the way it goes,
-    and the solve cannot settle: case 1 at t_u/10, 1.393 ms); a node whose trial force still points its way, and a
-    contact with no frozen sets, are left alone."""
+    solve's last iterate points the other way is made to stick for the step (its frozen friction would push it the
+    way it goes, and the solve cannot settle: case 1 at t_u/10, 1.393 ms); a node whose trial force still points
+    its way, and a contact with no frozen sets, are left alone."""
     from refsph.contact import CoulombFriction
     from refsph.penalty import RoundedPolygon
     from refsph.pfem.contact import StepContact, ToolContact
@@ -378,6 +378,8 @@ def test_a_frozen_slip_turned_against_its_direction_sticks():
     assert c.stick_reversed(x_n + [[-1e-7, 0.0], [2e-7, 0.0]])          # the first turned, the second did not
     assert c.slip[0] == 0.0 and c.slip[1] == first[1]
     assert not c.stick_reversed(x_n + [[-1e-7, 0.0], [2e-7, 0.0]])      # once stuck, nothing more
+    c.freeze(x_n + [[1e-7, 0.0], [1e-7, 0.0]])                          # and it stays stuck for the step
+    assert c.slip[0] == 0.0 and c.slip[1] == first[1]
 
 
 def test_solve_linear_fast_path_and_fallback():

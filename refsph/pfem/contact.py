@@ -70,6 +70,7 @@ class StepContact:
         self.mu = np.zeros(len(x_n)) if params.friction is None else params.friction.mu(T)
         self.last = None
         self.active = self.slip = None                         # frozen sets (None: decided by the gap / the cap)
+        self.stuck = np.zeros(len(x_n), bool)                  # made to stick for the step (stick_reversed)
 
     def freeze(self, x_new: np.ndarray, grow: bool = False) -> bool:
         """Fix the contact and slip sets at positions x_new (the active-set strategy: within one Newton-Raphson
@@ -93,14 +94,17 @@ class StepContact:
         if grow and saved[0] is not None:
             active |= saved[0]
             slip = np.where(saved[1] != 0, saved[1], slip)
+        slip[self.stuck] = 0.0
         changed = saved[0] is None or not (np.array_equal(saved[0], active) and np.array_equal(saved[1], slip))
         self.active, self.slip = active, slip
         return changed
 
     def stick_reversed(self, x_new: np.ndarray) -> bool:
         """Frozen slips whose trial force at positions x_new points against their direction are made to stick (slip
-        0); True if there were any. Frozen, such a node's friction pushes it the way it is going, so a solve cannot
-        settle (case 1 at t_u/10, 1.393 ms: a node frozen sliding +1 with its trial force -150 times the cap)."""
+        0) for the rest of the step (:meth:`freeze` keeps them stuck: set free again, the node slid and turned on
+        alternate solves); True if there were any. Frozen, such a node's friction pushes it the way it is going, so
+        a solve cannot settle (case 1 at t_u/10, 1.393 ms: a node frozen sliding +1 with its trial force -150 times
+        the cap)."""
         if self.slip is None:
             return False
         idx = self.nodes
@@ -111,6 +115,7 @@ class StepContact:
         sl = self.slip[idx]
         turned = (sl != 0) & (np.sign(trial) == -sl)
         self.slip[idx[turned]] = 0.0
+        self.stuck[idx[turned]] = True
         return bool(np.any(turned))
 
     def forces(self, x: np.ndarray, idx: np.ndarray) -> dict:
@@ -165,21 +170,22 @@ def solve_with_active_set(nodes, mesh, hist, law, dt, loads, max_outer: int = 8,
     grazing the tool or at the friction cap, in and out on alternate solves): up to ``max_outer`` more solves let
     the sets only grow (:meth:`StepContact.freeze` with ``grow``), which ends the cycle, before the last solve with
     the sets free. A solve that fails with a frozen slip turned against its direction
-    (:meth:`StepContact.stick_reversed`) is made again from the same start with that node stuck (it counts as one
-    of the solves). Each solve after the first starts from the one before's du and p (with p from t_n instead, a
-    solve whose sets had not changed took an iteration to find the pressures again). The result's ``iterations``
+    (:meth:`StepContact.stick_reversed`) is made again from the same start with that node stuck for the step (it
+    counts as one of the solves; three such at most). Each solve after the first starts from the one before's du
+    and p (with p from t_n instead, a solve whose sets had not changed took an iteration to find the pressures
+    again). The result's ``iterations``
     counts those of every solve."""
     c = loads.contact
     c.freeze(nodes.x)
-    total, pattern, p0 = 0, {}, None                              # the solves share the mesh's sparsity pattern
+    total, pattern, p0, sticks = 0, {}, None, 0                   # the solves share the mesh's sparsity pattern
     for k in range(2 * max_outer):
         try:
             r = newton_step(nodes, mesh, hist, law, dt, loads, dynamic=dynamic, predictor=False, max_iter=max_iter,
                             max_move=max_move, du0=du0, p0=p0, pattern=pattern)
         except NewtonFailed as e:                                 # a frozen slip that turned: it sticks, and the
-            if len(e.args) < 3 or not c.stick_reversed(nodes.x + e.args[2][0]):   # solve starts again
-                raise
-            total += len(e.args[1])
+            if sticks >= 3 or len(e.args) < 3 or not c.stick_reversed(nodes.x + e.args[2][0]):   # solve starts
+                raise                                                                             # again
+            total, sticks = total + len(e.args[1]), sticks + 1
             continue
         du0, p0, total = r.du, r.p, total + r.iterations
         if not c.freeze(nodes.x + r.du, grow=k >= max_outer - 1):

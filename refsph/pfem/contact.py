@@ -86,8 +86,7 @@ class StepContact:
         active = np.zeros(len(x_new), bool)
         active[idx] = res["gap"] > 0
         slip = np.zeros(len(x_new))
-        trial = self.f_T_n[idx] - self.p.k_tangent * self.length[idx] * res["slip_raw"]
-        cap = self.mu[idx] * res["f_N"]
+        trial, cap = res["trial"], self.mu[idx] * res["f_N"]
         slip[idx] = np.where(active[idx] & (np.abs(trial) > cap), np.sign(trial), 0.0)
         if saved[1] is not None:
             slip[(saved[1] != 0) & (slip == -saved[1])] = 0.0         # a slip that reverses sticks first
@@ -108,18 +107,15 @@ class StepContact:
         if self.slip is None:
             return False
         idx = self.nodes
-        saved, self.active = self.active, None                 # the raw slip, whatever the frozen contact set
-        res = self.forces(x_new[idx], idx)
-        self.active = saved
-        trial = self.f_T_n[idx] - self.p.k_tangent * self.length[idx] * res["slip_raw"]
         sl = self.slip[idx]
-        turned = (sl != 0) & (np.sign(trial) == -sl)
+        turned = (sl != 0) & (np.sign(self.forces(x_new[idx], idx)["trial"]) == -sl)
         self.slip[idx[turned]] = 0.0
         self.stuck[idx[turned]] = True
         return bool(np.any(turned))
 
     def forces(self, x: np.ndarray, idx: np.ndarray) -> dict:
-        """The forces on nodes ``idx`` at positions x (len(idx), 2): f (.., 2), f_N, f_T, slip s, g."""
+        """The forces on nodes ``idx`` at positions x (len(idx), 2): f (.., 2), f_N, f_T, slip s, g, and the trial
+        (stick) tangential force f_T* (module text)."""
         g, n = self.shape.gap(x, self.shift)
         t = np.stack([-n[:, 1], n[:, 0]], axis=1)
         on = g > 0 if self.active is None else self.active[idx]
@@ -134,7 +130,7 @@ class StepContact:
             sl = self.slip[idx]
             fT = np.where(on, np.where(sl != 0, sl * cap, trial), 0.0)
         return dict(f=fN[:, None] * n + fT[:, None] * t, f_N=fN, f_T=fT, slip=np.where(on, s, 0.0), gap=g,
-                    slip_raw=s)
+                    trial=trial)
 
     def __call__(self, x_new: np.ndarray, stiffness: bool = True):
         """(f (N, 2), df/dx (N, 2, 2)) at positions x_new; ``stiffness=False``: the derivative left zero (a line
@@ -173,8 +169,7 @@ def solve_with_active_set(nodes, mesh, hist, law, dt, loads, max_outer: int = 8,
     (:meth:`StepContact.stick_reversed`) is made again from the same start with that node stuck for the step (it
     counts as one of the solves; three such at most). Each solve after the first starts from the one before's du
     and p (with p from t_n instead, a solve whose sets had not changed took an iteration to find the pressures
-    again). The result's ``iterations``
-    counts those of every solve."""
+    again). The result's ``iterations`` counts those of every solve."""
     c = loads.contact
     c.freeze(nodes.x)
     total, pattern, p0, sticks = 0, {}, None, 0                   # the solves share the mesh's sparsity pattern

@@ -294,7 +294,15 @@ for title in ("## Mass scaling", "## The mass scale", "## Run-to-run scatter at 
 # * **The force ratio.** The measured $F_p/F_c$ of steel is 0.65–0.83, the paper's SPH gives 0.41–0.48. Merchant's
 #   relation $F_p/F_c = \tan(\beta - \gamma)$ needs an apparent friction angle $\beta$ near 48°, i.e.
 #   $\mu \approx 1.1$, above the law's 0.81: part of the measured thrust comes from the edge and the flank, and a
-#   sticking rake face cannot give more than the chip's shear flow stress times the contact length.
+#   sticking rake face cannot give more than the chip's shear flow stress times the contact length. The cell
+#   below splits the tool's force in recorded cuts (`benchmarks/force_split.py`): most of the rake face sticks.
+
+# %%
+split_page = (repository_root() / "benchmarks" / "force_split_report.md").read_text()
+blocks = split_page.split("\n\n")
+display(Markdown("\n\n".join(b for b in blocks if b.startswith("| case") or b.startswith("How to read"))))
+
+# %% [markdown]
 # * **The pinball carries friction only while a pair approaches** (Eq. (34) makes the normal force zero while the
 #   particles separate): on chapter 5's (continued) tilted plane its block slides at 0.07–0.46 of the closed-form
 #   acceleration, and a frictionless pinball plane still drags. The penalty contact gives the law's $\mu$ and the

@@ -1,0 +1,314 @@
+"""Where the tool's force comes from in a steady cut (issue 22): the force ratio Fp/Fc that the thermomechanical
+cutting scene predicts for AISI 1045 is about 0.43 where the second paper's measurements give 0.65-0.83. This script
+takes a cut the sweep recorded (``benchmarks/thermal_cutting.py``; its run folder under ``runs/thermal_cutting/``),
+continues it from its last checkpoint for a short window (``--travel`` t_u more of cut, 0.5 by default), records
+every evaluation of the penalty contact (:func:`refsph.penalty.penalty_contact`) and splits the force on the tool by
+where it acts and how:
+
+* **rake face**, **edge** (the 10 um fillet) and **flank** (the clearance face): a contact belongs to the part of
+  the tool's outline its normal comes from (the rake face's normal and the flank's within 1 deg; the rest is the
+  fillet);
+* each part's normal and tangential (friction) force, resolved into Fc (along the cut) and Fp (normal to it);
+* on the rake face: the delivered friction coefficient mu_eff = sum |f_t| / sum f_N against the law's mu(T) of the
+  same contacts (force-weighted), and the share of the normal force carried by contacts that slip (the return map
+  capped them at mu f_N) rather than stick;
+* Merchant's bound for a face of rake angle gamma whose contacts all slip at mu: Fp/Fc = tan(atan(mu) - gamma).
+
+    python benchmarks/force_split.py                    # cases 1, 4, 11 and case 1 at t_u/5, 1-3 minutes each
+    python benchmarks/force_split.py --keys "case 4"    # the sweep's key(s); writes force_split.json
+
+The window's means are printed beside the sweep's record (means over the last quarter of the cut), so that a reader
+sees how representative the short window is. The continued run is written to a scratch folder (``--scratch``); the
+recorded run is only read.
+"""
+from __future__ import annotations
+
+import json
+import math
+import shutil
+import sys
+import tempfile
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))      # benchmarks/study.py, however this file is loaded
+import study  # noqa: E402
+
+study.pin_threads()
+
+import numpy as np  # noqa: E402
+import thermal_cutting  # noqa: E402
+
+ROOT = Path(__file__).resolve().parents[1]
+OUT_JSON = Path(__file__).resolve().parent / "force_split.json"
+REPORT = Path(__file__).resolve().parent / "force_split_report.md"
+SWEEP_JSON = Path(__file__).resolve().parent / "thermal_cutting.json"
+PARTS = ("rake face", "edge", "flank")
+DEFAULT_KEYS = ["case 1", "case 4", "case 11", "case 1 n_tu 5 courant 0.075"]   # t_u/10; the last at t_u/5
+
+
+def tool_normals() -> dict:
+    """The outward normals of the rake face and the flank in the scene's frame (tool moving along -x, chip rising
+    along the rake face): the rake face leans back by the rake angle gamma, the flank rises by the clearance angle."""
+    from refsph.scenes.thermal_cutting import CLEARANCE_DEG, RAKE_DEG
+    g, c = math.radians(RAKE_DEG), math.radians(CLEARANCE_DEG)
+    return {"rake face": np.array([-math.cos(g), math.sin(g)]), "flank": np.array([math.sin(c), -math.cos(c)])}
+
+
+def classify(n: np.ndarray, normals: dict, tol_deg: float = 1.0) -> np.ndarray:
+    """The part of the outline (index into PARTS) of contacts with outward tool normals n (M, 2)."""
+    part = np.full(len(n), PARTS.index("edge"))
+    for name, nn in normals.items():
+        part[n @ nn > math.cos(math.radians(tol_deg))] = PARTS.index(name)
+    return part
+
+
+def continue_run(folder: Path, travel: float, scratch: Path):
+    """Continue the recorded run in ``folder`` (a copy in ``scratch``) by ``travel`` t_u of cut, recording every
+    penalty evaluation: (rows, summary of the window). A row per evaluation: per part, the normal and the friction
+    force on the tool (x, y), the slipping contacts' normal force, mu(T) f_N summed."""
+    import refsph.coupling as coupling
+    from refsph.simulate import _prepare, simulate
+
+    summary = json.loads((folder / "summary.json").read_text())
+    args = summary["run_args"]
+    work = scratch / folder.name
+    if work.exists():
+        shutil.rmtree(work)
+    shutil.copytree(folder, work)
+    setup, scene, metrics, _ = _prepare(args["scene_name"], args["method"], args["dim"], args["dp"], args["t_end"],
+                                        args["quick"], args["dt"], args["numerics"], args["options"], None)
+    info = setup.info
+    t_more = travel * info["tu_m"] / info["vc_m_s"] if "tu_m" in info else None
+    if t_more is None:
+        raise ValueError(f"{folder}: the scene's info has no tu_m / vc_m_s")
+    setup.t_end = float(summary["t_final"]) + t_more
+    rows, original = [], coupling.penalty_contact
+
+    def recorded(x, v, m, T, tool, shift, V, dt, contact, xi):
+        c = original(x, v, m, T, tool, shift, V, dt, contact, xi)
+        on = c.gap > 0
+        if np.any(on):
+            _, n = tool.gap(x[on], shift)
+            f_N = c.f_normal[on]
+            mu = contact.friction.mu(T[on]) if contact.friction is not None else np.zeros(len(f_N))
+            slip = np.linalg.norm(c.f_trial[on], axis=1) > mu * f_N * (1 + 1e-12)
+            rows.append(_row(n, f_N, c.f_tangent[on], mu, slip))
+        return c
+
+    coupling.penalty_contact = recorded
+    try:
+        res = simulate(setup, args["method"], scene=scene, out=work, progress=False, restart=True,
+                       meta=dict(run_args=args), metrics=metrics)
+    finally:
+        coupling.penalty_contact = original
+    return np.asarray(rows), res.summary, summary
+
+
+def _row(n, f_N, f_t, mu, slip) -> list:
+    """One evaluation's row (:func:`continue_run`) from its contacts: outward tool normals n (M, 2), the normal
+    force f_N (M,) and the tangential force f_t (M, 2) on the workpiece, mu(T) (M,) and which contacts slip."""
+    part, row = classify(n, tool_normals()), []
+    fn, ft = -f_N[:, None] * n, -f_t                                # on the tool
+    for k in range(len(PARTS)):
+        s = part == k
+        row += [*fn[s].sum(0), *ft[s].sum(0), float(f_N[s].sum()), float(np.linalg.norm(f_t[s], axis=1).sum()),
+                float((mu * f_N)[s].sum()), float(f_N[s & slip].sum()), int(s.sum())]
+    return row
+
+
+def continue_pfem(folder: Path, travel: float, scratch: Path):
+    """:func:`continue_run` for a PFEM run folder (:mod:`refsph.pfem_run`): its CutRun restored from the last
+    checkpoint and stepped ``travel`` t_u on, each step's converged contact (:class:`refsph.pfem.contact.StepContact`
+    after its last Newton solve, the sets free) recorded. A node slips where |f_T| reached mu(T) f_N."""
+    import dataclasses
+
+    from refsph.pfem import cutting
+    from refsph.pfem_run import CHECKPOINT, PREVIOUS, _options, _restore
+
+    summary = json.loads((folder / "summary.json").read_text())
+    work = scratch / folder.name
+    if work.exists():
+        shutil.rmtree(work)
+    (work / "snapshots").mkdir(parents=True)
+    for name in (CHECKPOINT, PREVIOUS):
+        if (folder / "snapshots" / name).exists():
+            shutil.copy(folder / "snapshots" / name, work / "snapshots" / name)
+    kwargs = _options(summary["run_args"]["options"], summary["run_args"]["quick"])
+    cut = cutting.pfem_cut(**kwargs)
+    t_more = travel * cut.info["tu_m"] / cut.info["vc_m_s"]
+    run, _, _ = _restore(work / "snapshots", dataclasses.replace(cut, t_end=float(summary["t_final"]) + t_more))
+    made, rows, original = [], [], cutting.StepContact
+
+    class Recorded(original):
+        def __init__(self, *a, **kw):
+            super().__init__(*a, **kw)
+            made.append(self)
+
+        def __call__(self, x_new, stiffness=True):
+            self.x_last = np.array(x_new)
+            return super().__call__(x_new, stiffness)
+
+    cutting.StepContact = Recorded
+    try:
+        while not run.done:
+            run.step()
+            c, last = made[-1], made[-1].last                    # the step's converged contact (the last try's)
+            idx = np.flatnonzero(last["gap"] > 0)
+            if len(idx):
+                _, n = c.shape.gap(c.x_last[idx], c.shift)
+                t = np.stack([-n[:, 1], n[:, 0]], axis=1)
+                f_N, f_T, mu = last["f_N"][idx], last["f_T"][idx], c.mu[idx]
+                rows.append(_row(n, f_N, f_T[:, None] * t, mu, (mu > 0) & (np.abs(f_T) >= mu * f_N * (1 - 1e-9))))
+            made.clear()
+    finally:
+        cutting.StepContact = original
+    return np.asarray(rows), dict(t_final=run.nodes.t), summary
+
+
+def split(rows: np.ndarray, gamma_deg: float) -> dict:
+    """The window's means of the recorded rows (:func:`continue_run`) as the force split (module text)."""
+    width = 9
+    mean = rows.mean(axis=0)
+    parts, Fx, Fy = {}, 0.0, 0.0
+    for k, name in enumerate(PARTS):
+        fnx, fny, ftx, fty, fN, ft, cap, fN_slip, count = mean[k * width:(k + 1) * width]
+        # the force on the tool: Fc along the cut (the tool moves along -x, so +x resists it), Fp = the force
+        # pushing the tool away from the workpiece (+y)
+        parts[name] = dict(Fc_normal=fnx, Fc_friction=ftx, Fp_normal=fny, Fp_friction=fty, f_N=fN, f_t=ft,
+                           mu_eff=ft / fN if fN > 0 else math.nan, mu_law=cap / fN if fN > 0 else math.nan,
+                           slip_share=fN_slip / fN if fN > 0 else math.nan, contacts=count)
+        Fx, Fy = Fx + fnx + ftx, Fy + fny + fty
+    rake = parts["rake face"]
+    g = math.radians(gamma_deg)
+    return dict(Fc=Fx, Fp=Fy, force_ratio=Fy / Fx, parts=parts,
+                rake_only_ratio=(rake["Fp_normal"] + rake["Fp_friction"]) / (rake["Fc_normal"] + rake["Fc_friction"]),
+                merchant_bound_mu_law=math.tan(math.atan(rake["mu_law"]) - g),
+                merchant_bound_mu_eff=math.tan(math.atan(rake["mu_eff"]) - g))
+
+
+def measure(key: str, travel: float, scratch: Path, folder: Path | None = None) -> dict:
+    """The force split of the sweep's record ``key`` (its run folder; or the run folder ``folder``, SPH or PFEM,
+    under the label ``key``), continued by ``travel`` t_u; the record's forces from the folder's summary.json."""
+    from refsph.scenes.thermal_cutting import RAKE_DEG
+    if folder is None:
+        record = json.loads(SWEEP_JSON.read_text())["runs"].get(key)
+        if record is None or record.get("status") != "ok":
+            raise SystemExit(f"{key!r}: no recorded run in {SWEEP_JSON.name} (run benchmarks/thermal_cutting.py)")
+        folder = thermal_cutting.run_folder(key)
+    if not (folder / "snapshots" / "restart.npz").exists():
+        raise SystemExit(f"{key!r}: its run folder {folder} has no checkpoint to continue from")
+    method = json.loads((folder / "summary.json").read_text())["method"]
+    rows, window, recorded = (continue_pfem if method == "pfem" else continue_run)(folder, travel, scratch)
+    if recorded["status"] != "ok" or len(rows) == 0:
+        raise SystemExit(f"{key!r}: the run in {folder} did not end 'ok', or no contact in the window")
+    out = split(rows, RAKE_DEG)
+    m, row = recorded["metrics"], recorded["scene_info"]["measured"]
+    return dict(key=key, method=method, material=row["material"],
+                measured_force_ratio=row["Fp_exp_N"] / row["Fc_exp_N"], travel_t_u=travel, evaluations=len(rows),
+                t_start_s=recorded["t_final"], t_end_s=window["t_final"],
+                recorded_Fc_N_per_m=m["cutting_force_N_per_m"], recorded_Fp_N_per_m=m["passive_force_N_per_m"], **out)
+
+
+HEAD = ("case", "material", "Fc [N/mm] window (record)", "Fp/Fc window (record)", "Fp/Fc measured",
+        "rake face: share of Fc, Fp", "edge", "flank",
+        "rake face mu_eff / mu(T)", "slipping share of rake f_N", "Fp/Fc of the rake face alone",
+        "Merchant bound at mu(T)")
+
+
+def table(results: list) -> str:
+    """The markdown table of the results."""
+    rows = []
+    for r in results:
+        P, rake = r["parts"], r["parts"]["rake face"]
+
+        def share(name):
+            p = P[name]
+            fc, fp = (p["Fc_normal"] + p["Fc_friction"]) / r["Fc"], (p["Fp_normal"] + p["Fp_friction"]) / r["Fp"]
+            return f"{fc:.2f}, {fp:.2f}"
+        label = r["key"] + (" (PFEM)" if r.get("method") == "pfem" else "")
+        rows.append([label, r["material"], f"{r['Fc'] / 1e3:.0f} ({r['recorded_Fc_N_per_m'] / 1e3:.0f})",
+                     f"{r['force_ratio']:.2f} ({r['recorded_Fp_N_per_m'] / r['recorded_Fc_N_per_m']:.2f})",
+                     f"{r['measured_force_ratio']:.2f}",
+                     share("rake face"), share("edge"), share("flank"), f"{rake['mu_eff']:.2f} / {rake['mu_law']:.2f}",
+                     f"{rake['slip_share']:.2f}", f"{r['rake_only_ratio']:.2f}", f"{r['merchant_bound_mu_law']:.2f}"])
+    return study.md_table(HEAD, rows)
+
+
+def report(doc: dict) -> str:
+    """benchmarks/force_split_report.md from the JSON document (the template's prose filled with its numbers)."""
+    from refsph.scenes.thermal_cutting import RAKE_DEG
+    results = doc["results"]
+    page = study.Page("force_split_report")
+
+    def span(values, spec=".2f", scale=1.0):
+        lo, hi = format(min(values) * scale, spec), format(max(values) * scale, spec)
+        return (lo, "") if lo == hi else (lo, "-" + hi)
+
+    def share(r, name, k):
+        p = r["parts"][name]
+        return (p[f"{k}_normal"] + p[f"{k}_friction"]) / r[k]
+    v = {}
+    for name, values in (("rake_fc", [share(r, "rake face", "Fc") for r in results]),
+                         ("rake_fp", [share(r, "rake face", "Fp") for r in results])):
+        v[f"{name}_min"], v[f"{name}_max"] = span(values)
+    v["flank_fp_max"] = f'{max(share(r, "flank", "Fp") for r in results):.2f}'
+    fc_dev = max(abs(r["Fc"] / r["recorded_Fc_N_per_m"] - 1) for r in results)
+    ratio_dev = max(abs(r["force_ratio"] - r["recorded_Fp_N_per_m"] / r["recorded_Fc_N_per_m"]) for r in results)
+    travel = sorted({r["travel_t_u"] for r in results})
+    parts = [page("head", travel="/".join(f"{t:g}" for t in travel), rake_deg=f"{RAKE_DEG:g}"), table(results),
+             page("how_to_read", fc_window_dev=f"{100 * fc_dev:.0f}", ratio_window_dev=f"{ratio_dev:.2f}", **v)]
+    for material in sorted({r["material"] for r in results}):
+        rs = [r for r in results if r["material"] == material]
+        rake, m = [r["parts"]["rake face"] for r in rs], {}
+        for name, values, spec, scale in (
+                ("stick", [1.0 - p["slip_share"] for p in rake], ".0f", 100.0),
+                ("mueff", [p["mu_eff"] for p in rake], ".2f", 1.0), ("mulaw", [p["mu_law"] for p in rake], ".2f", 1.0),
+                ("bound", [r["merchant_bound_mu_law"] for r in rs], ".2f", 1.0),
+                ("measured", [r["measured_force_ratio"] for r in rs], ".2f", 1.0)):
+            m[f"{name}_min"], m[f"{name}_max"] = span(values, spec, scale)
+        parts.append(page("material", material=material, rows=", ".join(r["key"] for r in rs), **m))
+    above = [r["key"] for r in results if r["merchant_bound_mu_law"] >= r["measured_force_ratio"]]
+    parts.append(page("conclusion", bound_vs_measured="below the measured ratio in every row" if not above else
+                      f"at or above the measured ratio in {', '.join(above)}"))
+    return "\n\n".join(parts) + "\n"
+
+
+def main(argv=None) -> int:
+    ap = study.parser(__doc__)
+    ap.add_argument("--keys", nargs="*", default=DEFAULT_KEYS, help="the sweep's keys (default: "
+                                                                              + ", ".join(DEFAULT_KEYS) + ")")
+    ap.add_argument("--folders", nargs="+", type=Path, default=[], help="run folders (SPH or PFEM) to split as "
+                                                                         "well, each labelled by its name")
+    ap.add_argument("--travel", type=float, default=0.5, help="t_u of cut in the window (default 0.5)")
+    ap.add_argument("--scratch", type=Path, default=None, help="where the continued runs go (default: a temporary "
+                                                               "folder, removed)")
+    ap.add_argument("--json", type=Path, default=OUT_JSON, help="where to write the results (default: "
+                                                                "force_split.json)")
+    ap.add_argument("--report", action="store_true", help="no runs: the report page from the JSON")
+    a = ap.parse_args(argv)
+    if a.report:                                           # the committed page only from the committed JSON
+        page = report(json.loads(a.json.read_text()))
+        if a.json.resolve() == OUT_JSON:
+            study.write_if_changed(REPORT, page)
+        print(page)
+        return 0
+    if not (a.travel > 0):
+        ap.error(f"--travel must be > 0, got {a.travel}")
+    results = []
+    with tempfile.TemporaryDirectory() as tmp:
+        scratch = a.scratch or Path(tmp)
+        jobs = [(key, None) for key in a.keys] + [(f.name, f) for f in a.folders]
+        for key, folder in jobs:
+            results.append(measure(key, a.travel, scratch, folder))
+            print(table(results[-1:]), flush=True)
+    old = json.loads(a.json.read_text())["results"] if a.json.exists() else []
+    keep = [r for r in old if r["key"] not in {r["key"] for r in results}]
+    study.write_json(a.json, dict(results=keep + results))
+    if a.json.resolve() == OUT_JSON:
+        study.write_if_changed(REPORT, report(json.loads(a.json.read_text())))
+    print(table(keep + results))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

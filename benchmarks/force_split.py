@@ -1,7 +1,7 @@
 """Where the tool's force comes from in a steady cut (issue 22): the force ratio Fp/Fc that the thermomechanical
 cutting scene predicts for AISI 1045 is about 0.43 where the second paper's measurements give 0.65-0.83. This script
 takes a cut the sweep recorded (``benchmarks/thermal_cutting.py``; its run folder under ``runs/thermal_cutting/``),
-continues it from its last checkpoint for a short window (``--travel`` t_u more of cut, 0.5 by default), records
+continues it from its last checkpoint for a short window (``--travel`` t_u more of cut, 1 by default), records
 every evaluation of the penalty contact (:func:`refsph.penalty.penalty_contact`) and splits the force on the tool by
 where it acts and how:
 
@@ -14,8 +14,10 @@ where it acts and how:
   capped them at mu f_N) rather than stick;
 * Merchant's bound for a face of rake angle gamma whose contacts all slip at mu: Fp/Fc = tan(atan(mu) - gamma).
 
-    python benchmarks/force_split.py                    # cases 1, 4, 11 and case 1 at t_u/5, 1-3 minutes each
+    python benchmarks/force_split.py                    # cases 1, 4, 11 and case 1 at t_u/5, 2-5 minutes each
     python benchmarks/force_split.py --keys "case 4"    # the sweep's key(s); writes force_split.json
+    python benchmarks/force_split.py --keys "case 1" --set penalty_alpha=0.4    # a what-if: a stiffer penalty
+    python benchmarks/force_split.py --keys --folders runs/pfem_cost/case_1_n_tu_10   # a PFEM run folder
 
 The window's means are printed beside the sweep's record (means over the last quarter of the cut), so that a reader
 sees how representative the short window is. The continued run is written to a scratch folder (``--scratch``); the
@@ -62,73 +64,110 @@ def classify(n: np.ndarray, normals: dict, tol_deg: float = 1.0) -> np.ndarray:
     return part
 
 
-def continue_run(folder: Path, travel: float, scratch: Path):
-    """Continue the recorded run in ``folder`` (a copy in ``scratch``) by ``travel`` t_u of cut, recording every
-    penalty evaluation: (rows, summary of the window). A row per evaluation: per part, the normal and the friction
-    force on the tool (x, y), the slipping contacts' normal force, mu(T) f_N summed."""
-    import refsph.coupling as coupling
-    from refsph.simulate import _prepare, simulate
-
-    summary = json.loads((folder / "summary.json").read_text())
-    args = summary["run_args"]
-    work = scratch / folder.name
-    if work.exists():
-        shutil.rmtree(work)
-    shutil.copytree(folder, work)
-    setup, scene, metrics, _ = _prepare(args["scene_name"], args["method"], args["dim"], args["dp"], args["t_end"],
-                                        args["quick"], args["dt"], args["numerics"], args["options"], None)
-    info = setup.info
-    t_more = travel * info["tu_m"] / info["vc_m_s"] if "tu_m" in info else None
-    if t_more is None:
-        raise ValueError(f"{folder}: the scene's info has no tu_m / vc_m_s")
-    setup.t_end = float(summary["t_final"]) + t_more
-    rows, original = [], coupling.penalty_contact
-
-    def recorded(x, v, m, T, tool, shift, V, dt, contact, xi):
-        c = original(x, v, m, T, tool, shift, V, dt, contact, xi)
-        on = c.gap > 0
-        if np.any(on):
-            _, n = tool.gap(x[on], shift)
-            f_N = c.f_normal[on]
-            mu = contact.friction.mu(T[on]) if contact.friction is not None else np.zeros(len(f_N))
-            slip = np.linalg.norm(c.f_trial[on], axis=1) > mu * f_N * (1 + 1e-12)
-            rows.append(_row(n, f_N, c.f_tangent[on], mu, slip))
-        return c
-
-    coupling.penalty_contact = recorded
-    try:
-        res = simulate(setup, args["method"], scene=scene, out=work, progress=False, restart=True,
-                       meta=dict(run_args=args), metrics=metrics)
-    finally:
-        coupling.penalty_contact = original
-    return np.asarray(rows), res.summary, summary
-
-
-def _row(n, f_N, f_t, mu, slip) -> list:
-    """One evaluation's row (:func:`continue_run`) from its contacts: outward tool normals n (M, 2), the normal
-    force f_N (M,) and the tangential force f_t (M, 2) on the workpiece, mu(T) (M,) and which contacts slip."""
+def row_of(n, f_N, f_t, mu, slip, dt: float) -> list:
+    """One evaluation's row from its contacts: outward tool normals n (M, 2), the normal force f_N (M,) and the
+    tangential force f_t (M, 2) on the workpiece, mu(T) (M,), which contacts slip (M,), and the step dt [s] it
+    stands for (the weight of its time mean). Per part of PARTS: the normal and the friction force on the tool (x, y),
+    sum f_N, sum |f_t|, sum mu f_N, the slipping contacts' f_N, the number of contacts; then dt."""
     part, row = classify(n, tool_normals()), []
     fn, ft = -f_N[:, None] * n, -f_t                                # on the tool
     for k in range(len(PARTS)):
         s = part == k
         row += [*fn[s].sum(0), *ft[s].sum(0), float(f_N[s].sum()), float(np.linalg.norm(f_t[s], axis=1).sum()),
                 float((mu * f_N)[s].sum()), float(f_N[s & slip].sum()), int(s.sum())]
-    return row
+    return row + [float(dt)]
 
 
-def continue_pfem(folder: Path, travel: float, scratch: Path):
+def row_from_penalty(c, x, T, tool, shift, contact, dt: float) -> list:
+    """The row of one SPH penalty evaluation (:class:`refsph.penalty.PenaltyResult` ``c`` of particles x with
+    temperatures T against ``tool`` at ``shift``): a contact slips where the return map capped its trial force
+    (:func:`refsph.penalty.return_map_friction`); a step without contact gives a row of zeros."""
+    on = c.gap > 0
+    _, n = tool.gap(x[on], shift) if np.any(on) else (None, np.zeros((0, 2)))
+    f_N = c.f_normal[on]
+    mu = contact.friction.mu(T[on]) if contact.friction is not None and np.any(on) else np.zeros(len(f_N))
+    slip = np.linalg.norm(c.f_trial[on], axis=1) > mu * f_N
+    return row_of(n, f_N, c.f_tangent[on], mu, slip, dt)
+
+
+def row_from_step_contact(c, x: np.ndarray, dt: float) -> list:
+    """The row of one PFEM step's converged contact (:class:`refsph.pfem.contact.StepContact` ``c`` after its last
+    call, which was at node positions x): f = f_N n + f_T t on the node, t = n turned by +90 deg; with the sets free
+    (the last solve) f_T is the trial force clipped to mu f_N, so a node slips where |f_T| reached the cap."""
+    last = c.last
+    idx = np.flatnonzero(last["gap"] > 0)
+    _, n = c.shape.gap(x[idx], c.shift) if len(idx) else (None, np.zeros((0, 2)))
+    t = np.stack([-n[:, 1], n[:, 0]], axis=1)
+    f_N, f_T, mu = last["f_N"][idx], last["f_T"][idx], c.mu[idx]
+    return row_of(n, f_N, f_T[:, None] * t, mu, (mu > 0) & (np.abs(f_T) >= mu * f_N * (1 - 1e-9)), dt)
+
+
+def scratch_copy(folder: Path, scratch: Path) -> Path:
+    """The scratch folder a continuation of ``folder`` is written to (emptied first); refused where it is the
+    recorded folder or lies inside it, or the other way round, so that the recorded run is only read."""
+    work = scratch / folder.name
+    a, b = work.resolve(), folder.resolve()
+    if a == b or b in a.parents or a in b.parents:
+        raise SystemExit(f"--scratch {scratch}: the continuation would overwrite the recorded run {folder}")
+    if work.exists():
+        shutil.rmtree(work)
+    return work
+
+
+def continue_run(folder: Path, travel: float, scratch: Path, numerics: dict | None = None):
+    """Continue the recorded SPH run in ``folder`` (a copy in ``scratch``) by ``travel`` t_u of cut with the
+    arguments it was made with (``numerics``: fields changed for a what-if, else the recorded numerics must be
+    the rebuilt ones), recording every penalty evaluation: (rows, summary of the window, recorded summary)."""
+    import dataclasses
+
+    import refsph.coupling as coupling
+    from refsph.simulate import _prepare, simulate
+
+    summary = json.loads((folder / "summary.json").read_text())
+    args = summary["run_args"]
+    work = scratch_copy(folder, scratch)
+    shutil.copytree(folder, work)
+    setup, scene, metrics, _ = _prepare(args["scene_name"], args["method"], args["dim"], args["dp"], args["t_end"],
+                                        args["quick"], args["dt"], dict(args["numerics"] or {}, **(numerics or {})),
+                                        args["options"], args.get("particles"))
+    rebuilt = dataclasses.asdict(setup.numerics)
+    differ = {k: (v, rebuilt[k]) for k, v in summary["numerics"].items()
+              if k in rebuilt and rebuilt[k] != v and k not in (numerics or {})}
+    if differ:
+        raise SystemExit(f"{folder}: the scene rebuilds other numerics than the run's (recorded, now): {differ}")
+    info = setup.info
+    setup.t_end = float(summary["t_final"]) + travel * info["tu_m"] / info["vc_m_s"]
+    if setup.t_end * info["vc_m_s"] > 0.8 * info["length_m"]:
+        raise SystemExit(f"{folder}: {travel} t_u more would cut past 80 % of the workpiece")
+    rows, original = [], coupling.penalty_contact
+
+    def recorded(x, v, m, T, tool, shift, V, dt, contact, xi):
+        c = original(x, v, m, T, tool, shift, V, dt, contact, xi)
+        rows.append(row_from_penalty(c, x, T, tool, shift, contact, dt))
+        return c
+
+    coupling.penalty_contact = recorded
+    try:
+        res = simulate(setup, args["method"], scene=scene, out=work, dt=args["dt"], progress=False, restart=True,
+                       meta=dict(run_args=args), metrics=metrics)
+    finally:
+        coupling.penalty_contact = original
+    return np.asarray(rows), res.summary, summary
+
+
+def continue_pfem(folder: Path, travel: float, scratch: Path, numerics: dict | None = None):
     """:func:`continue_run` for a PFEM run folder (:mod:`refsph.pfem_run`): its CutRun restored from the last
-    checkpoint and stepped ``travel`` t_u on, each step's converged contact (:class:`refsph.pfem.contact.StepContact`
-    after its last Newton solve, the sets free) recorded. A node slips where |f_T| reached mu(T) f_N."""
+    checkpoint and stepped ``travel`` t_u on, each step's converged contact recorded (:func:`row_from_step_contact`;
+    the last :class:`refsph.pfem.contact.StepContact` a step made is the try that converged)."""
     import dataclasses
 
     from refsph.pfem import cutting
     from refsph.pfem_run import CHECKPOINT, PREVIOUS, _options, _restore
 
+    if numerics:
+        raise SystemExit("--set applies to SPH runs only")
     summary = json.loads((folder / "summary.json").read_text())
-    work = scratch / folder.name
-    if work.exists():
-        shutil.rmtree(work)
+    work = scratch_copy(folder, scratch)
     (work / "snapshots").mkdir(parents=True)
     for name in (CHECKPOINT, PREVIOUS):
         if (folder / "snapshots" / name).exists():
@@ -152,13 +191,7 @@ def continue_pfem(folder: Path, travel: float, scratch: Path):
     try:
         while not run.done:
             run.step()
-            c, last = made[-1], made[-1].last                    # the step's converged contact (the last try's)
-            idx = np.flatnonzero(last["gap"] > 0)
-            if len(idx):
-                _, n = c.shape.gap(c.x_last[idx], c.shift)
-                t = np.stack([-n[:, 1], n[:, 0]], axis=1)
-                f_N, f_T, mu = last["f_N"][idx], last["f_T"][idx], c.mu[idx]
-                rows.append(_row(n, f_N, f_T[:, None] * t, mu, (mu > 0) & (np.abs(f_T) >= mu * f_N * (1 - 1e-9))))
+            rows.append(row_from_step_contact(made[-1], made[-1].x_last, run.reaction["dt"][-1]))
             made.clear()
     finally:
         cutting.StepContact = original
@@ -168,7 +201,7 @@ def continue_pfem(folder: Path, travel: float, scratch: Path):
 def split(rows: np.ndarray, gamma_deg: float) -> dict:
     """The window's means of the recorded rows (:func:`continue_run`) as the force split (module text)."""
     width = 9
-    mean = rows.mean(axis=0)
+    mean = np.average(rows[:, :-1], axis=0, weights=rows[:, -1])          # time means (each row's dt)
     parts, Fx, Fy = {}, 0.0, 0.0
     for k, name in enumerate(PARTS):
         fnx, fny, ftx, fty, fN, ft, cap, fN_slip, count = mean[k * width:(k + 1) * width]
@@ -180,15 +213,21 @@ def split(rows: np.ndarray, gamma_deg: float) -> dict:
         Fx, Fy = Fx + fnx + ftx, Fy + fny + fty
     rake = parts["rake face"]
     g = math.radians(gamma_deg)
-    return dict(Fc=Fx, Fp=Fy, force_ratio=Fy / Fx, parts=parts,
+    N, mu = rake["f_N"], rake["mu_law"] if rake["f_N"] > 0 else 0.0        # the rake face slipping at mu(T)
+    Fc_other = Fx - rake["Fc_normal"] - rake["Fc_friction"]
+    Fp_other = Fy - rake["Fp_normal"] - rake["Fp_friction"]
+    slipping = (N * (mu * math.cos(g) - math.sin(g)) + Fp_other) / (N * (math.cos(g) + mu * math.sin(g)) + Fc_other)
+    return dict(Fc=Fx, Fp=Fy, force_ratio=Fy / Fx, parts=parts, ratio_rake_slipping=slipping,
                 rake_only_ratio=(rake["Fp_normal"] + rake["Fp_friction"]) / (rake["Fc_normal"] + rake["Fc_friction"]),
                 merchant_bound_mu_law=math.tan(math.atan(rake["mu_law"]) - g),
                 merchant_bound_mu_eff=math.tan(math.atan(rake["mu_eff"]) - g))
 
 
-def measure(key: str, travel: float, scratch: Path, folder: Path | None = None) -> dict:
-    """The force split of the sweep's record ``key`` (its run folder; or the run folder ``folder``, SPH or PFEM,
-    under the label ``key``), continued by ``travel`` t_u; the record's forces from the folder's summary.json."""
+def measure(key: str, travel: float, scratch: Path, folder: Path | None = None, numerics: dict | None = None,
+            label: str | None = None) -> dict:
+    """The force split of the sweep's record ``key`` (its run folder; or the run folder ``folder``, SPH or PFEM),
+    continued by ``travel`` t_u (with the Numerics fields ``numerics`` changed: a what-if) and labelled ``label``
+    (default ``key``); the record's forces from the folder's summary.json."""
     from refsph.scenes.thermal_cutting import RAKE_DEG
     if folder is None:
         record = json.loads(SWEEP_JSON.read_text())["runs"].get(key)
@@ -198,12 +237,12 @@ def measure(key: str, travel: float, scratch: Path, folder: Path | None = None) 
     if not (folder / "snapshots" / "restart.npz").exists():
         raise SystemExit(f"{key!r}: its run folder {folder} has no checkpoint to continue from")
     method = json.loads((folder / "summary.json").read_text())["method"]
-    rows, window, recorded = (continue_pfem if method == "pfem" else continue_run)(folder, travel, scratch)
+    rows, window, recorded = (continue_pfem if method == "pfem" else continue_run)(folder, travel, scratch, numerics)
     if recorded["status"] != "ok" or len(rows) == 0:
         raise SystemExit(f"{key!r}: the run in {folder} did not end 'ok', or no contact in the window")
     out = split(rows, RAKE_DEG)
     m, row = recorded["metrics"], recorded["scene_info"]["measured"]
-    return dict(key=key, method=method, material=row["material"],
+    return dict(key=label or key, method=method, numerics_changed=dict(numerics or {}), material=row["material"],
                 measured_force_ratio=row["Fp_exp_N"] / row["Fc_exp_N"], travel_t_u=travel, evaluations=len(rows),
                 t_start_s=recorded["t_final"], t_end_s=window["t_final"],
                 recorded_Fc_N_per_m=m["cutting_force_N_per_m"], recorded_Fp_N_per_m=m["passive_force_N_per_m"], **out)
@@ -212,7 +251,7 @@ def measure(key: str, travel: float, scratch: Path, folder: Path | None = None) 
 HEAD = ("case", "material", "Fc [N/mm] window (record)", "Fp/Fc window (record)", "Fp/Fc measured",
         "rake face: share of Fc, Fp", "edge", "flank",
         "rake face mu_eff / mu(T)", "slipping share of rake f_N", "Fp/Fc of the rake face alone",
-        "Merchant bound at mu(T)")
+        "Merchant bound at mu(T)", "Fp/Fc with the rake face slipping at mu(T)")
 
 
 def table(results: list) -> str:
@@ -230,7 +269,8 @@ def table(results: list) -> str:
                      f"{r['force_ratio']:.2f} ({r['recorded_Fp_N_per_m'] / r['recorded_Fc_N_per_m']:.2f})",
                      f"{r['measured_force_ratio']:.2f}",
                      share("rake face"), share("edge"), share("flank"), f"{rake['mu_eff']:.2f} / {rake['mu_law']:.2f}",
-                     f"{rake['slip_share']:.2f}", f"{r['rake_only_ratio']:.2f}", f"{r['merchant_bound_mu_law']:.2f}"])
+                     f"{rake['slip_share']:.2f}", f"{r['rake_only_ratio']:.2f}", f"{r['merchant_bound_mu_law']:.2f}",
+                     f"{r['ratio_rake_slipping']:.2f}"])
     return study.md_table(HEAD, rows)
 
 
@@ -258,7 +298,7 @@ def report(doc: dict) -> str:
     parts = [page("head", travel="/".join(f"{t:g}" for t in travel), rake_deg=f"{RAKE_DEG:g}"), table(results),
              page("how_to_read", fc_window_dev=f"{100 * fc_dev:.0f}", ratio_window_dev=f"{ratio_dev:.2f}", **v)]
     for material in sorted({r["material"] for r in results}):
-        rs = [r for r in results if r["material"] == material]
+        rs = [r for r in results if r["material"] == material and not r.get("numerics_changed")]
         rake, m = [r["parts"]["rake face"] for r in rs], {}
         for name, values, spec, scale in (
                 ("stick", [1.0 - p["slip_share"] for p in rake], ".0f", 100.0),
@@ -268,9 +308,44 @@ def report(doc: dict) -> str:
             m[f"{name}_min"], m[f"{name}_max"] = span(values, spec, scale)
         parts.append(page("material", material=material, rows=", ".join(r["key"] for r in rs), **m))
     above = [r["key"] for r in results if r["merchant_bound_mu_law"] >= r["measured_force_ratio"]]
+    slipping = []
+    for material in sorted({r["material"] for r in results}):
+        rs = [r for r in results if r["material"] == material and not r.get("numerics_changed")]
+        lo, hi = span([r["ratio_rake_slipping"] for r in rs])
+        mlo, mhi = span([r["measured_force_ratio"] for r in rs])
+        elo, ehi = span([100 * (1 - r["ratio_rake_slipping"] / r["measured_force_ratio"]) for r in rs], ".0f")
+        slipping.append(f"{material} {lo}{hi} against the measured {mlo}{mhi} ({elo}{ehi} % low)")
     parts.append(page("conclusion", bound_vs_measured="below the measured ratio in every row" if not above else
-                      f"at or above the measured ratio in {', '.join(above)}"))
+                      f"at or above the measured ratio in {', '.join(above)}", slipping="; ".join(slipping)))
+    parts += [whatif(page, r, base) for r in results if r.get("numerics_changed")
+              for base in results if base["key"] == r["key"].split(",")[0]]
     return "\n\n".join(parts) + "\n"
+
+
+def whatif(page, r: dict, base: dict) -> str:
+    """The what-if paragraph of the report: row ``r`` (a continuation with changed numerics) against ``base``."""
+    def rake(x, k):
+        return x["parts"]["rake face"][k]
+    return page("whatif", label=r["key"], change=", ".join(f"{k} = {v}" for k, v in r["numerics_changed"].items()),
+                stick_base=f"{100 * (1 - rake(base, 'slip_share')):.0f}",
+                stick_whatif=f"{100 * (1 - rake(r, 'slip_share')):.0f}", mueff_base=f"{rake(base, 'mu_eff'):.2f}",
+                mueff_whatif=f"{rake(r, 'mu_eff'):.2f}", ratio_base=f"{base['force_ratio']:.2f}",
+                ratio_whatif=f"{r['force_ratio']:.2f}", fc_base=f"{base['Fc'] / 1e3:.0f}",
+                fc_whatif=f"{r['Fc'] / 1e3:.0f}")
+
+
+def parse_set(items: list) -> dict:
+    """{name: value} of NAME=VALUE items, each value read as JSON where it can be (numbers, true, null)."""
+    out = {}
+    for item in items:
+        name, eq, value = item.partition("=")
+        if not eq or not name:
+            raise SystemExit(f"--set {item!r}: expected NAME=VALUE")
+        try:
+            out[name] = json.loads(value)
+        except ValueError:
+            out[name] = value
+    return out
 
 
 def main(argv=None) -> int:
@@ -279,7 +354,9 @@ def main(argv=None) -> int:
                                                                               + ", ".join(DEFAULT_KEYS) + ")")
     ap.add_argument("--folders", nargs="+", type=Path, default=[], help="run folders (SPH or PFEM) to split as "
                                                                          "well, each labelled by its name")
-    ap.add_argument("--travel", type=float, default=0.5, help="t_u of cut in the window (default 0.5)")
+    ap.add_argument("--travel", type=float, default=1.0, help="t_u of cut in the window (default 1)")
+    ap.add_argument("--set", nargs="+", default=[], metavar="NAME=VALUE", help="a what-if: Numerics fields changed "
+                    "in the continuation (SPH), e.g. penalty_alpha=0.4; the rows are labelled with them")
     ap.add_argument("--scratch", type=Path, default=None, help="where the continued runs go (default: a temporary "
                                                                "folder, removed)")
     ap.add_argument("--json", type=Path, default=OUT_JSON, help="where to write the results (default: "
@@ -297,9 +374,11 @@ def main(argv=None) -> int:
     results = []
     with tempfile.TemporaryDirectory() as tmp:
         scratch = a.scratch or Path(tmp)
+        changed = parse_set(a.set)
+        suffix = "".join(f", {k} {v}" for k, v in changed.items())
         jobs = [(key, None) for key in a.keys] + [(f.name, f) for f in a.folders]
         for key, folder in jobs:
-            results.append(measure(key, a.travel, scratch, folder))
+            results.append(measure(key, a.travel, scratch, folder, changed, key + suffix))
             print(table(results[-1:]), flush=True)
     old = json.loads(a.json.read_text())["results"] if a.json.exists() else []
     keep = [r for r in old if r["key"] not in {r["key"] for r in results}]

@@ -295,12 +295,12 @@ for title in ("## Mass scaling", "## The mass scale", "## Run-to-run scatter at 
 #   relation $F_p/F_c = \tan(\beta - \gamma)$ needs an apparent friction angle $\beta$ near 48°, i.e.
 #   $\mu \approx 1.1$, above the law's 0.81: part of the measured thrust comes from the edge and the flank, and a
 #   sticking rake face cannot give more than the chip's shear flow stress times the contact length. The cell
-#   below splits the tool's force in recorded cuts (`benchmarks/force_split.py`): most of the rake face sticks.
+#   below splits the tool's force in recorded cuts (`benchmarks/force_split.py`): how much of the rake face
+#   sticks, and what a rake face slipping everywhere at $\mu(T)$ would give.
 
 # %%
 split_page = (repository_root() / "benchmarks" / "force_split_report.md").read_text()
-blocks = split_page.split("\n\n")
-display(Markdown("\n\n".join(b for b in blocks if b.startswith("| case") or b.startswith("How to read"))))
+display(Markdown(split_page.split("\n\n", 2)[2]))             # the page without its title and introduction
 
 # %% [markdown]
 # * **The pinball carries friction only while a pair approaches** (Eq. (34) makes the normal force zero while the

@@ -169,3 +169,21 @@ def test_viscous_pressure_is_the_pair_pressure_of_the_artificial_viscosity(tmp_p
                                        kernel, b1, b2, eps, c) == 0.0)
     assert mod.main(["--run", str(tmp_path)]) == 2
     assert "not a run folder" in capsys.readouterr().err
+
+
+def test_thermal_cutting_takes_a_failed_case_again_at_half_the_step():
+    """thermal_cutting.comparison: a case of the t_u/10 table that failed at the sweep's step takes its run at half
+    the step ('case N courant 0.075') where that one is recorded 'ok', and its row says so; a case that ran at the
+    sweep's step keeps that run."""
+    mod = _script("thermal_cutting")
+    runs = json.loads((ROOT / "benchmarks" / "thermal_cutting.json").read_text())["runs"]
+    ok = next(r for r in runs.values() if r["status"] == "ok" and r.get("metrics"))
+    res = dict(runs={"case 9": dict(status="error", error="inverted particle"), "case 9" + mod.RETRY: ok,
+                     "case 8": ok, "case 8" + mod.RETRY: dict(ok, metrics=dict(ok["metrics"], force_ratio=9.0))})
+    rows = {r["case"]: r for r in mod.comparison(res)}
+    assert rows[9]["status"] == "ok" and rows[9]["key"] == "case 9" + mod.RETRY
+    assert "ok (courant 0.075)" in mod._case_line(rows[9])
+    assert rows[8]["key"] == "case 8" and "courant" not in mod._case_line(rows[8])
+    assert rows[7]["status"] == "to run"
+    del res["runs"]["case 9" + mod.RETRY]
+    assert {r["case"]: r for r in mod.comparison(res)}[9]["status"] == "error"

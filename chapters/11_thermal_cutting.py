@@ -298,9 +298,9 @@ for title in ("## Mass scaling", "## The mass scale", "## Run-to-run scatter at 
 #   below splits the tool's force in recorded cuts (`benchmarks/force_split.py`): how much of the rake face
 #   sticks, and what a rake face slipping everywhere at $\mu(T)$ would give.
 
-# %%
+# %% mystnb={"markdown_format": "gfm"}
 split_page = (repository_root() / "benchmarks" / "force_split_report.md").read_text()
-display(Markdown(split_page.split("\n\n", 2)[2]))             # the page without its title and introduction
+display(Markdown(split_page.split("\n\n", 1)[1]))             # the page without its title
 
 # %% [markdown]
 # * **The pinball carries friction only while a pair approaches** (Eq. (34) makes the normal force zero while the

@@ -287,6 +287,9 @@ def report(doc: dict) -> str:
     def share(r, name, k):
         p = r["parts"][name]
         return (p[f"{k}_normal"] + p[f"{k}_friction"]) / r[k]
+
+    def group(r):                                          # the paragraphs: per material and method
+        return r["material"] + (", PFEM" if r.get("method") == "pfem" else "")
     v = {}
     for name, values in (("rake_fc", [share(r, "rake face", "Fc") for r in results]),
                          ("rake_fp", [share(r, "rake face", "Fp") for r in results])):
@@ -297,8 +300,8 @@ def report(doc: dict) -> str:
     travel = sorted({r["travel_t_u"] for r in results})
     parts = [page("head", travel="/".join(f"{t:g}" for t in travel), rake_deg=f"{RAKE_DEG:g}"), table(results),
              page("how_to_read", fc_window_dev=f"{100 * fc_dev:.0f}", ratio_window_dev=f"{ratio_dev:.2f}", **v)]
-    for material in sorted({r["material"] for r in results}):
-        rs = [r for r in results if r["material"] == material and not r.get("numerics_changed")]
+    for material in sorted({group(r) for r in results}):
+        rs = [r for r in results if group(r) == material and not r.get("numerics_changed")]
         rake, m = [r["parts"]["rake face"] for r in rs], {}
         for name, values, spec, scale in (
                 ("stick", [1.0 - p["slip_share"] for p in rake], ".0f", 100.0),
@@ -309,8 +312,8 @@ def report(doc: dict) -> str:
         parts.append(page("material", material=material, rows=", ".join(r["key"] for r in rs), **m))
     above = [r["key"] for r in results if r["merchant_bound_mu_law"] >= r["measured_force_ratio"]]
     slipping = []
-    for material in sorted({r["material"] for r in results}):
-        rs = [r for r in results if r["material"] == material and not r.get("numerics_changed")]
+    for material in sorted({group(r) for r in results}):
+        rs = [r for r in results if group(r) == material and not r.get("numerics_changed")]
         lo, hi = span([r["ratio_rake_slipping"] for r in rs])
         mlo, mhi = span([r["measured_force_ratio"] for r in rs])
         elo, ehi = span([100 * (1 - r["ratio_rake_slipping"] / r["measured_force_ratio"]) for r in rs], ".0f")

@@ -39,12 +39,14 @@ study.pin_threads()
 
 import numpy as np  # noqa: E402
 import thermal_cutting  # noqa: E402
+from pfem_rake_friction import rake_friction_bound  # noqa: E402   (Merchant's tan(atan(m) - alpha))
 
 ROOT = Path(__file__).resolve().parents[1]
 OUT_JSON = Path(__file__).resolve().parent / "force_split.json"
 REPORT = Path(__file__).resolve().parent / "force_split_report.md"
 SWEEP_JSON = Path(__file__).resolve().parent / "thermal_cutting.json"
 PARTS = ("rake face", "edge", "flank")
+PART_WIDTH = 9                                    # the numbers of one part in a row (:func:`row_of`)
 DEFAULT_KEYS = ["case 1", "case 4", "case 11", "case 1 n_tu 5 courant 0.075"]   # t_u/10; the last at t_u/5
 
 
@@ -200,7 +202,7 @@ def continue_pfem(folder: Path, travel: float, scratch: Path, numerics: dict | N
 
 def split(rows: np.ndarray, gamma_deg: float) -> dict:
     """The window's means of the recorded rows (:func:`continue_run`) as the force split (module text)."""
-    width = 9
+    width = PART_WIDTH
     mean = np.average(rows[:, :-1], axis=0, weights=rows[:, -1])          # time means (each row's dt)
     parts, Fx, Fy = {}, 0.0, 0.0
     for k, name in enumerate(PARTS):
@@ -219,8 +221,8 @@ def split(rows: np.ndarray, gamma_deg: float) -> dict:
     slipping = (N * (mu * math.cos(g) - math.sin(g)) + Fp_other) / (N * (math.cos(g) + mu * math.sin(g)) + Fc_other)
     return dict(Fc=Fx, Fp=Fy, force_ratio=Fy / Fx, parts=parts, ratio_rake_slipping=slipping,
                 rake_only_ratio=(rake["Fp_normal"] + rake["Fp_friction"]) / (rake["Fc_normal"] + rake["Fc_friction"]),
-                merchant_bound_mu_law=math.tan(math.atan(rake["mu_law"]) - g),
-                merchant_bound_mu_eff=math.tan(math.atan(rake["mu_eff"]) - g))
+                merchant_bound_mu_law=rake_friction_bound(rake["mu_law"], gamma_deg),
+                merchant_bound_mu_eff=rake_friction_bound(rake["mu_eff"], gamma_deg))
 
 
 def measure(key: str, travel: float, scratch: Path, folder: Path | None = None, numerics: dict | None = None,
@@ -248,6 +250,13 @@ def measure(key: str, travel: float, scratch: Path, folder: Path | None = None, 
                 recorded_Fc_N_per_m=m["cutting_force_N_per_m"], recorded_Fp_N_per_m=m["passive_force_N_per_m"], **out)
 
 
+def share(r: dict, name: str, k: str) -> float:
+    """The share of the window's force ``k`` ('Fc' or 'Fp') that part ``name`` of the tool carries (normal and
+    friction force together)."""
+    p = r["parts"][name]
+    return (p[f"{k}_normal"] + p[f"{k}_friction"]) / r[k]
+
+
 HEAD = ("case", "material", "Fc [N/mm] window (record)", "Fp/Fc window (record)", "Fp/Fc measured",
         "rake face: share of Fc, Fp", "edge", "flank",
         "rake face mu_eff / mu(T)", "slipping share of rake f_N", "Fp/Fc of the rake face alone",
@@ -258,17 +267,16 @@ def table(results: list) -> str:
     """The markdown table of the results."""
     rows = []
     for r in results:
-        P, rake = r["parts"], r["parts"]["rake face"]
+        rake = r["parts"]["rake face"]
 
-        def share(name):
-            p = P[name]
-            fc, fp = (p["Fc_normal"] + p["Fc_friction"]) / r["Fc"], (p["Fp_normal"] + p["Fp_friction"]) / r["Fp"]
-            return f"{fc:.2f}, {fp:.2f}"
+        def shares(name):
+            return f"{share(r, name, 'Fc'):.2f}, {share(r, name, 'Fp'):.2f}"
         label = r["key"] + (" (PFEM)" if r.get("method") == "pfem" else "")
         rows.append([label, r["material"], f"{r['Fc'] / 1e3:.0f} ({r['recorded_Fc_N_per_m'] / 1e3:.0f})",
                      f"{r['force_ratio']:.2f} ({r['recorded_Fp_N_per_m'] / r['recorded_Fc_N_per_m']:.2f})",
                      f"{r['measured_force_ratio']:.2f}",
-                     share("rake face"), share("edge"), share("flank"), f"{rake['mu_eff']:.2f} / {rake['mu_law']:.2f}",
+                     shares("rake face"), shares("edge"), shares("flank"),
+                     f"{rake['mu_eff']:.2f} / {rake['mu_law']:.2f}",
                      f"{rake['slip_share']:.2f}", f"{r['rake_only_ratio']:.2f}", f"{r['merchant_bound_mu_law']:.2f}",
                      f"{r['ratio_rake_slipping']:.2f}"])
     return study.md_table(HEAD, rows)
@@ -283,10 +291,6 @@ def report(doc: dict) -> str:
     def span(values, spec=".2f", scale=1.0):
         lo, hi = format(min(values) * scale, spec), format(max(values) * scale, spec)
         return (lo, "") if lo == hi else (lo, "-" + hi)
-
-    def share(r, name, k):
-        p = r["parts"][name]
-        return (p[f"{k}_normal"] + p[f"{k}_friction"]) / r[k]
 
     def group(r):                                          # the paragraphs: per material and method
         return r["material"] + (", PFEM" if r.get("method") == "pfem" else "")
@@ -337,21 +341,18 @@ def whatif(page, r: dict, base: dict) -> str:
                 fc_whatif=f"{r['Fc'] / 1e3:.0f}")
 
 
-def parse_set(items: list) -> dict:
-    """{name: value} of NAME=VALUE items, each value read as JSON where it can be (numbers, true, null)."""
-    out = {}
-    for item in items:
-        name, eq, value = item.partition("=")
-        if not eq or not name:
-            raise SystemExit(f"--set {item!r}: expected NAME=VALUE")
-        try:
-            out[name] = json.loads(value)
-        except ValueError:
-            out[name] = value
-    return out
+def _read_json(path: Path, ap) -> dict:
+    """The JSON document at ``path``; a clear error (not a traceback) where it is not JSON."""
+    try:
+        doc = json.loads(path.read_text())
+    except (OSError, ValueError) as e:
+        ap.error(f"--json {path}: cannot be read as JSON ({e})")
+    return doc if isinstance(doc, dict) else {}
 
 
 def main(argv=None) -> int:
+    from refsph.cli import _parse_numerics
+
     ap = study.parser(__doc__)
     ap.add_argument("--keys", nargs="*", default=DEFAULT_KEYS, help="the sweep's keys (default: "
                                                                               + ", ".join(DEFAULT_KEYS) + ")")
@@ -366,24 +367,31 @@ def main(argv=None) -> int:
                                                                 "force_split.json)")
     ap.add_argument("--report", action="store_true", help="no runs: the report page from the JSON")
     a = ap.parse_args(argv)
+    if a.json.exists() and not isinstance(_read_json(a.json, ap).get("results"), list):
+        ap.error(f"--json {a.json}: not a force-split file (no 'results' list); refusing to read or overwrite it")
     if a.report:                                           # the committed page only from the committed JSON
-        page = report(json.loads(a.json.read_text()))
+        if not a.json.exists():
+            ap.error(f"--report: {a.json} does not exist (run the script first)")
+        page = report(_read_json(a.json, ap))
         if a.json.resolve() == OUT_JSON:
             study.write_if_changed(REPORT, page)
         print(page)
         return 0
     if not (a.travel > 0):
         ap.error(f"--travel must be > 0, got {a.travel}")
+    try:
+        changed = _parse_numerics(a.set)                   # refsph run's --set: typed, unknown names refused
+    except ValueError as e:
+        ap.error(str(e))
     results = []
     with tempfile.TemporaryDirectory() as tmp:
         scratch = a.scratch or Path(tmp)
-        changed = parse_set(a.set)
         suffix = "".join(f", {k} {v}" for k, v in changed.items())
         jobs = [(key, None) for key in a.keys] + [(f.name, f) for f in a.folders]
         for key, folder in jobs:
             results.append(measure(key, a.travel, scratch, folder, changed, key + suffix))
             print(table(results[-1:]), flush=True)
-    old = json.loads(a.json.read_text())["results"] if a.json.exists() else []
+    old = _read_json(a.json, ap)["results"] if a.json.exists() else []
     keep = [r for r in old if r["key"] not in {r["key"] for r in results}]
     study.write_json(a.json, dict(results=keep + results))
     if a.json.resolve() == OUT_JSON:

@@ -25,7 +25,7 @@ import study  # noqa: E402
 
 study.pin_threads()
 
-from refsph.scenes.base import parse_bool  # noqa: E402
+from refsph.cli import _parse_numerics  # noqa: E402
 from refsph.simulate import run  # noqa: E402
 
 OPTIONS = dict(case=1, travel=1.0)
@@ -84,14 +84,10 @@ def main(argv=None) -> int:
             ap.error(f"--option takes NAME=VALUE (a scene option), got {item!r}")
         name, value = item.split("=", 1)
         options[name] = value
-    numerics = dict(threads=1)
-    for item in args.set:
-        if "=" not in item:
-            ap.error(f"--set takes NAME=VALUE (a Numerics field), got {item!r}")
-        name, value = item.split("=", 1)
-        numerics[name] = value if not value.replace(".", "", 1).isdigit() else float(value)
-        if value.lower() in ("true", "false"):
-            numerics[name] = parse_bool(value, name)
+    try:                                                   # refsph run's --set: typed, unknown names refused
+        numerics = {"threads": 1, **_parse_numerics(args.set)}
+    except ValueError as e:
+        ap.error(str(e))
     prof = cProfile.Profile()
     t0 = time.perf_counter()
     prof.enable()

@@ -39,7 +39,7 @@ def _friction():
 
 def _totals(fs, row):
     """The force on the tool (x, y) summed over the parts of a row, and the rake face's friction force."""
-    w = 9
+    w = fs.PART_WIDTH
     parts = np.array(row[:-1]).reshape(len(fs.PARTS), w)
     return parts[:, 0:2].sum(0) + parts[:, 2:4].sum(0), parts[fs.PARTS.index("rake face"), 2:4]
 
@@ -79,7 +79,7 @@ def test_pfem_rows_add_up_to_the_force_on_the_tool():
     row = fs.row_from_step_contact(c, x_new, 2.5e-6)
     total, rake_friction = _totals(fs, row)
     np.testing.assert_allclose(total, -f.sum(0), rtol=1e-12)
-    assert rake_friction @ up > 0 and row[fs.PARTS.index("rake face") * 9 + 8] == 2    # two nodes touch
+    assert rake_friction @ up > 0 and row[fs.PARTS.index("rake face") * fs.PART_WIDTH + 8] == 2    # two nodes touch
 
 
 @pytest.mark.parametrize("mu", [0.0, 0.3, 0.81])

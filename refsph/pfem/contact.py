@@ -155,38 +155,49 @@ class StepContact:
 
 
 def solve_with_active_set(nodes, mesh, hist, law, dt, loads, max_outer: int = 8, dynamic=True, max_iter: int = 25,
-                          max_move: float | None = None, du0=None):
+                          max_move: float | None = None, du0=None, settle: int | None = None):
     """Newton-Raphson with the contact and slip sets frozen (:meth:`StepContact.freeze`): set at the step's start
     x_n (the tool already at t_{n+1}), the first solve started from ``du0`` (default zeros; not the predictor dt v:
     the trapezoidal rule's velocities ring at an impact, and the predictor would drive the contact nodes deep into
     the tool; sets taken at x_n + du0 instead cost twice the iterations on case 1's short cut at t_u / 10), solved,
     set again from the solution, until the sets stop changing (the active-set strategy, Wriggers 2006, Section
-    6.3); then a last solve with the sets free checks that the solution satisfies the contact law itself. Sets
-    still changing after ``max_outer`` solves cycle (a node
-    grazing the tool or at the friction cap, in and out on alternate solves): up to ``max_outer`` more solves let
-    the sets only grow (:meth:`StepContact.freeze` with ``grow``), which ends the cycle, before the last solve with
-    the sets free. A solve that fails with a frozen slip turned against its direction
-    (:meth:`StepContact.stick_reversed`) is made again from the same start with that node stuck for the step (it
-    counts as one of the solves; three such at most). Each solve after the first starts from the one before's du
-    and p (with p from t_n instead, a solve whose sets had not changed took an iteration to find the pressures
-    again). The result's ``iterations`` counts those of every solve."""
+    6.3); then a last solve with the sets free checks that the solution satisfies the contact law itself.
+    ``settle``: the sets are looked at again after every ``settle`` Newton corrections, not only once a solve has
+    converged (the active set updated inside the iterations, Wriggers 2006, Section 6.3.1; None: after each
+    converged solve); a solve whose sets have not changed then goes on from where it stopped. Sets still changing
+    after ``max_outer`` changes cycle (a node grazing the tool or at the friction cap, in and out on alternate
+    solves): up to ``max_outer`` more let the sets only grow (:meth:`StepContact.freeze` with ``grow``), which ends
+    the cycle, before the last solve with the sets free. A solve that fails (``max_iter`` corrections since the
+    sets last changed) with a frozen slip turned against its direction (:meth:`StepContact.stick_reversed`) is made
+    again from the same start with that node stuck for the step (it counts as one change of the sets; three such at
+    most). Each solve after the first starts from the one before's du and p (with p from t_n instead, a solve whose
+    sets had not changed took an iteration to find the pressures again). The result's ``iterations`` counts those
+    of every solve."""
     c = loads.contact
     c.freeze(nodes.x)
-    total, pattern, p0, sticks = 0, {}, None, 0                   # the solves share the mesh's sparsity pattern
-    for k in range(2 * max_outer):
+    total, pattern, p0, sticks, changes, since = 0, {}, None, 0, 0, 0       # the solves share the mesh's pattern
+    while changes < 2 * max_outer:
         try:
-            r = newton_step(nodes, mesh, hist, law, dt, loads, dynamic=dynamic, predictor=False, max_iter=max_iter,
-                            max_move=max_move, du0=du0, p0=p0, pattern=pattern)
+            r = newton_step(nodes, mesh, hist, law, dt, loads, dynamic=dynamic, predictor=False,
+                            max_iter=max_iter - since, max_move=max_move, du0=du0, p0=p0, pattern=pattern,
+                            settle=settle)
         except NewtonFailed as e:                                 # a frozen slip that turned: it sticks, and the
             if sticks >= 3 or len(e.args) < 3 or not c.stick_reversed(nodes.x + e.args[2][0]):   # solve starts
                 raise                                                                             # again
-            total, sticks = total + len(e.args[1]), sticks + 1
+            total, sticks, changes, since = total + len(e.args[1]), sticks + 1, changes + 1, 0
             continue
         du0, p0, total = r.du, r.p, total + r.iterations
-        if not c.freeze(nodes.x + r.du, grow=k >= max_outer - 1):
+        if c.freeze(nodes.x + r.du, grow=changes >= max_outer - 1):
+            changes, since = changes + 1, 0
+        elif r.converged:
             c.active = c.slip = None
             last = newton_step(nodes, mesh, hist, law, dt, loads, dynamic=dynamic, predictor=False,
                                max_iter=max_iter, max_move=max_move, du0=r.du, p0=r.p, pattern=pattern)  # sets free
             last.solves_iterations = total + last.iterations
             return last
+        else:
+            since += r.iterations
+            if since >= max_iter:
+                raise NewtonFailed(f"Newton-Raphson did not converge in {max_iter} iterations with the contact's "
+                                   f"sets unchanged (residuals {r.residuals[-3:]})", r.residuals, (r.du, r.p))
     raise NewtonFailed(f"the contact's active set kept changing over {2 * max_outer} solves", [])

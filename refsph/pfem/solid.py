@@ -194,6 +194,7 @@ class StepResult:
     residuals: list = field(default_factory=list)
     contact_force: np.ndarray | None = None
     solves_iterations: int | None = None
+    converged: bool = True
 
     @property
     def iterations(self) -> int:
@@ -439,7 +440,7 @@ def _shared_pattern(pattern: dict | None, mesh: Mesh, n: int, fix: np.ndarray):
 def newton_step(nodes: Nodes, mesh: Mesh, hist: History, law: SolidLaw, dt: float, loads: Loads,
                 dynamic: bool = True, tol: float = 1e-10, max_iter: int = 25, predictor: bool = True,
                 max_move: float | None = None, du0: np.ndarray | None = None, p0: np.ndarray | None = None,
-                pattern: dict | None = None) -> StepResult:
+                pattern: dict | None = None, settle: int | None = None) -> StepResult:
     """Solve Eqs. (19)-(20) for the step's du and p by Newton-Raphson. Converged when the residual of the free
     displacement rows and that of the pressure rows are below ``tol`` times their scales (:func:`assemble`), or
     below 100 tol and no longer falling (the round-off floor of a large system: the sums of many forces).
@@ -450,7 +451,10 @@ def newton_step(nodes: Nodes, mesh: Mesh, hist: History, law: SolidLaw, dt: floa
     of one remove; the line search alone then crawls (chapter 12). ``du0``: the first guess of du where the
     predictor is off (default zeros); ``p0``: that of p (default p at t_n). ``pattern``: a dict kept between the
     solves of one mesh and one set of held dofs (the Newton matrix's sparsity pattern and ordering,
-    :class:`FreeMatrix`, :func:`solve_linear`; found again where they differ). Raises :class:`NewtonFailed`."""
+    :class:`FreeMatrix`, :func:`solve_linear`; found again where they differ). ``settle``: return after this many
+    corrections even if not converged (the result's ``converged`` False: the active-set strategy looks at its sets
+    there, :func:`refsph.pfem.contact.solve_with_active_set`; None: solve to the tolerance). Raises
+    :class:`NewtonFailed`."""
     n = nodes.n
     size = None if max_move is None else _node_sizes(nodes, mesh)
     fixed = np.asarray(loads.fixed, dtype=bool).copy()
@@ -485,12 +489,13 @@ def newton_step(nodes: Nodes, mesh: Mesh, hist: History, law: SolidLaw, dt: floa
         history.append((res_u, res_p))
         floor = (len(history) > 2 and max(res_u, res_p) < 100.0 * tol
                  and max(res_u, res_p) > 0.5 * max(history[-2]))      # stagnating at round-off, just above tol
-        if ((res_u < tol and res_p < tol) or floor) and not np.any(lift):
+        done = ((res_u < tol and res_p < tol) or floor) and not np.any(lift)
+        if done or (settle is not None and len(history) > settle and not np.any(lift) and np.all(np.isfinite(R))):
             return StepResult(du=du, p=p, history=History(resp["S"], resp["S_zz"], hist.eps_p + resp["d_eps_p"],
                                                            hist.W_p + resp["d_w_p"], resp["J"],
                                                            None if hist.eps_dot is None else resp["eps_dot"]),
                               d_eps_p=resp["d_eps_p"], d_w_p=resp["d_w_p"], area=resp["area"], residuals=history,
-                              contact_force=fc)
+                              contact_force=fc, converged=bool(done))
         if not np.all(np.isfinite(R)):
             break
         Kg = evaluate(du, p, True, resp)[1]                       # the tangent at this point (its residual known)

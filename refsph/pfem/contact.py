@@ -175,29 +175,30 @@ def solve_with_active_set(nodes, mesh, hist, law, dt, loads, max_outer: int = 8,
     of every solve."""
     c = loads.contact
     c.freeze(nodes.x)
-    total, pattern, p0, sticks, changes, since = 0, {}, None, 0, 0, 0       # the solves share the mesh's pattern
+    total, pattern, sticks, changes, since = 0, {}, 0, 0, 0              # the solves share the mesh's pattern
+    du, p = start = (du0, None)                                          # start: where the sets' solve began
     while changes < 2 * max_outer:
         try:
             r = newton_step(nodes, mesh, hist, law, dt, loads, dynamic=dynamic, predictor=False,
-                            max_iter=max_iter - since, max_move=max_move, du0=du0, p0=p0, pattern=pattern,
+                            max_iter=max_iter - since, max_move=max_move, du0=du, p0=p, pattern=pattern,
                             settle=settle)
+            since += r.iterations
+            if not r.converged and since >= max_iter:
+                raise NewtonFailed(f"Newton-Raphson did not converge in {max_iter} iterations with the contact's "
+                                   f"sets unchanged (residuals {r.residuals[-3:]})", r.residuals, (r.du, r.p))
         except NewtonFailed as e:                                 # a frozen slip that turned: it sticks, and the
             if sticks >= 3 or len(e.args) < 3 or not c.stick_reversed(nodes.x + e.args[2][0]):   # solve starts
                 raise                                                                             # again
             total, sticks, changes, since = total + len(e.args[1]), sticks + 1, changes + 1, 0
+            du, p = start
             continue
-        du0, p0, total = r.du, r.p, total + r.iterations
+        du, p, total = r.du, r.p, total + r.iterations
         if c.freeze(nodes.x + r.du, grow=changes >= max_outer - 1):
-            changes, since = changes + 1, 0
+            changes, since, start = changes + 1, 0, (du, p)
         elif r.converged:
             c.active = c.slip = None
             last = newton_step(nodes, mesh, hist, law, dt, loads, dynamic=dynamic, predictor=False,
                                max_iter=max_iter, max_move=max_move, du0=r.du, p0=r.p, pattern=pattern)  # sets free
             last.solves_iterations = total + last.iterations
             return last
-        else:
-            since += r.iterations
-            if since >= max_iter:
-                raise NewtonFailed(f"Newton-Raphson did not converge in {max_iter} iterations with the contact's "
-                                   f"sets unchanged (residuals {r.residuals[-3:]})", r.residuals, (r.du, r.p))
     raise NewtonFailed(f"the contact's active set kept changing over {2 * max_outer} solves", [])

@@ -431,3 +431,45 @@ def test_cut_takes_the_damped_newmark_rule_as_an_option():
     assert cut.info["newmark_gamma"] == 0.6
     with pytest.raises(ValueError, match="gamma"):
         pfem_cut(1, n_tu=3.0, travel=2.0, length=1e-3, gamma=0.4)
+
+
+def test_contact_sets_looked_at_inside_the_iterations_give_the_same_cut_in_fewer_iterations():
+    """solve_with_active_set with ``settle`` (the sets looked at every two Newton corrections, the cut's default)
+    against the sets looked at only after each converged solve (``settle=None``): the quick cut's first 20 steps
+    give the same tool force at every step (measured: 2e-10 apart) in fewer Newton iterations (292 against 332)."""
+    from dataclasses import replace
+
+    from refsph.pfem.cutting import CutRun, pfem_cut
+    runs = {}
+    for settle, max_outer in ((None, 8), (2, 16)):
+        run = CutRun(replace(pfem_cut(1, n_tu=5.0, travel=4.0, length=1.2e-3), settle=settle, max_outer=max_outer))
+        for _ in range(20):
+            run.step()
+        runs[settle] = (np.array(run.reaction["tool"]), sum(run.iterations), run.retries)
+    (F_old, its_old, halved_old), (F_new, its_new, halved_new) = runs[None], runs[2]
+    print("Newton iterations, settle None / 2:", its_old, its_new)
+    assert halved_old == halved_new == 0
+    assert np.allclose(F_new, F_old, rtol=1e-8, atol=1e-6 * np.abs(F_old).max())
+    assert its_new < 0.95 * its_old
+
+
+def test_newton_step_with_settle_returns_after_that_many_corrections():
+    """newton_step(settle=k): back after k corrections, flagged not converged, at the point reached; the same
+    problem solved on from there converges to the answer of an uninterrupted solve."""
+    x = lattice(4, 4, 0, 1e-3, 0, 1e-3)
+    mesh = alpha_shape_mesh(x, None)
+    lw = law()
+    nodes, hist = solid.make_nodes(x, lumped_masses(x, mesh), 293.0), fresh_history(mesh)
+    top, bottom = np.isclose(x[:, 1], 1e-3), np.isclose(x[:, 1], 0.0)
+    fixed = np.zeros((len(x), 2), bool)
+    fixed[top | bottom] = True
+    du = np.zeros_like(x)
+    du[top, 1] = -2e-5                                                  # 2 % compression: plastic
+    loads = solid.Loads(fixed, du)
+    whole = solid.newton_step(nodes, mesh, hist, lw, 1e-3, loads, dynamic=False)
+    part = solid.newton_step(nodes, mesh, hist, lw, 1e-3, loads, dynamic=False, settle=1)
+    assert whole.converged and whole.iterations > 2
+    assert not part.converged and part.iterations == 1
+    rest = solid.newton_step(nodes, mesh, hist, lw, 1e-3, loads, dynamic=False, du0=part.du, p0=part.p,
+                             predictor=False)
+    assert rest.converged and np.allclose(rest.du, whole.du, rtol=0, atol=1e-12 * 2e-5)

@@ -200,6 +200,8 @@ def main(argv=None) -> int:
     if args.full and not args.report:
         rec = full_record(full_folder(args.gamma), args.label, None) if args.record else \
             measure_full(args.label or version(), args.gamma)
+        data = json.loads(OUT_JSON.read_text()) if OUT_JSON.exists() else {}     # again: rows added meanwhile stay
+        rows, full = data.get("rows", []), data.get("full", [])
         full = [r for r in full if (r["commit"], r["options"].get("gamma", 0.5))
                 != (rec["commit"], rec["options"].get("gamma", 0.5))] + [rec]
         OUT_JSON.write_text(json.dumps(dict(rows=rows, full=full), indent=1) + "\n")

@@ -491,11 +491,7 @@ def newton_step(nodes: Nodes, mesh: Mesh, hist: History, law: SolidLaw, dt: floa
                  and max(res_u, res_p) > 0.5 * max(history[-2]))      # stagnating at round-off, just above tol
         done = ((res_u < tol and res_p < tol) or floor) and not np.any(lift)
         if done or (settle is not None and len(history) > settle and not np.any(lift) and np.all(np.isfinite(R))):
-            return StepResult(du=du, p=p, history=History(resp["S"], resp["S_zz"], hist.eps_p + resp["d_eps_p"],
-                                                           hist.W_p + resp["d_w_p"], resp["J"],
-                                                           None if hist.eps_dot is None else resp["eps_dot"]),
-                              d_eps_p=resp["d_eps_p"], d_w_p=resp["d_w_p"], area=resp["area"], residuals=history,
-                              contact_force=fc, converged=bool(done))
+            return _step_result(du, p, hist, resp, history, fc, bool(done))
         if not np.all(np.isfinite(R)):
             break
         Kg = evaluate(du, p, True, resp)[1]                       # the tangent at this point (its residual known)
@@ -520,6 +516,15 @@ def newton_step(nodes: Nodes, mesh: Mesh, hist: History, law: SolidLaw, dt: floa
         R, Kg, resp, scale, fc = trial if trial is not None else evaluate(du, p, False)   # the accepted trial
     raise NewtonFailed(f"Newton-Raphson did not converge in {max_iter} iterations (residuals {history[-3:]})",
                        history, (du, p))
+
+
+def _step_result(du, p, hist, resp, history, fc, converged) -> StepResult:
+    """newton_step's result at (du, p): the element response ``resp`` there as the triangles' new history."""
+    return StepResult(du=du, p=p, history=History(resp["S"], resp["S_zz"], hist.eps_p + resp["d_eps_p"],
+                                                   hist.W_p + resp["d_w_p"], resp["J"],
+                                                   None if hist.eps_dot is None else resp["eps_dot"]),
+                      d_eps_p=resp["d_eps_p"], d_w_p=resp["d_w_p"], area=resp["area"], residuals=history,
+                      contact_force=fc, converged=converged)
 
 
 def solve_linear(A, b: np.ndarray, ordering: dict | None = None) -> np.ndarray:

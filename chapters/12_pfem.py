@@ -594,7 +594,7 @@ print(f"case 1: finest spacing {cut.info['dx'] * 1e6:.0f} um, edge radius {cut.i
 # correction of 12 spacings where tenths would do: `max_move=0.05` caps each correction at 0.05 of a node's size.
 # At t_u/10 the node where chip and machined surface part slipped forwards in one solve and backwards in the next:
 # a slip that reverses now sticks first, as a return map would. The sets are looked at again after every two
-# corrections (`settle=2`), not only after a converged solve: a third fewer iterations, the same forces. The quick
+# corrections (`settle=2`), not only after a converged solve: a fifth to a third fewer iterations. The quick
 # cut (`--quick`) takes 2-3 minutes.
 #
 # **The cut, side by side.** `refsph run thermal_cutting --method pfem` writes a run folder like an SPH run's

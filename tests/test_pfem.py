@@ -473,3 +473,12 @@ def test_newton_step_with_settle_returns_after_that_many_corrections():
     rest = solid.newton_step(nodes, mesh, hist, lw, 1e-3, loads, dynamic=False, du0=part.du, p0=part.p,
                              predictor=False)
     assert rest.converged and np.allclose(rest.du, whole.du, rtol=0, atol=1e-12 * 2e-5)
+
+
+def test_settle_below_two_is_refused():
+    """solve_with_active_set(settle=0) would spin (no correction between looks at the sets) and settle=1 never has
+    the three residuals newton_step's round-off stopping rule needs: both are refused with a ValueError."""
+    from refsph.pfem.contact import solve_with_active_set
+    for bad in (0, 1, 1.5):
+        with pytest.raises(ValueError, match="settle must be None or a whole number of at least 2"):
+            solve_with_active_set(None, None, None, None, 1e-9, None, settle=bad)

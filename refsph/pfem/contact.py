@@ -162,9 +162,9 @@ def solve_with_active_set(nodes, mesh, hist, law, dt, loads, max_outer: int = 8,
     the tool; sets taken at x_n + du0 instead cost twice the iterations on case 1's short cut at t_u / 10), solved,
     set again from the solution, until the sets stop changing (the active-set strategy, Wriggers 2006, Section
     6.3); then a last solve with the sets free checks that the solution satisfies the contact law itself.
-    ``settle``: the sets are looked at again after every ``settle`` Newton corrections, not only once a solve has
-    converged (the active set updated inside the iterations, Wriggers 2006, Section 6.3.1; None: after each
-    converged solve); a solve whose sets have not changed then goes on from where it stopped. Sets still changing
+    ``settle`` (None or at least 2): the sets are looked at again after every ``settle`` Newton corrections, not only
+    once a solve has converged (the active set updated within the iterations; None: after each converged solve); a
+    solve whose sets have not changed then goes on from where it stopped. Sets still changing
     after ``max_outer`` changes cycle (a node grazing the tool or at the friction cap, in and out on alternate
     solves): up to ``max_outer`` more let the sets only grow (:meth:`StepContact.freeze` with ``grow``), which ends
     the cycle, before the last solve with the sets free. A solve that fails (``max_iter`` corrections since the
@@ -173,6 +173,9 @@ def solve_with_active_set(nodes, mesh, hist, law, dt, loads, max_outer: int = 8,
     most). Each solve after the first starts from the one before's du and p (with p from t_n instead, a solve whose
     sets had not changed took an iteration to find the pressures again). The result's ``iterations`` counts those
     of every solve."""
+    if settle is not None and not (isinstance(settle, (int, np.integer)) and settle >= 2):
+        raise ValueError(f"settle must be None or a whole number of at least 2 corrections, got {settle!r} (the "
+                         "round-off stopping rule of newton_step needs three residuals of one solve)")
     c = loads.contact
     c.freeze(nodes.x)
     total, pattern, sticks, changes, since = 0, {}, 0, 0, 0              # the solves share the mesh's pattern
@@ -201,4 +204,4 @@ def solve_with_active_set(nodes, mesh, hist, law, dt, loads, max_outer: int = 8,
                                max_iter=max_iter, max_move=max_move, du0=r.du, p0=r.p, pattern=pattern)  # sets free
             last.solves_iterations = total + last.iterations
             return last
-    raise NewtonFailed(f"the contact's active set kept changing over {2 * max_outer} solves", [])
+    raise NewtonFailed(f"the contact's active set changed {2 * max_outer} times", [])

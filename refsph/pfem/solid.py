@@ -183,7 +183,8 @@ class Loads:
 
 @dataclass
 class StepResult:
-    """A converged step: du (N, 2), p (N,), the triangles' new history and heat, the Newton record."""
+    """A step's solution: du (N, 2), p (N,), the triangles' new history and heat, the Newton record; ``converged``
+    False where :func:`newton_step` came back early (``settle``) at a point short of the tolerance."""
 
     du: np.ndarray
     p: np.ndarray
@@ -452,8 +453,8 @@ def newton_step(nodes: Nodes, mesh: Mesh, hist: History, law: SolidLaw, dt: floa
     predictor is off (default zeros); ``p0``: that of p (default p at t_n). ``pattern``: a dict kept between the
     solves of one mesh and one set of held dofs (the Newton matrix's sparsity pattern and ordering,
     :class:`FreeMatrix`, :func:`solve_linear`; found again where they differ). ``settle``: return after this many
-    corrections even if not converged (the result's ``converged`` False: the active-set strategy looks at its sets
-    there, :func:`refsph.pfem.contact.solve_with_active_set`; None: solve to the tolerance). Raises
+    corrections, at a finite residual with no prescribed correction pending, even if not converged (``converged``
+    False; :func:`refsph.pfem.contact.solve_with_active_set` looks at its sets there; None: to the tolerance). Raises
     :class:`NewtonFailed`."""
     n = nodes.n
     size = None if max_move is None else _node_sizes(nodes, mesh)

@@ -619,7 +619,7 @@ for case in (1, 10):
 
 # %% [markdown]
 # **Where it stands.** 17 of 18 cuts run at t_u/5 (mind chapter 11's scatter, Fc 17 %); case 16's chip rings under
-# the trapezoidal rule until Newton stalls (`gamma=0.6` damps it). At t_u/10 case 1 runs to the end (51 min CPU).
+# the trapezoidal rule until Newton stalls (`gamma=0.6` damps it). At t_u/10 case 1 runs to the end (41 min CPU).
 
 # %% [markdown]
 # ## Your turn

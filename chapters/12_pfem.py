@@ -590,12 +590,10 @@ print(f"case 1: finest spacing {cut.info['dx'] * 1e6:.0f} um, edge radius {cut.i
 # tool as an exact shape, a penalty contact with Coulomb friction inside the Newton iterations). Newton stalled at
 # the first contact, twice over. The trapezoidal rule's velocities ring at an impact, so the predictor du = dt v
 # drove contact nodes deep into the tool: each step starts from the last step's du, the contact and slip sets
-# frozen within a solve (`solve_with_active_set`). A node on the tool, held by soft flowing elements, got an (exact)
-# correction of 12 spacings where tenths would do: `max_move=0.05` caps each correction at 0.05 of a node's size.
-# At t_u/10 the node where chip and machined surface part slipped forwards in one solve and backwards in the next:
-# a slip that reverses now sticks first, as a return map would. The sets are looked at again after every two
-# corrections (`settle=2`), not only after a converged solve: a fifth to a third fewer iterations. The quick
-# cut (`--quick`) takes 2-3 minutes.
+# frozen (`solve_with_active_set`) and looked at again every two corrections (`settle=2`: a fifth to a third fewer
+# iterations). A node on the tool, held by soft flowing elements, got a correction of 12 spacings where tenths
+# would do: `max_move=0.05` caps each at 0.05 of a node's size. At t_u/10 the node where chip and surface part
+# slipped to and fro on alternate solves: a slip that reverses now sticks first. `--quick` takes 2-3 minutes.
 #
 # **The cut, side by side.** `refsph run thermal_cutting --method pfem` writes a run folder like an SPH run's
 # (with the triangles); `python benchmarks/thermal_cutting.py --study pfem` runs the 18 cases, too slow for this

@@ -128,6 +128,12 @@ def full_record(out: Path, label: str | None, cpu: float | None, wall: float | N
                 error=s.get("error", "")[:200])
 
 
+def records() -> tuple[list, list]:
+    """(rows, full): this script's records in its JSON (empty where there is none yet)."""
+    data = json.loads(OUT_JSON.read_text()) if OUT_JSON.exists() else {}
+    return data.get("rows", []), data.get("full", [])
+
+
 def sweep_record() -> dict | None:
     """The sweep's record of the cut --full times (None: not recorded)."""
     if not SWEEP_JSON.exists():
@@ -193,15 +199,13 @@ def main(argv=None) -> int:
                     help="--full: record the run in its folder (one whose process ended before it could) without "
                          "running it again; its CPU time is then unknown")
     args = ap.parse_args(argv)
-    data = json.loads(OUT_JSON.read_text()) if OUT_JSON.exists() else {}
-    rows, full = data.get("rows", []), data.get("full", [])
+    rows, full = records()
     if args.record and not (full_folder(args.gamma) / "summary.json").exists():
         ap.error(f"--record: no run in {full_folder(args.gamma)} (run --full first)")
     if args.full and not args.report:
         rec = full_record(full_folder(args.gamma), args.label, None) if args.record else \
             measure_full(args.label or version(), args.gamma)
-        data = json.loads(OUT_JSON.read_text()) if OUT_JSON.exists() else {}     # again: rows added meanwhile stay
-        rows, full = data.get("rows", []), data.get("full", [])
+        rows, full = records()                        # read again: rows added while the cut ran stay
         full = [r for r in full if (r["commit"], r["options"].get("gamma", 0.5))
                 != (rec["commit"], rec["options"].get("gamma", 0.5))] + [rec]
         OUT_JSON.write_text(json.dumps(dict(rows=rows, full=full), indent=1) + "\n")

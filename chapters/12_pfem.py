@@ -415,7 +415,7 @@ for name, nr in norms.items():
     print(f"{name:16s} ({len(nr):2d} iterations):", " ".join(f"{v:.1e}" for v in nr[:8]), "..." * (len(nr) > 8))
 print(f"after 10 steps: mean plastic strain {hist.eps_p.mean():.3f}, T up to {nodes.T.max():.0f} K")
 exact, slow = norms["refsph's tangent"], norms["elastic tangent"]
-assert exact[-1] < 1e-10 and len(exact) <= 6 and slow[-1] > 1e-8 and all(b < a for a, b in zip(slow, slow[1:]))
+assert exact[-1] < 1e-10 and len(exact) <= 6 and len(slow) >= 4 * len(exact) and np.all(np.diff(slow) < 0)
 
 # %%
 fig, ax = plt.subplots(figsize=(6.5, 3.6), constrained_layout=True)
@@ -429,12 +429,12 @@ ch.show(fig, "12_newton.png", caption="Scaled residual per Newton iteration in o
 # %% [markdown]
 # With refsph's tangent the residual falls as $r_{k+1} \approx C r_k^2$: the digits double each iteration; with the
 # elastic stiffness it falls by a constant factor per iteration. refsph's tangent is the *exact derivative of the
-# discrete residual*: the pressure columns written out, the displacement columns forward differences of each
-# element's residual (six perturbations of $10^{-8}$ of the element size). A **stated choice**: the analytic
-# consistent tangent of the Hughes–Winget update with the radial return, the rate and temperature dependence and the
-# geometric stiffness is pages of algebra per strength law, and a wrong term costs the quadratic rate silently;
-# forward differences serve every law of `refsph.strength` for 6 element evaluations, with an error ($10^{-8}$)
-# below Newton's tolerance. The assembled matrix against a derivative of the whole residual:
+# discrete residual*, written by hand for the radial return (Johnson-Cook and its modification) and the elastic
+# solid: the midpoint and end gradients moving with $\Delta u$, the Hughes–Winget rotation, the return factor
+# $c_f = \sigma_y/\sigma_{vm}$ and Eq. (13) through $\det f$ (`solid._element_tangent_exact`; a test holds it to
+# central differences at $10^{-9}$). Any other law of `refsph.strength` gets forward differences of the element
+# residual (six perturbations of $10^{-8}$ of the element size): the same iterations, at 1.3 times the CPU on the
+# short cut. The assembled matrix against a derivative of the whole residual:
 
 # %%
 nodes5, hist5, du5 = mid_state

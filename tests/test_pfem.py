@@ -482,3 +482,58 @@ def test_settle_below_two_is_refused():
     for bad in (0, 1, 1.5):
         with pytest.raises(ValueError, match="settle must be None or a whole number of at least 2"):
             solve_with_active_set(None, None, None, None, 1e-9, None, settle=bad)
+
+
+class _OwnReturnMap:
+    """A strength model with its own return map (not the radial return): the tangent falls back to differences."""
+
+    state_fields = ("eps_p",)
+    heating = False
+
+    def return_map(self, S, S_zz, eps_p, eps_dot, T, G):
+        f = 1.0 / (1.0 + 1e-18 * np.einsum("mij,mij->m", S, S))
+        return S * f[:, None, None], S_zz * f, np.zeros(len(S)), np.zeros(len(S))
+
+    def heat(self, d_w_p, rho):
+        return np.zeros_like(d_w_p)
+
+
+@pytest.mark.parametrize("lagged", [True, False])
+@pytest.mark.parametrize("kind", ["johnson-cook", "modified", "elastic", "own return map"])
+def test_element_tangent_is_the_derivative_of_the_element_residual(kind, lagged):
+    """The element tangent (exact for the radial return and the elastic solid, forward differences for another
+    law) against central differences of the element residual, on distorted, rotated, heated triangles, most of
+    them flowing plastically, the rest elastic (the rate lagged as the cutting runs do it, or the step's own)."""
+    from refsph.plasticity import ModifiedJohnsonCook
+    rng = np.random.default_rng(3)
+    m = 150
+    xe = np.array([[0, 0], [1, 0], [0.3, 0.9]])[None] * 1e-4 + rng.normal(0, 1e-5, (m, 3, 2))
+    due, pe = rng.normal(0, 2e-7, (m, 3, 2)), rng.normal(0, 3e8, (m, 3))
+    S = rng.normal(0, 6e8, (m, 2, 2)) * rng.random(m)[:, None, None]     # some inside the yield surface
+    jc = dict(A=553e6, B=601e6, n=0.234, C=0.0134, m=1.0, eps_dot_0=1.0, T_room=293.0, T_melt=1733.0, cp=486.0,
+              chi=0.9)
+    strength = {"johnson-cook": JohnsonCook(**jc), "elastic": Elastic(), "own return map": _OwnReturnMap(),
+                "modified": ModifiedJohnsonCook(**jc, hardening_saturation_strain=2.0)}[kind]
+    lw = solid.SolidLaw(rho0=7800.0, G=80e9, K=160e9, alpha_T=1.2e-5, T_ref=293.0, strength=strength)
+    hist = solid.History(S=0.5 * (S + np.swapaxes(S, 1, 2)), S_zz=rng.normal(0, 1e8, m), eps_p=rng.random(m) * 2.5,
+                         W_p=np.zeros(m), J=1 + rng.normal(0, 0.01, m), eps_dot=rng.random(m) * 1e5 if lagged else None)
+    Te, dt = 293 + rng.random(m) * 600, 1e-7
+    r_u, r_p, r = solid.element_residual(xe, due, pe, hist, Te, dt, lw)
+    K = solid._element_tangent(xe, due, pe, hist, Te, dt, lw, r, r_u, r_p)
+    eps = 1e-7 * np.sqrt(np.abs(r["area_n"]))
+    Kc = np.empty((m, 9, 6))
+    for k in range(6):
+        d = np.zeros_like(due)
+        d[:, k // 2, k % 2] = eps
+        (up, pp, _), (um, pm, _) = (solid.element_residual(xe, due + s * d, pe, hist, Te, dt, lw) for s in (1, -1))
+        Kc[:, :, k] = np.concatenate([(up - um).reshape(m, 6), pp - pm], axis=1) / (2 * eps[:, None])
+    err = np.abs(K[:, :, :6] - Kc).max(axis=(1, 2)) / np.abs(Kc).max(axis=(1, 2))
+    _, svm, sy, _, _ = solid._return_factor(hist, Te, dt, lw, r)
+    kink = np.abs(svm / np.where(sy > 0, sy, 1.0) - 1.0) < 1e-4 if hasattr(strength, "flow_stress") else svm < 0
+    err = err[~kink]                            # the differences straddle the yield surface there (one here)
+    assert np.sum(kink) <= 2
+    plastic = int(np.sum(r["d_eps_p"] > 0))
+    print(f"{kind}, rate {'lagged' if lagged else 'own'}: {plastic} of {m} plastic, largest error {err.max():.1e}")
+    assert err.max() < (1e-8 if kind != "own return map" else 1e-5)       # exact; forward differences
+    assert kind in ("elastic", "own return map") or m // 5 < plastic < m - m // 5
+    assert solid._exact_tangent_known(strength) == (kind != "own return map")

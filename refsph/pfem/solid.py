@@ -31,17 +31,21 @@ triangle e, with the mesh at t_n (x_n), the displacement increment du of the ste
 M_{n+1} is the consistent one of the current mesh. With fixed nodal masses a remeshing neither creates nor loses
 mass (the standard PFEM mass error is the change of the meshed area; here that change is a density change instead).
 
-**Tangent.** The Newton-Raphson matrix is the exact derivative of the discrete residual: the pressure columns are
-linear and written out; the displacement columns are the element residual's forward differences from the residual
-already computed at du (6 evaluations of all the elements at once, step 1e-8 of the element size, about the square
-root of the machine epsilon: truncation and round-off ~1e-8 relative), so the tangent includes the geometric
-stiffness, the return map and the strain-rate dependence without deriving them (stated as the issue allows).
-Newton then converges quadratically down to the tolerance (``tests/test_pfem.py`` prints the residual norms); a
-tangent wrong in its eighth digit only shows below it. Central differences (12 evaluations, step 1e-7: ~1e-10)
-gave the quick cut's first 40 steps the same forces to 2e-13 in 633 iterations against 626, at 1.13 times the
-time. The line search's accepted point is not evaluated again (its residual and element response are kept), and
-the tangent is computed only where a correction follows: a solve's converged point (one a step, often its last
-solve's only point) needs none.
+**Tangent.** The Newton-Raphson matrix is the exact derivative of the discrete residual. The pressure columns are
+linear and written out. The displacement columns are differentiated by hand (:func:`_element_tangent_exact`) for
+the laws whose return map is the von Mises radial return (Johnson-Cook, the modified Johnson-Cook, any
+:class:`refsph.plasticity.J2Plasticity` with its own flow stress) and for the elastic solid: the midpoint and end
+gradients moving with du, the Hughes-Winget rotation, the radial return's factor c_f = sigma_y / sigma_vm (with
+d sigma_y / d eps_dot where the rate is the step's own, by central differences in that scalar) and Eq. (13) through
+det f. It agrees with central differences of the element residual to 1e-9 (``tests/test_pfem.py``). For any other
+strength model the columns are the element residual's forward differences from the residual already computed at du
+(:func:`_element_tangent_fd`: 6 evaluations of all the elements at once, step 1e-8 of the element size; error
+~1e-8 relative). On the short cut's first 30 steps at t_u/10 the two give the same 362 Newton iterations and the
+same tool force to 1e-11; the exact one takes 22.8 s of CPU against 29.3 s (the tangent 10 % of the time against
+27 %; ``benchmarks/pfem_step_cost.py``). Newton converges quadratically down to the tolerance (``tests/test_pfem.py``
+prints the residual norms). The line search's accepted point is not evaluated again (its residual and element
+response are kept), and the tangent is computed only where a correction follows: a solve's converged point (one a
+step, often its last solve's only point) needs none.
 
 **Linear solve.** Each Newton correction solves K delta = -R with SuperLU (:func:`solve_linear`): a symmetric
 fill-reducing ordering (minimum degree on K^T + K) and the diagonal as pivots, since K's diagonal never vanishes
@@ -286,7 +290,9 @@ def element_response(xe: np.ndarray, due: np.ndarray, hist: History, Te: np.ndar
     J = hist.J * (1.0 + dJ)
     lnJ = np.log(hist.J) + np.log1p(dJ)                          # no cancellation at small strains
     return dict(S=S_new, S_zz=S_zz_new, d_eps_p=d_eps_p, d_w_p=d_w_p, J=J, eps_dot=eps_dot,
-                p_hat=volumetric_pressure(J, Te, law, lnJ), grad=g_end, area=A_end, area_n=A_n)
+                p_hat=volumetric_pressure(J, Te, law, lnJ), grad=g_end, area=A_end, area_n=A_n,
+                grad_half=g_half, grad_n=g_n, L=L, H=H, w=w, S_trial=S_trial, S_zz_trial=S_zz_trial, rate=rate,
+                lnJ=lnJ)
 
 
 def element_residual(xe, due, pe, hist, Te, dt, law) -> tuple[np.ndarray, np.ndarray, dict]:
@@ -307,6 +313,125 @@ def _element_dofs(tri: np.ndarray, n: int) -> np.ndarray:
 
 
 def _element_tangent(xe, due, pe, hist, Te, dt, law, r, r_u, r_p) -> np.ndarray:
+    """(M, 9, 9) d(r_u, r_p)/d(du, p) (module text, "Tangent"): exact (:func:`_element_tangent_exact`) for the laws
+    whose return map it knows (von Mises radial return, :class:`refsph.plasticity.J2Plasticity`, and the elastic
+    solid), forward differences (:func:`_element_tangent_fd`) for any other strength model."""
+    if _exact_tangent_known(law.strength):
+        return _element_tangent_exact(pe, hist, Te, dt, law, r)
+    return _element_tangent_fd(xe, due, pe, hist, Te, dt, law, r, r_u, r_p)
+
+
+def _exact_tangent_known(strength) -> bool:
+    """Whether :func:`_element_tangent_exact` knows the law's return map: the radial return of
+    :class:`J2Plasticity` with its ``flow_stress`` (not a subclass's own return map), or the elastic solid."""
+    from ..plasticity import J2Plasticity
+    from ..strength import Elastic
+    return (type(strength).return_map is J2Plasticity.return_map) or type(strength).return_map is Elastic.return_map
+
+
+def _return_factor(hist, Te, dt, law, r):
+    """The radial return at the trial stress of ``r``: (c_f, sigma_vm trial, sigma_y, d sigma_y / d eps_dot where
+    the rate is the step's own (zeros where it is lagged, :class:`History`), plastic mask); c_f = 1 for the
+    elastic solid."""
+    S_tr, Szz_tr = r["S_trial"], r["S_zz_trial"]
+    svm = np.sqrt(1.5 * (np.einsum("mij,mij->m", S_tr, S_tr) + Szz_tr * Szz_tr))
+    zero = np.zeros_like(svm)
+    if not hasattr(law.strength, "flow_stress"):                    # the elastic solid
+        return np.ones_like(svm), svm, zero, zero, np.zeros(len(svm), dtype=bool)
+    rate = r["rate"]
+    sy = law.strength.flow_stress(hist.eps_p, rate, Te)
+    dsy = zero
+    if hist.eps_dot is None:                                      # sigma_y(eps_dot(du)): central differences in the
+        h = 1e-6 * np.maximum(rate, 1e-300)                       # scalar rate (the law is smooth but for its kink)
+        dsy = (law.strength.flow_stress(hist.eps_p, rate + h, Te)
+               - law.strength.flow_stress(hist.eps_p, np.maximum(rate - h, 0.0), Te)) / (rate + h - np.maximum(
+                   rate - h, 0.0))
+    plastic = svm > sy
+    cf = np.where(plastic, sy / np.where(svm > 0, svm, 1.0), 1.0)
+    return cf, svm, sy, dsy, plastic
+
+
+def _element_tangent_exact(pe, hist, Te, dt, law, r) -> np.ndarray:
+    """(M, 9, 9) d(r_u, r_p)/d(du, p), differentiated by hand (module text). For a column du_b,i (node b,
+    direction i) and G_b,i = e_i (x) grad N_b on a configuration:
+
+        dL = (I - L/2) (e_i (x) grad_{n+1/2} N_b)                 (the midpoint gradient moves with du/2)
+        d grad_{n+1} N_a = -(grad_{n+1} N_a)_i grad_{n+1} N_b,   dA_{n+1} = A_{n+1} (grad_{n+1} N_b)_i
+        dQ from dw (Q's entries c, s of w: dc/dw = -w q^2, ds/dw = q^2 (1 - w^2/4), q = 1 / (1 + w^2/4))
+        ds* = dQ s_n Q^T + Q s_n dQ^T + 2 G dev(dd),  dc_f = d sigma_y / sigma_vm - sigma_y d sigma_vm / sigma_vm^2
+        d(det f) = (cofactor of f = I + H) : (e_i (x) grad_n N_b),  d p_hat / dJ = K (1 - ln J) / J^2
+                   - 3 K alpha (ln J - 2) / J^2 (T - T0)
+
+    and the pressure columns as in the forward-difference tangent. Checked against central differences in
+    ``tests/test_pfem.py``."""
+    m, G = len(pe), law.G
+    T = _components_first                                           # arrays (..., M): each operation one long loop
+    A, g, gh, gn = r["area"], T(r["grad"]), T(r["grad_half"]), T(r["grad_n"])
+    L, H, w, S_tr, Szz_tr = T(r["L"]), T(r["H"]), r["w"], T(r["S_trial"]), r["S_zz_trial"]
+    cf, svm, sy, dsy, plastic = _return_factor(hist, Te, dt, law, r)
+    eye = np.eye(2)[:, :, None]
+    sigma = T(r["S"]) + pe.mean(axis=1) * eye
+    q = 1.0 / (1.0 + 0.25 * w * w)
+    dc, ds = -w * q * q, q * q * (1.0 - 0.25 * w * w)
+    c, s = (1.0 - 0.25 * w * w) * q, w * q
+    a0, b0, d0 = hist.S[:, 0, 0], hist.S[:, 0, 1], hist.S[:, 1, 1]
+    dR = np.empty((2, 2, m))                                       # d(Q s_n Q^T)/dw (the entries of _rotated)
+    dR[0, 0] = (2 * c * a0 + 2 * s * b0) * dc + (2 * c * b0 + 2 * s * d0) * ds
+    dR[1, 1] = (-2 * s * b0 + 2 * c * d0) * dc + (2 * s * a0 - 2 * c * b0) * ds
+    dR[0, 1] = dR[1, 0] = (2 * c * b0 + s * (d0 - a0)) * dc + (-2 * s * b0 + c * (d0 - a0)) * ds
+    lnJ = r["lnJ"]
+    dphat = (law.K * (1.0 - lnJ) - 3.0 * law.K * law.alpha_T * (lnJ - 2.0) * (Te - law.T_ref)) / r["J"] ** 2
+    gsig = g[:, None, 0] * sigma[None, :, 0] + g[:, None, 1] * sigma[None, :, 1]   # [a, i'] grad N_a . sigma_i'
+    unit = np.ones(1)                                               # M_e / A and S_e / A (:mod:`.element`)
+    pm_pe = (pressure_mass(unit)[0] / law.K + ppp_stabilisation(unit)[0] / G) @ pe.T   # the r_p terms, per A
+    # every column (b, i) at once: arrays [b, i, ..., M]
+    I_L = eye - 0.5 * L
+    dL = np.swapaxes(I_L, 0, 1)[None, :, :, None] * gh[:, None, None, :]          # [b, i, j, l]
+    dd = 0.5 * (dL + np.swapaxes(dL, 2, 3))
+    dtr = dd[:, :, 0, 0] + dd[:, :, 1, 1]
+    dw = 0.5 * (dL[:, :, 0, 1] - dL[:, :, 1, 0])
+    dS_tr = dR * dw[:, :, None, None] + 2.0 * G * (dd - dtr[:, :, None, None] / 3.0 * eye)
+    inv_svm = 1.0 / np.where(svm > 0, svm, 1.0)
+    dsvm = 1.5 * (np.einsum("jlm,bijlm->bim", S_tr, dS_tr) - Szz_tr * 2.0 * G * dtr / 3.0) * inv_svm
+    dsy_k = dsy * _rate_derivative(L, r["eps_dot"], dd, dtr, dt) if hist.eps_dot is None else 0.0
+    dcf = np.where(plastic, (dsy_k - sy * dsvm * inv_svm) * inv_svm, 0.0)
+    dS = cf * dS_tr + dcf[:, :, None, None] * S_tr
+    dr_u = g[:, None, 0] * dS[:, :, None, :, 0]     # [b, i, a, i']: A (grad N_a . dS_i' + dA / A grad N_a . sigma_i'
+    dr_u += g[:, None, 1] * dS[:, :, None, :, 1]    # + dgrad N_a . sigma_i')
+    dr_u -= np.swapaxes(g, 0, 1)[None, :, :, None] * gsig[:, None, None]
+    dr_u += g[:, :, None, None] * gsig
+    dr_u *= A
+    dA = A * g                                                      # [b, i]
+    cof = np.array([[1.0 + H[1, 1], -H[1, 0]], [-H[0, 1], 1.0 + H[0, 0]]])
+    dJ = hist.J * (cof[None, :, 0] * gn[:, None, 0] + cof[None, :, 1] * gn[:, None, 1])
+    dr_p = dA[:, :, None] * pm_pe - ((dA * r["p_hat"] + A * dphat * dJ) / (3.0 * law.K))[:, :, None]
+    K = np.empty((9, 9, m))
+    K[:6, :6] = np.swapaxes(dr_u.reshape(6, 6, m), 0, 1)
+    K[6:, :6] = np.swapaxes(dr_p.reshape(6, 3, m), 0, 1)
+    K[:6, 6:] = (A * g / 3.0).reshape(6, 1, m)
+    K = np.ascontiguousarray(np.moveaxis(K, 2, 0))
+    K[:, 6:, 6:] = pressure_mass(A) / law.K + ppp_stabilisation(A) / law.G
+    return K
+
+
+def _components_first(a: np.ndarray) -> np.ndarray:
+    """(M, ...) -> (..., M), contiguous."""
+    return np.ascontiguousarray(np.moveaxis(a, 0, -1))
+
+
+def _rate_derivative(L, eps_dot, dd, dtr, dt):
+    """d eps_dot [b, i, M] for the strain-rate changes dd [b, i, j, l, M] of the columns (eps_dot = sqrt(2/3
+    (dev d : dev d + dev_zz^2)) / dt); L [j, l, M]."""
+    d = 0.5 * (L + np.swapaxes(L, 0, 1))
+    tr = d[0, 0] + d[1, 1]
+    eye = np.eye(2)[:, :, None]
+    dev, dev_zz = d - tr / 3.0 * eye, -tr / 3.0
+    ddev, ddev_zz = dd - dtr[:, :, None, None] / 3.0 * eye, -dtr / 3.0
+    num = 2.0 / 3.0 * (np.einsum("jlm,bijlm->bim", dev, ddev) + dev_zz * ddev_zz) / (dt * dt)
+    return np.where(eps_dot > 0, num / np.where(eps_dot > 0, eps_dot, 1.0), 0.0)
+
+
+def _element_tangent_fd(xe, due, pe, hist, Te, dt, law, r, r_u, r_p) -> np.ndarray:
     """(M, 9, 9) d(r_u, r_p)/d(du, p): forward differences in du from the residual (r_u, r_p) at du (module text),
     the pressure columns exactly."""
     m = len(xe)

@@ -415,9 +415,18 @@ def test_free_matrix_is_the_masked_tangent():
     fix = rng.random(3 * n) < 0.3
     keep = sp.diags((~fix).astype(float))
     expected = (keep @ parts.sparse() @ keep + sp.diags(fix.astype(float))).toarray()
-    got = solid.FreeMatrix(dofs, n, fix)(parts)
+    free = solid.FreeMatrix(dofs, n, fix)
+    got = free(parts)
     assert got.format == "csc"
     np.testing.assert_allclose(got.toarray(), expected, rtol=1e-14, atol=1e-14)
+    inv = rng.permutation(3 * n)                    # given permuted (the factor's order), the same matrix relabelled
+    free.permute(inv)
+    perm = free(parts)
+    assert perm.has_sorted_indices
+    np.testing.assert_array_equal(perm.toarray(), got[inv][:, inv].toarray())
+    b = rng.standard_normal(3 * n)
+    ordering = dict(inverse=inv, permuted=True)     # solve_linear takes it so, and answers in the original order
+    np.testing.assert_allclose(solid.solve_linear(perm, b, ordering), np.linalg.solve(expected, b), rtol=1e-9)
 
 
 def test_cut_takes_the_damped_newmark_rule_as_an_option():

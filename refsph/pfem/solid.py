@@ -55,7 +55,12 @@ unknowns: 0.057 against 0.113 s on one core); the result is checked (relative re
 default way where the check fails. The matrix is summed into a sparsity pattern found once per mesh
 (:class:`FreeMatrix`: the held dofs' rows and columns already the identity), not built, masked and converted at
 every iteration. With the forward-difference tangent: the quick cut's first 40 steps take 20-23 s of CPU against
-38 s before both changes (timed back to back on a loaded machine), the forces the same to 1e-12.
+38 s before both changes (timed back to back on a loaded machine), the forces the same to 1e-12. The first
+factorisation on a pattern keeps its minimum-degree ordering, and the pattern is then relabelled into that order
+once (:meth:`FreeMatrix.permute`), so later factorisations get the matrix already permuted instead of slicing it
+(the short cut's first 30 steps at t_u/10 under cProfile: 22.8 against 24.8 s in :func:`solve_linear`, the same
+bits). Modified Newton was tried and left: the factors reused for one or two corrections after each new one took
+829 instead of 362 iterations and 36 against 24 s.
 Tried on a Newton matrix of the t_u/10 short cut (8538 unknowns, 171,200 entries; one core) and left: the other
 orderings SuperLU offers (COLAMD 41 ms, minimum degree on K^T K 39 ms, against 28 ms, and a third to a half more
 fill), a nested dissection by breadth-first level sets (27-44 ms with the factor's 1.2-1.7 million entries against
@@ -491,10 +496,32 @@ class FreeMatrix:
         rows, cols, _ = TangentParts(np.zeros((len(dofs), 9, 9)), dofs, n).entries()
         self.valid = ~(fix[rows] | fix[cols])
         self.valid[-3 * n:] = True                                # the diagonal entries come last
-        uniq, self.where = np.unique(cols[self.valid] * (3 * n) + rows[self.valid], return_inverse=True)
+        self._uniq, self.where = np.unique(cols[self.valid] * (3 * n) + rows[self.valid], return_inverse=True)
+        self._where0, uniq = self.where, self._uniq
         self.indices, self.n3 = uniq % (3 * n), 3 * n
         self.indptr = np.concatenate([[0], np.cumsum(np.bincount(uniq // (3 * n), minlength=3 * n))])
         self.fix_diag = np.flatnonzero(fix)
+
+    def permute(self, inverse: np.ndarray) -> None:
+        """From now on give the matrix permuted, A[inverse][:, inverse] (:func:`solve_linear`'s stored ordering):
+        its pattern relabelled once, instead of the matrix sliced at every factorisation."""
+        pos = np.argsort(inverse)                                  # entry (r, c) goes to (pos[r], pos[c])
+        n3 = self.n3
+        rows, cols = pos[self._uniq % n3], pos[self._uniq // n3]
+        order = np.argsort(cols * n3 + rows)
+        new_pos = np.empty_like(order)
+        new_pos[order] = np.arange(len(order))
+        self.where = new_pos[self._where0]
+        self.indices = rows[order]
+        self.indptr = np.concatenate([[0], np.cumsum(np.bincount(cols, minlength=n3))])
+
+    def solve(self, parts: TangentParts, b: np.ndarray, ordering: dict) -> np.ndarray:
+        """:func:`solve_linear` on this matrix with the ordering dict of its pattern; once that holds an ordering,
+        the pattern is relabelled into it (:meth:`permute`) and the matrix given permuted."""
+        if "inverse" in ordering and not ordering.get("permuted"):
+            self.permute(ordering["inverse"])
+            ordering["permuted"] = True
+        return solve_linear(self(parts), b, ordering)
 
     def __call__(self, parts: TangentParts):
         vals = parts.values()
@@ -622,7 +649,7 @@ def newton_step(nodes: Nodes, mesh: Mesh, hist: History, law: SolidLaw, dt: floa
             break
         Kg = evaluate(du, p, True, resp)[1]                       # the tangent at this point (its residual known)
         rhs = -R_free - (np.where(fix, 0.0, Kg.sparse() @ lift) if np.any(lift) else 0.0)
-        step = solve_linear(free(Kg), rhs, ordering) + lift
+        step = free.solve(Kg, rhs, ordering) + lift
         if not np.all(np.isfinite(step)):
             break
         s = 1.0 if max_move is None else min(1.0, max_move / max(float(np.max(
@@ -657,25 +684,33 @@ def solve_linear(A, b: np.ndarray, ordering: dict | None = None) -> np.ndarray:
     """x with A x = b (module text, "Linear solve"): SuperLU with the minimum-degree ordering of A^T + A and
     diagonal pivots; where that fails or leaves a relative residual above 1e-8, scipy's spsolve (partial
     pivoting). ``ordering``: a dict kept between solves on one sparsity pattern; the first solve stores its
-    ordering there, and later ones permute A by it and factor in that order (the same factors, without computing
-    the ordering again)."""
+    ordering there ("inverse"), and later ones permute A by it and factor in that order (the same factors, without
+    computing the ordering again); with "permuted" True there, A is given already permuted (A[inv][:, inv], as
+    :meth:`FreeMatrix.permute` makes it) and x is still returned in the original order."""
     A = sp.csc_matrix(A)
     opts = dict(diag_pivot_thresh=0.0, options=dict(SymmetricMode=True))
+    inv = None if ordering is None else ordering.get("inverse")
+    given = inv is not None and ordering.get("permuted", False)
+    M, rhs = (A, b) if inv is None else (A if given else A[inv][:, inv].tocsc(), b[inv])
     try:
-        if ordering is not None and "inverse" in ordering:
-            inv = ordering["inverse"]
-            x = np.empty_like(b)
-            x[inv] = splu(A[inv][:, inv].tocsc(), permc_spec="NATURAL", **opts).solve(b[inv])
-        else:
-            lu = splu(A, permc_spec="MMD_AT_PLUS_A", **opts)
-            x = lu.solve(b)
-            if ordering is not None:
-                ordering["inverse"] = np.argsort(lu.perm_c)
-        if np.all(np.isfinite(x)) and np.linalg.norm(A @ x - b) <= 1e-8 * np.linalg.norm(b):
-            return x
+        lu = splu(M, permc_spec="MMD_AT_PLUS_A" if inv is None else "NATURAL", **opts)
+        y = lu.solve(rhs)
+        if ordering is not None and inv is None:
+            ordering["inverse"] = np.argsort(lu.perm_c)
+        if np.all(np.isfinite(y)) and np.linalg.norm(M @ y - rhs) <= 1e-8 * np.linalg.norm(rhs):
+            return _unpermuted(y, inv)
     except RuntimeError:                                           # an exactly zero pivot
         pass
-    return spsolve(A, b)
+    return _unpermuted(spsolve(M, rhs), inv)
+
+
+def _unpermuted(y: np.ndarray, inv: np.ndarray | None) -> np.ndarray:
+    """x with x[inv] = y (y itself where inv is None)."""
+    if inv is None:
+        return y
+    x = np.empty_like(y)
+    x[inv] = y
+    return x
 
 
 def _residual(nodes, mesh, hist, law, du, p, dt, dynamic, f_ext, contact, tangent=True, known=None):

@@ -2,6 +2,8 @@
 locking and no pressure checkerboard on a bent cantilever, Newton-Raphson's quadratic convergence, plane-strain
 J2 compression against the rigid-plastic curve, the cantilever's period, and a remeshing that conserves mass and
 momentum exactly."""
+from unittest import mock
+
 import numpy as np
 import pytest
 import scipy.sparse as sp
@@ -482,6 +484,14 @@ def test_newton_step_with_settle_returns_after_that_many_corrections():
     rest = solid.newton_step(nodes, mesh, hist, lw, 1e-3, loads, dynamic=False, du0=part.du, p0=part.p,
                              predictor=False)
     assert rest.converged and np.allclose(rest.du, whole.du, rtol=0, atol=1e-12 * 2e-5)
+    calls = []                                # given the settled point's evaluation, it is not computed again
+    real = solid._residual
+    with mock.patch.object(solid, "_residual", lambda *a, **k: calls.append((a[4], a[10])) or real(*a, **k)):
+        again = solid.newton_step(nodes, mesh, hist, lw, 1e-3, loads, dynamic=False, du0=part.du, p0=part.p,
+                                  predictor=False, start=part.evaluation)
+    assert not any(np.array_equal(du, part.du) and not tangent for du, tangent in calls)   # only its tangent there
+    np.testing.assert_array_equal(again.du, rest.du)
+    np.testing.assert_array_equal(again.p, rest.p)
 
 
 def test_settle_below_two_is_refused():

@@ -180,11 +180,12 @@ def solve_with_active_set(nodes, mesh, hist, law, dt, loads, max_outer: int = 8,
     c.freeze(nodes.x)
     total, pattern, sticks, changes, since = 0, {}, 0, 0, 0              # the solves share the mesh's pattern
     du, p = start = (du0, None)                                          # start: where the sets' solve began
+    ev = None                                                 # the residual at (du, p) where the sets did not change
     while changes < 2 * max_outer:
         try:
             r = newton_step(nodes, mesh, hist, law, dt, loads, dynamic=dynamic, predictor=False,
                             max_iter=max_iter - since, max_move=max_move, du0=du, p0=p, pattern=pattern,
-                            settle=settle)
+                            settle=settle, start=ev)
             since += r.iterations
             if not r.converged and since >= max_iter:
                 raise NewtonFailed(f"Newton-Raphson did not converge in {max_iter} iterations with the contact's "
@@ -192,12 +193,12 @@ def solve_with_active_set(nodes, mesh, hist, law, dt, loads, max_outer: int = 8,
         except NewtonFailed as e:                                 # a frozen slip that turned: it sticks, and the
             if sticks >= 3 or len(e.args) < 3 or not c.stick_reversed(nodes.x + e.args[2][0]):   # solve starts
                 raise                                                                             # again
-            total, sticks, changes, since = total + len(e.args[1]), sticks + 1, changes + 1, 0
+            total, sticks, changes, since, ev = total + len(e.args[1]), sticks + 1, changes + 1, 0, None
             du, p = start
             continue
-        du, p, total = r.du, r.p, total + r.iterations
+        du, p, total, ev = r.du, r.p, total + r.iterations, r.evaluation
         if c.freeze(nodes.x + r.du, grow=changes >= max_outer - 1):
-            changes, since, start = changes + 1, 0, (du, p)
+            changes, since, start, ev = changes + 1, 0, (du, p), None
         elif r.converged:
             c.active = c.slip = None
             last = newton_step(nodes, mesh, hist, law, dt, loads, dynamic=dynamic, predictor=False,

@@ -193,7 +193,8 @@ class Loads:
 @dataclass
 class StepResult:
     """A step's solution: du (N, 2), p (N,), the triangles' new history and heat, the Newton record; ``converged``
-    False where :func:`newton_step` came back early (``settle``) at a point short of the tolerance."""
+    False where :func:`newton_step` came back early (``settle``) at a point short of the tolerance; ``evaluation``
+    the residual's evaluation there (:func:`newton_step`'s ``start`` for a solve that goes on from it)."""
 
     du: np.ndarray
     p: np.ndarray
@@ -205,6 +206,7 @@ class StepResult:
     contact_force: np.ndarray | None = None
     solves_iterations: int | None = None
     converged: bool = True
+    evaluation: tuple | None = None
 
     @property
     def iterations(self) -> int:
@@ -593,21 +595,21 @@ def _shared_pattern(pattern: dict | None, mesh: Mesh, n: int, fix: np.ndarray):
 def newton_step(nodes: Nodes, mesh: Mesh, hist: History, law: SolidLaw, dt: float, loads: Loads,
                 dynamic: bool = True, tol: float = 1e-10, max_iter: int = 25, predictor: bool = True,
                 max_move: float | None = None, du0: np.ndarray | None = None, p0: np.ndarray | None = None,
-                pattern: dict | None = None, settle: int | None = None) -> StepResult:
+                pattern: dict | None = None, settle: int | None = None, start: tuple | None = None) -> StepResult:
     """Solve Eqs. (19)-(20) for the step's du and p by Newton-Raphson. Converged when the residual of the free
     displacement rows and that of the pressure rows are below ``tol`` times their scales (:func:`assemble`), or
     below 100 tol and no longer falling (the round-off floor of a large system: the sums of many forces).
     Nodes without a triangle keep p = 0 (and, quasi-static, du = 0). ``max_move``: no Newton correction moves a
     node by more than this fraction of its local size sqrt(mean area of its triangles) (the whole correction scaled
-    down, before the line search; None: no limit). Where elements flow plastically the tangent is soft, and a node
-    on the tool (sliding, or frictionless) can get a correction of ten spacings from a residual that a few tenths
-    of one remove; the line search alone then crawls (chapter 12). ``du0``: the first guess of du where the
-    predictor is off (default zeros); ``p0``: that of p (default p at t_n). ``pattern``: a dict kept between the
-    solves of one mesh and one set of held dofs (the Newton matrix's sparsity pattern and ordering,
-    :class:`FreeMatrix`, :func:`solve_linear`; found again where they differ). ``settle``: return after this many
+    down, before the line search; None: no limit; where elements flow the tangent is soft and a node on the tool can
+    get a correction of ten spacings, on which the line search alone crawls: chapter 12). ``du0``: the first guess
+    of du where the predictor is off (default zeros); ``p0``: that of p (default p at t_n). ``pattern``: a dict
+    kept between the solves of one mesh and one set of held dofs (the Newton matrix's sparsity pattern and ordering,
+    :class:`FreeMatrix`; found again where they differ). ``settle``: return after this many
     corrections, at a finite residual with no prescribed correction pending, even if not converged (``converged``
-    False; :func:`refsph.pfem.contact.solve_with_active_set` looks at its sets there; None: to the tolerance). Raises
-    :class:`NewtonFailed`."""
+    False; :func:`refsph.pfem.contact.solve_with_active_set` looks at its sets there; None: to the tolerance).
+    ``start``: the residual's evaluation at (du0, p0) under these loads (a settled result's ``evaluation``), not
+    computed again. Raises :class:`NewtonFailed`."""
     n = nodes.n
     size = None if max_move is None else _node_sizes(nodes, mesh)
     fixed = np.asarray(loads.fixed, dtype=bool).copy()
@@ -633,7 +635,7 @@ def newton_step(nodes: Nodes, mesh: Mesh, hist: History, law: SolidLaw, dt: floa
         return R_free, (float(np.linalg.norm(R_free[:2 * n])) / scale[0], float(np.linalg.norm(R_free[2 * n:]))
                         / scale[1])
 
-    R, Kg, resp, scale, fc = evaluate(du, p, False)                  # the matrix only where a correction is needed
+    R, Kg, resp, scale, fc = ev = start or evaluate(du, p, False)    # the matrix only where a correction is needed
     for _ in range(max_iter + 1):
         lift = np.zeros(3 * n)
         lift[:2 * n] = target - du.ravel()                        # the prescribed part of the correction
@@ -644,7 +646,7 @@ def newton_step(nodes: Nodes, mesh: Mesh, hist: History, law: SolidLaw, dt: floa
                  and max(res_u, res_p) > 0.5 * max(history[-2]))      # stagnating at round-off, just above tol
         done = ((res_u < tol and res_p < tol) or floor) and not np.any(lift)
         if done or (settle is not None and len(history) > settle and not np.any(lift) and np.all(np.isfinite(R))):
-            return _step_result(du, p, hist, resp, history, fc, bool(done))
+            return _step_result(du, p, hist, history, ev, bool(done))
         if not np.all(np.isfinite(R)):
             break
         Kg = evaluate(du, p, True, resp)[1]                       # the tangent at this point (its residual known)
@@ -666,18 +668,20 @@ def newton_step(nodes: Nodes, mesh: Mesh, hist: History, law: SolidLaw, dt: floa
         else:
             trial = None                                          # no trial taken: the point is new
         du, p = du + s * step[:2 * n].reshape(n, 2), p + s * step[2 * n:]
-        R, Kg, resp, scale, fc = trial if trial is not None else evaluate(du, p, False)   # the accepted trial
+        R, Kg, resp, scale, fc = ev = trial if trial is not None else evaluate(du, p, False)   # the accepted trial
     raise NewtonFailed(f"Newton-Raphson did not converge in {max_iter} iterations (residuals {history[-3:]})",
                        history, (du, p))
 
 
-def _step_result(du, p, hist, resp, history, fc, converged) -> StepResult:
-    """newton_step's result at (du, p): the element response ``resp`` there as the triangles' new history."""
+def _step_result(du, p, hist, history, ev, converged) -> StepResult:
+    """newton_step's result at (du, p): the element response there (of the evaluation ``ev``, :func:`_residual`'s
+    tuple) as the triangles' new history."""
+    resp, fc = ev[2], ev[4]
     return StepResult(du=du, p=p, history=History(resp["S"], resp["S_zz"], hist.eps_p + resp["d_eps_p"],
                                                    hist.W_p + resp["d_w_p"], resp["J"],
                                                    None if hist.eps_dot is None else resp["eps_dot"]),
                       d_eps_p=resp["d_eps_p"], d_w_p=resp["d_w_p"], area=resp["area"], residuals=history,
-                      contact_force=fc, converged=converged)
+                      contact_force=fc, converged=converged, evaluation=ev)
 
 
 def solve_linear(A, b: np.ndarray, ordering: dict | None = None) -> np.ndarray:

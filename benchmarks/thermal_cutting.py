@@ -221,6 +221,8 @@ def run_case(key: str, options: dict, numerics: dict, quick: bool = False) -> di
                metrics={k: m[k] for k in KEEP if k in m},
                histories={k: _thin(m[k]) for k in ("cutting_force_history", "passive_force_history",
                                                      "temperature_history") if k in m})
+    prov = s.get("provenance") or {}                                 # the code that ran it (a restart: each part's)
+    rec["commits"] = [c for c in prov.get("earlier_commits", []) + [prov.get("git_commit")] if c]
     if s.get("heat_dissipation"):                                    # the ledger's dissipation split (newer runs)
         rec["heat_dissipation"] = s["heat_dissipation"]
     rec["script_wall_s"] = time.perf_counter() - t0

@@ -38,7 +38,7 @@ from .io import claim_run_folder, read_npz, save_reactions, write_json, write_sn
 from .material import von_mises
 from .pfem.cutting import CutRun, pfem_cut
 from .scenes.base import parse_bool
-from .simulate import SimulationError, provenance
+from .simulate import SimulationError, earlier_commits, provenance
 
 __all__ = ["run_pfem", "restart_pfem", "is_pfem_run", "pfem_options", "PFEM_SCENES", "QUICK", "N_SNAPSHOTS",
            "PFEMRunResult"]
@@ -152,10 +152,11 @@ def run_pfem(scene_name: str = "thermal_cutting", *, out=None, options: dict | N
         _checkpoint(snaps_dir, run, snapshots, next_snap)
     times = np.linspace(0.0, cut.t_end, N_SNAPSHOTS + 1)
     args = dict(scene_name=scene_name, method="pfem", options=dict(options or {}), quick=bool(quick))
+    prov = _provenance(out, restart)                        # the code this call runs, taken once at its start
 
     def running_summary():                                  # at each checkpoint: a killed run can be continued
         write_json(out / "summary.json", _summary(scene_name, run, run.result(), kwargs, args, snapshots, "running",
-                                                  None))
+                                                  None, prov))
     if not restart:
         running_summary()
     status, error, t_start, steps0 = "ok", None, time.perf_counter(), run.steps
@@ -188,16 +189,25 @@ def run_pfem(scene_name: str = "thermal_cutting", *, out=None, options: dict | N
     if len(reaction["t"]):
         save_reactions(out / "reaction_forces.csv", dict(t=reaction["t"], dt=reaction["dt"],
                                                          tool=reaction["tool"].reshape(-1, 2)), 2)
-    summary = _summary(scene_name, run, res, kwargs, args, snapshots, status, error)
+    summary = _summary(scene_name, run, res, kwargs, args, snapshots, status, error, prov)
     write_json(out / "summary.json", summary)
     if status != "ok":
         raise SimulationError(f"PFEM {scene_name}: {error}; the last state is in {snaps_dir / 'last_good.npz'}")
     return PFEMRunResult(summary, res)
 
 
+def _provenance(out: Path, restart: bool) -> dict:
+    """:func:`refsph.simulate.provenance` at the start of this call; a restarted run's also names the commits its
+    earlier parts ran (:func:`refsph.simulate.earlier_commits`), since a run may be continued at another commit."""
+    prov = provenance(1)
+    if restart:
+        prov["earlier_commits"] = earlier_commits(out)
+    return prov
+
+
 def _summary(scene_name: str, run: CutRun, res: dict, kwargs: dict, args: dict, snapshots: list, status: str,
-             error: str | None) -> dict:
-    """summary.json's content (module text)."""
+             error: str | None, prov: dict) -> dict:
+    """summary.json's content (module text); ``prov`` the run's provenance (:func:`_provenance`)."""
     cut = run.cut
     it = np.asarray(run.iterations)
     summary = dict(scene=scene_name, method="pfem", dim=2, dp=cut.info["dx"], h=None, n_particles=run.nodes.n,
@@ -210,7 +220,7 @@ def _summary(scene_name: str, run: CutRun, res: dict, kwargs: dict, args: dict, 
                                max_outer=cut.max_outer, nodes_inserted=run.inserted, nodes_removed=run.removed),
                    options=kwargs, run_args=args, wall_time_s=run.wall, snapshots=snapshots,
                    particle_steps_per_s=run.nodes.n * run.steps / run.wall if run.wall > 0 else 0.0,
-                   reaction_forces_file="reaction_forces.csv", provenance=provenance(1))
+                   reaction_forces_file="reaction_forces.csv", provenance=prov)
     if error:
         summary["error"] = error
     return summary

@@ -56,7 +56,7 @@ from .state import State
 from .tlsph import TLSPHParams
 
 __all__ = ["SimulationError", "RunResult", "RunRecord", "make_solver", "step_physics", "run", "check_run", "simulate",
-           "snapshot_times", "step_or_fail", "provenance", "restart_run", "METHODS"]
+           "snapshot_times", "step_or_fail", "provenance", "earlier_commits", "restart_run", "METHODS"]
 
 METHODS = ("esph", "tlsph")
 CHECKPOINT = "restart.npz"          # snapshots/restart.npz: how to continue from the last snapshot (see simulate)
@@ -189,6 +189,16 @@ def provenance(threads: int) -> dict:
                 scipy=scipy.__version__, platform=platform.platform(), threads=threads, command=list(sys.argv))
 
 
+def earlier_commits(out) -> list:
+    """The git commits a run folder's earlier parts ran (its summary.json's provenance: ``git_commit`` and, for a run
+    continued before, ``earlier_commits``), for a restart that may run another commit; [] where there is none."""
+    try:
+        old = json.loads((Path(out) / "summary.json").read_text()).get("provenance") or {}
+    except (OSError, ValueError, AttributeError):
+        return []
+    return [c for c in list(old.get("earlier_commits", [])) + [old.get("git_commit")] if c]
+
+
 def _as_dict(obj) -> dict:
     """A strength model, wall, body ... as {'model': its class, its fields}."""
     fields = dataclasses.asdict(obj) if dataclasses.is_dataclass(obj) else {}
@@ -223,6 +233,7 @@ class RunRecord:
         self.n_steps, self.dts, self.record_every = 0, [], 1
         self.t0, self.c0 = time.perf_counter(), time.process_time()
         self.lost = False                                   # the run folder vanished during the run
+        earlier = earlier_commits(self.out) if resume is not None and self.out is not None else []
         if resume is not None:
             self._resume(resume)
         if self.out is not None:
@@ -230,6 +241,7 @@ class RunRecord:
         self.summary = self._initial_summary(setup, parts.solver, dt, name)
         if resume is not None:
             self.summary["restarts"] = int(resume["run"]["restarts"]) + 1
+            self.summary["provenance"]["earlier_commits"] = earlier
 
     def _resume(self, ck: dict) -> None:
         """Continue the record of an interrupted run from its checkpoint."""

@@ -72,6 +72,20 @@ def test_restart_gives_the_uninterrupted_numbers(short_run, tmp_path):
         np.testing.assert_array_equal(za[k], zb[k])
 
 
+def test_provenance_is_the_code_that_ran(tmp_path, monkeypatch):
+    """summary.json's provenance is taken when a run starts, not when the summary is written (a long run outlives
+    its commit); a run continued at another commit names the earlier one."""
+    import refsph.pfem_run as pr
+    out = tmp_path / "run"
+    commits = iter(["aaaa", "bbbb", "cccc", "dddd"])
+    monkeypatch.setattr(pr, "provenance", lambda threads: dict(git_commit=next(commits), threads=threads))
+    run_pfem("thermal_cutting", out=out, options=SHORT, quick=True, progress=False, max_steps=2)
+    assert json.loads((out / "summary.json").read_text())["provenance"]["git_commit"] == "aaaa"
+    restart_pfem(out, progress=False)
+    prov = json.loads((out / "summary.json").read_text())["provenance"]
+    assert prov["git_commit"] == "bbbb" and prov["earlier_commits"] == ["aaaa"]
+
+
 def test_export_gives_paraview_the_triangles(short_run):
     meshio = pytest.importorskip("meshio")
     from refsph.crosscheck.export import export_vtk

@@ -99,6 +99,17 @@ def test_restart_falls_back_to_the_checkpoint_before_a_spoilt_one(tmp_path, monk
     assert again["n_steps"] == whole.summary["n_steps"] and again["snapshots"] == whole.summary["snapshots"]
 
 
+def test_a_restart_names_the_commit_of_the_part_before(tmp_path, monkeypatch):
+    """A run continued at another commit keeps that of its first part in provenance.earlier_commits."""
+    commits = iter(["first", "second"])
+    monkeypatch.setattr(sim, "provenance", lambda threads: dict(git_commit=next(commits), threads=threads))
+    _killed(monkeypatch, "pressing", "tlsph", tmp_path / "cut", KW)
+    assert json.loads((tmp_path / "cut" / "summary.json").read_text())["provenance"]["git_commit"] == "first"
+    run("pressing", "tlsph", out=tmp_path / "cut", progress=False, restart=True, **KW)
+    prov = json.loads((tmp_path / "cut" / "summary.json").read_text())["provenance"]
+    assert prov["git_commit"] == "second" and prov["earlier_commits"] == ["first"]
+
+
 def test_restart_refuses_a_hand_edited_summary(tmp_path, capsys):
     run("bar", "tlsph", out=tmp_path / "r", progress=False, quick=True, t_end=0.2e-6)
     path = tmp_path / "r" / "summary.json"

@@ -222,7 +222,8 @@ def run_case(key: str, options: dict, numerics: dict, quick: bool = False) -> di
                histories={k: _thin(m[k]) for k in ("cutting_force_history", "passive_force_history",
                                                      "temperature_history") if k in m})
     prov = s.get("provenance") or {}                                 # the code that ran it (a restart: each part's)
-    rec["commits"] = [c for c in prov.get("earlier_commits", []) + [prov.get("git_commit")] if c]
+    commits = [c for c in prov.get("earlier_commits", []) + [prov.get("git_commit")] if c]
+    rec["commits"] = [c for k, c in enumerate(commits) if k == 0 or c != commits[k - 1]]
     if s.get("heat_dissipation"):                                    # the ledger's dissipation split (newer runs)
         rec["heat_dissipation"] = s["heat_dissipation"]
     rec["script_wall_s"] = time.perf_counter() - t0

@@ -432,7 +432,7 @@ ch.show(fig, "12_newton.png", caption="Scaled residual per Newton iteration in o
 # discrete residual*, written by hand for the radial return (Johnson-Cook and its modification) and the elastic
 # solid: the midpoint and end gradients moving with $\Delta u$, the Hughes–Winget rotation, the return factor
 # $c_f = \sigma_y/\sigma_{vm}$ and Eq. (13) through $\det f$ (`solid._element_tangent_exact`; a test holds it to
-# central differences at $10^{-9}$). Any other law of `refsph.strength` gets forward differences of the element
+# central differences at $10^{-8}$). Any other law of `refsph.strength` gets forward differences of the element
 # residual (six perturbations of $10^{-8}$ of the element size): the same iterations, at 1.3 times the CPU on the
 # short cut. The assembled matrix against a derivative of the whole residual:
 

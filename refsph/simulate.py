@@ -194,9 +194,10 @@ def earlier_commits(out) -> list:
     continued before, ``earlier_commits``), for a restart that may run another commit; [] where there is none."""
     try:
         old = json.loads((Path(out) / "summary.json").read_text()).get("provenance") or {}
-    except (OSError, ValueError, AttributeError):
+        commits = [c for c in list(old.get("earlier_commits", [])) + [old.get("git_commit")] if isinstance(c, str)]
+    except (OSError, ValueError, AttributeError, TypeError):        # no summary, or not one refsph wrote
         return []
-    return [c for c in list(old.get("earlier_commits", [])) + [old.get("git_commit")] if c]
+    return [c for k, c in enumerate(commits) if k == 0 or c != commits[k - 1]]   # a commit once per stretch
 
 
 def _as_dict(obj) -> dict:

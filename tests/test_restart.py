@@ -172,3 +172,15 @@ def test_a_restart_with_other_arguments_is_refused(tmp_path, monkeypatch):
         run("taylor", "tlsph", out=tmp_path / "cut", progress=False, restart=True, **dict(kw, t_end=5e-6))
     assert (tmp_path / "cut" / "summary.json").read_text() == before
     assert run("taylor", "tlsph", out=tmp_path / "cut", progress=False, restart=True, **kw).summary["status"] == "ok"
+
+
+def test_earlier_commits_reads_what_it_can(tmp_path):
+    """earlier_commits: a commit once per stretch of restarts at it; nothing from a folder without a summary or with
+    one that refsph did not write."""
+    assert sim.earlier_commits(tmp_path) == []
+    prov = dict(git_commit="b", earlier_commits=["a", "b"])
+    (tmp_path / "summary.json").write_text(json.dumps(dict(provenance=prov)))
+    assert sim.earlier_commits(tmp_path) == ["a", "b"]
+    for bad in ('{"provenance": "x"}', '{"provenance": {"earlier_commits": 3}}', "[1]", "{"):
+        (tmp_path / "summary.json").write_text(bad)
+        assert sim.earlier_commits(tmp_path) == []

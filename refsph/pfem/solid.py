@@ -32,20 +32,21 @@ M_{n+1} is the consistent one of the current mesh. With fixed nodal masses a rem
 mass (the standard PFEM mass error is the change of the meshed area; here that change is a density change instead).
 
 **Tangent.** The Newton-Raphson matrix is the exact derivative of the discrete residual. The pressure columns are
-linear and written out. The displacement columns are differentiated by hand (:func:`_element_tangent_exact`) for
-the laws whose return map is the von Mises radial return (Johnson-Cook, the modified Johnson-Cook, any
+linear and written out. The displacement columns are differentiated by hand (:func:`_element_tangent_exact`) for the
+laws whose return map is the von Mises radial return (Johnson-Cook, the modified Johnson-Cook, any
 :class:`refsph.plasticity.J2Plasticity` with its own flow stress) and for the elastic solid: the midpoint and end
-gradients moving with du, the Hughes-Winget rotation, the radial return's factor c_f = sigma_y / sigma_vm (with
-d sigma_y / d eps_dot where the rate is the step's own, by central differences in that scalar) and Eq. (13) through
-det f. It agrees with central differences of the element residual to 1e-9 (``tests/test_pfem.py``). For any other
-strength model the columns are the element residual's forward differences from the residual already computed at du
-(:func:`_element_tangent_fd`: 6 evaluations of all the elements at once, step 1e-8 of the element size; error
-~1e-8 relative). On the short cut's first 30 steps at t_u/10 the two give the same 362 Newton iterations and the
-same tool force to 1e-11; the exact one takes 22.8 s of CPU against 29.3 s (the tangent 10 % of the time against
-27 %; ``benchmarks/pfem_step_cost.py``). Newton converges quadratically down to the tolerance (``tests/test_pfem.py``
-prints the residual norms). The line search's accepted point is not evaluated again (its residual and element
-response are kept), and the tangent is computed only where a correction follows: a solve's converged point (one a
-step, often its last solve's only point) needs none.
+gradients moving with du, the Hughes-Winget rotation, the radial return's factor c_f = sigma_y / sigma_vm (with d
+sigma_y / d eps_dot where the rate is the step's own, by central differences in that scalar) and Eq. (13) through
+det f. It agrees with central differences of the element residual to their own error, 2e-10 with the rate lagged and
+5e-9 with the step's own (``tests/test_pfem.py``, the force and the pressure rows each against its own size). For
+any other strength model the columns are the element residual's forward differences from the residual already
+computed at du (:func:`_element_tangent_fd`: 6 evaluations of all the elements at once, step 1e-8 of the element
+size; error ~1e-8 relative). On the short cut's first 30 steps at t_u/10 the two give the same 362 Newton iterations
+and the same tool force to 1e-11; the exact one takes 22.8 s of CPU against 29.3 s (the tangent 10 % of the time
+against 27 %; ``benchmarks/pfem_step_cost.py``). Newton converges quadratically down to the tolerance
+(``tests/test_pfem.py`` prints the residual norms). The line search's accepted point is not evaluated again (its
+residual and element response are kept), and the tangent is computed only where a correction follows: a solve's
+converged point (one a step, often its last solve's only point) needs none.
 
 **Linear solve.** Each Newton correction solves K delta = -R with SuperLU (:func:`solve_linear`): a symmetric
 fill-reducing ordering (minimum degree on K^T + K) and the diagonal as pivots, since K's diagonal never vanishes
@@ -333,7 +334,8 @@ def _exact_tangent_known(strength) -> bool:
     :class:`J2Plasticity` with its ``flow_stress`` (not a subclass's own return map), or the elastic solid."""
     from ..plasticity import J2Plasticity
     from ..strength import Elastic
-    return (type(strength).return_map is J2Plasticity.return_map) or type(strength).return_map is Elastic.return_map
+    own = getattr(strength.return_map, "__func__", None)            # the bound method's function (an instance's
+    return own is J2Plasticity.return_map or own is Elastic.return_map   # own return map is not the class's)
 
 
 def _return_factor(hist, Te, dt, law, r):
@@ -609,7 +611,7 @@ def newton_step(nodes: Nodes, mesh: Mesh, hist: History, law: SolidLaw, dt: floa
     corrections, at a finite residual with no prescribed correction pending, even if not converged (``converged``
     False; :func:`refsph.pfem.contact.solve_with_active_set` looks at its sets there; None: to the tolerance).
     ``start``: the residual's evaluation at (du0, p0) under these loads (a settled result's ``evaluation``), not
-    computed again. Raises :class:`NewtonFailed`."""
+    computed again (taken only with the predictor off and du0 given). Raises :class:`NewtonFailed`."""
     n = nodes.n
     size = None if max_move is None else _node_sizes(nodes, mesh)
     fixed = np.asarray(loads.fixed, dtype=bool).copy()
@@ -635,7 +637,8 @@ def newton_step(nodes: Nodes, mesh: Mesh, hist: History, law: SolidLaw, dt: floa
         return R_free, (float(np.linalg.norm(R_free[:2 * n])) / scale[0], float(np.linalg.norm(R_free[2 * n:]))
                         / scale[1])
 
-    R, Kg, resp, scale, fc = ev = start or evaluate(du, p, False)    # the matrix only where a correction is needed
+    use = start if not predictor and du0 is not None else None       # an evaluation at du0 (docstring)
+    R, Kg, resp, scale, fc = ev = use or evaluate(du, p, False)      # the matrix only where a correction is needed
     for _ in range(max_iter + 1):
         lift = np.zeros(3 * n)
         lift[:2 * n] = target - du.ravel()                        # the prescribed part of the correction

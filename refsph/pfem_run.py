@@ -25,6 +25,7 @@ workpiece 1.2 mm long, the SPH scene's quick cut).
 """
 from __future__ import annotations
 
+import contextlib
 import inspect
 import json
 import os
@@ -40,8 +41,8 @@ from .pfem.cutting import CutRun, pfem_cut
 from .scenes.base import parse_bool
 from .simulate import SimulationError, earlier_commits, provenance
 
-__all__ = ["run_pfem", "restart_pfem", "is_pfem_run", "pfem_options", "PFEM_SCENES", "QUICK", "N_SNAPSHOTS",
-           "PFEMRunResult"]
+__all__ = ["run_pfem", "restart_pfem", "one_blas_thread", "is_pfem_run", "pfem_options", "PFEM_SCENES", "QUICK",
+           "N_SNAPSHOTS", "PFEMRunResult"]
 
 PFEM_SCENES = ("thermal_cutting",)
 QUICK = dict(case=1, n_tu=5.0, travel=4.0, length=1.2e-3)          # the SPH scene's quick cut
@@ -133,7 +134,27 @@ def run_pfem(scene_name: str = "thermal_cutting", *, out=None, options: dict | N
              max_steps: int | None = None) -> PFEMRunResult:
     """Run the PFEM version of a scene into the run folder ``out`` (default runs/SCENE-pfem-2d; module text);
     ``restart``: continue the run there from its last checkpoint. ``max_steps``: stop after that many steps of
-    this call (the folder can be continued with ``restart``). Returns a :class:`PFEMRunResult`."""
+    this call (the folder can be continued with ``restart``). BLAS runs at one thread meanwhile
+    (:func:`one_blas_thread`). Returns a :class:`PFEMRunResult`."""
+    with one_blas_thread():
+        return _run_pfem(scene_name, out, options, quick, progress, restart, overwrite, max_steps)
+
+
+def one_blas_thread():
+    """A context in which BLAS uses one thread, where threadpoolctl is installed (the ``fast`` extra; else a
+    context that changes nothing: start Python with OPENBLAS_NUM_THREADS=1 for the same). SuperLU's factorisations
+    and the Newton residual's norms call BLAS, and BLAS threads that compete with other work for the cores spin:
+    with one other run on this 2-core machine a norm of 19,000 numbers took 15.6 ms at two threads against 10 us at
+    one, and ten steps late in case 1's cut at t_u/10 took 107 against 55 s of CPU (README, issue 24)."""
+    try:
+        from threadpoolctl import threadpool_limits
+    except ImportError:
+        return contextlib.nullcontext()
+    return threadpool_limits(1, user_api="blas")
+
+
+def _run_pfem(scene_name, out, options, quick, progress, restart, overwrite, max_steps) -> PFEMRunResult:
+    """:func:`run_pfem`'s run."""
     if scene_name not in PFEM_SCENES:
         raise ValueError(f"scene {scene_name!r} has no PFEM version; PFEM scenes: {', '.join(PFEM_SCENES)}")
     kwargs = _options(options, quick)

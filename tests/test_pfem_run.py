@@ -170,3 +170,32 @@ def test_a_killed_run_can_be_continued_from_the_command_line(short_run, tmp_path
     done = json.loads((out / "summary.json").read_text())
     assert done["status"] == "ok" and done["n_steps"] == short_run[1].summary["n_steps"]
     assert done["metrics"]["cutting_force_N_per_m"] == short_run[1].summary["metrics"]["cutting_force_N_per_m"]
+
+
+def test_a_pfem_run_holds_blas_at_one_thread(monkeypatch):
+    """run_pfem runs inside one_blas_thread (BLAS threads that compete with other work for the cores spin: SuperLU
+    and the residual norms call BLAS); without threadpoolctl the context changes nothing."""
+    import builtins
+    import contextlib
+
+    import refsph.pfem_run as pr
+    threadpoolctl = pytest.importorskip("threadpoolctl")
+    with pr.one_blas_thread():
+        blas = [p for p in threadpoolctl.threadpool_info() if p["user_api"] == "blas"]
+        assert blas and all(p["num_threads"] == 1 for p in blas)
+    entered = []
+
+    @contextlib.contextmanager
+    def spy():
+        entered.append(True)
+        yield
+
+    monkeypatch.setattr(pr, "one_blas_thread", spy)
+    with pytest.raises(ValueError, match="has no PFEM version"):
+        pr.run_pfem("taylor_bar_of_nothing")
+    assert entered == [True]
+    monkeypatch.undo()
+    real_import = builtins.__import__
+    monkeypatch.setattr(builtins, "__import__", lambda name, *a, **k: (_ for _ in ()).throw(ImportError(name))
+                        if name == "threadpoolctl" else real_import(name, *a, **k))
+    assert isinstance(pr.one_blas_thread(), contextlib.nullcontext)

@@ -637,8 +637,7 @@ def newton_step(nodes: Nodes, mesh: Mesh, hist: History, law: SolidLaw, dt: floa
         return R_free, (float(np.linalg.norm(R_free[:2 * n])) / scale[0], float(np.linalg.norm(R_free[2 * n:]))
                         / scale[1])
 
-    use = start if not predictor and du0 is not None else None       # an evaluation at du0 (docstring)
-    R, Kg, resp, scale, fc = ev = use or evaluate(du, p, False)      # the matrix only where a correction is needed
+    R, Kg, resp, scale, fc = ev = (start if not predictor and du0 is not None else None) or evaluate(du, p, False)
     for _ in range(max_iter + 1):
         lift = np.zeros(3 * n)
         lift[:2 * n] = target - du.ravel()                        # the prescribed part of the correction

@@ -191,7 +191,7 @@ def run_case(key: str, options: dict, numerics: dict, quick: bool = False) -> di
     """One run (continued from its checkpoint if an earlier attempt was killed); its record. ``numerics`` with
     method 'pfem': the PFEM cut (:mod:`refsph.pfem_run`) with the options it takes (PFEM_OPTIONS; its tool is the
     sweep's, TOOL)."""
-    from refsph.simulate import SimulationError, run
+    from refsph.simulate import SimulationError, run, run_commits
     out = run_folder(key, quick)
     restart = (out / "snapshots" / "restart.npz").exists()
     t0 = time.perf_counter()
@@ -221,9 +221,7 @@ def run_case(key: str, options: dict, numerics: dict, quick: bool = False) -> di
                metrics={k: m[k] for k in KEEP if k in m},
                histories={k: _thin(m[k]) for k in ("cutting_force_history", "passive_force_history",
                                                      "temperature_history") if k in m})
-    prov = s.get("provenance") or {}                                 # the code that ran it (a restart: each part's)
-    commits = [c for c in prov.get("earlier_commits", []) + [prov.get("git_commit")] if c]
-    rec["commits"] = [c for k, c in enumerate(commits) if k == 0 or c != commits[k - 1]]
+    rec["commits"] = run_commits(s.get("provenance") or {})       # the code that ran it (a restart: each part's)
     if s.get("heat_dissipation"):                                    # the ledger's dissipation split (newer runs)
         rec["heat_dissipation"] = s["heat_dissipation"]
     rec["script_wall_s"] = time.perf_counter() - t0

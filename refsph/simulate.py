@@ -56,7 +56,7 @@ from .state import State
 from .tlsph import TLSPHParams
 
 __all__ = ["SimulationError", "RunResult", "RunRecord", "make_solver", "step_physics", "run", "check_run", "simulate",
-           "snapshot_times", "step_or_fail", "provenance", "earlier_commits", "restart_run", "METHODS"]
+           "snapshot_times", "step_or_fail", "provenance", "run_commits", "earlier_commits", "restart_run", "METHODS"]
 
 METHODS = ("esph", "tlsph")
 CHECKPOINT = "restart.npz"          # snapshots/restart.npz: how to continue from the last snapshot (see simulate)
@@ -189,15 +189,20 @@ def provenance(threads: int) -> dict:
                 scipy=scipy.__version__, platform=platform.platform(), threads=threads, command=list(sys.argv))
 
 
+def run_commits(prov: dict) -> list:
+    """The git commits a run's provenance names, its earlier parts' first (``earlier_commits``, then
+    ``git_commit``), each once per stretch of restarts at it."""
+    commits = [c for c in list(prov.get("earlier_commits", [])) + [prov.get("git_commit")] if isinstance(c, str)]
+    return [c for k, c in enumerate(commits) if k == 0 or c != commits[k - 1]]
+
+
 def earlier_commits(out) -> list:
-    """The git commits a run folder's earlier parts ran (its summary.json's provenance: ``git_commit`` and, for a run
-    continued before, ``earlier_commits``), for a restart that may run another commit; [] where there is none."""
+    """The git commits a run folder's earlier parts ran (:func:`run_commits` of its summary.json's provenance), for
+    a restart that may run another commit; [] where there is none."""
     try:
-        old = json.loads((Path(out) / "summary.json").read_text()).get("provenance") or {}
-        commits = [c for c in list(old.get("earlier_commits", [])) + [old.get("git_commit")] if isinstance(c, str)]
+        return run_commits(json.loads((Path(out) / "summary.json").read_text()).get("provenance") or {})
     except (OSError, ValueError, AttributeError, TypeError):        # no summary, or not one refsph wrote
         return []
-    return [c for k, c in enumerate(commits) if k == 0 or c != commits[k - 1]]   # a commit once per stretch
 
 
 def _as_dict(obj) -> dict:

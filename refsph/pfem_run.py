@@ -75,7 +75,7 @@ def _options(options: dict, quick: bool) -> dict:
             raise ValueError(f"option {name!r} is not an option of the PFEM cut; its options: {', '.join(known)}")
         default = known[name].default
         try:
-            if name in ("friction", "conduction", "refine"):
+            if name in ("friction", "conduction", "refine", "edge_nodes"):
                 out[name] = parse_bool(value, f"option {name}")
             elif name == "case":
                 out[name] = int(float(value))

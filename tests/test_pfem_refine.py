@@ -98,3 +98,39 @@ def test_held_nodes_stay_and_forbidden_places_get_no_node():
 def test_a_bad_rule_is_refused(r_min, a_max):
     with pytest.raises(ValueError, match="NodeRule"):
         NodeRule(r_min=r_min, a_max=a_max)
+
+
+def test_a_tool_edge_poking_between_two_boundary_nodes_gets_a_node_on_its_surface():
+    """The cut's ``edge_nodes``: a rounded tool whose edge pokes 0.3 spacings through the top boundary edge between
+    two nodes, both outside it, gets one node on its surface inside that edge's triangle; mass, momentum and heat
+    are conserved to round-off (each parent gives rho_k A lambda_k / 3)."""
+    from refsph.penalty import RoundedPolygon
+    from refsph.pfem.refine import barycentric, owner_triangles, tool_intrusions
+    nodes, mesh, hist, h, fixed = scene()
+    r = 0.4 * DX                                             # a square tool's lower corner, rounded by r, pokes down
+    top = 6 * DX
+    apex = np.array([2.5 * DX, top - 0.3 * DX + r])          # the arc's lowest point 0.3 DX below the top row
+    core = np.array([[0.0, 0.0], [DX, DX], [0.0, 2 * DX], [-DX, DX]])
+    tool = RoundedPolygon(core=core, radius=r)
+
+    def gap(x):
+        return tool.gap(x, apex)
+    assert np.all(gap(nodes.x)[0] < 0)                       # no node inside the tool
+    tri, lam = tool_intrusions(nodes.x, mesh, gap, 0.1 * h)
+    assert len(tri) == 1 and np.all(lam > 0.05) and np.isclose(lam.sum(), 1.0)
+    q = np.einsum("kp,kpd->kd", lam, nodes.x[mesh.tri[tri]])
+    assert abs(gap(q)[0][0]) < 1e-3 * DX and abs(q[0, 0] - 2.5 * DX) < 0.02 * DX   # on the tool, under its edge
+    edge = mesh.edges[owner_triangles(mesh.tri, mesh.edges) == tri[0]]
+    assert np.allclose(nodes.x[edge.ravel(), 1], top)        # the poked edge is the top one, (2 DX, 3 DX)
+    assert np.allclose(barycentric(nodes.x[mesh.tri[tri]], q), lam)
+    out, h2, _, _, change = refine_nodes(nodes, mesh, hist, h, fixed, NodeRule(r_min=0.5, a_max=50.0),
+                                         points=(tri, lam))
+    assert len(change.parents) == 1 and out.n == nodes.n - len(change.merged) + 1 and np.allclose(out.x[-1], q[0])
+    m0, P0, H0 = totals(nodes)
+    m1, P1, H1 = totals(out)
+    assert abs(m1 - m0) <= 1e-14 * m0 and np.all(out.m > 0)
+    assert np.allclose(P1, P0, rtol=0, atol=1e-13 * np.abs(nodes.m[:, None] * nodes.v).sum())
+    assert abs(H1 - H0) <= 1e-14 * H0
+    assert out.eps_p[-1] == hist.eps_p[tri[0]] and h2[-1] == DX
+    grazing = apex + [0.0, 0.25 * DX]                       # 0.05 DX through the edge: less than 0.1 h, nothing
+    assert len(tool_intrusions(nodes.x, mesh, lambda x: tool.gap(x, grazing), 0.1 * h)[0]) == 0

@@ -109,8 +109,8 @@ from ..scenes.thermal_cutting import (CLEARANCE_DEG, EDGE_RADIUS, RAKE_DEG, chip
                                       tool_particles, tool_shape)
 from ..thermal import SurfaceLoss
 from .contact import StepContact, ToolContact, boundary_lengths, solve_with_active_set
-from .mesh import Mesh, alpha_shape_mesh, remesh_needed, tributary_areas
-from .refine import NodeRule, refine_nodes, renumber_mesh
+from .mesh import Mesh, alpha_shape_mesh, mesh_of, remesh_needed, tributary_areas
+from .refine import NodeRule, refine_nodes, renumber_mesh, tool_intrusions
 from .solid import (TRAPEZOIDAL, History, Loads, Newmark, NewtonFailed, Nodes, SolidLaw, commit, history_from_nodes,
                     make_nodes, plastic_heat, settle_nodes, transfer_history)
 from .thermal import contact_conductance, thermal_step
@@ -160,7 +160,10 @@ class PFEMCut:
     each converged solve); ``node_rule`` the node insertion and removal at each
     remeshing (:class:`refsph.pfem.refine.NodeRule`; None: the nodes stay as they are); ``warm_start``: each step's
     Newton-Raphson starts from the last step's du (scaled by the ratio of the steps; False: from du = 0), which
-    changes the path to the solution, not the solution (module text)."""
+    changes the path to the solution, not the solution (module text); ``edge_nodes``: the mesh kept off the tool
+    (a node inserted on the tool's surface where its edge pokes through the boundary between two nodes, deeper than
+    a tenth of their spacing, :func:`refsph.pfem.refine.tool_intrusions`; triangles whose centroid is inside the tool
+    left out of each new mesh; needs ``node_rule``; False: the paper's node-on-tool contact alone, module text)."""
 
     nodes: object
     h: np.ndarray
@@ -185,6 +188,7 @@ class PFEMCut:
     max_outer: int = 16
     node_rule: NodeRule | None = None
     warm_start: bool = True
+    edge_nodes: bool = False
 
 
 def graded_workpiece(length: float, tu: float, dx: float) -> tuple[np.ndarray, np.ndarray]:
@@ -204,14 +208,15 @@ def graded_workpiece(length: float, tu: float, dx: float) -> tuple[np.ndarray, n
 def pfem_cut(case: int, n_tu: float = 10.0, travel: float = 16.0, length: float | None = None,
              courant: float = 0.25, alpha: float = 1.4, penalty: float = 20.0, friction: bool = True,
              conduction: bool = True, chip_fraction: float = 0.5, refine: bool = True, r_min: float = 0.5,
-             a_max: float = 2.5, gamma: float = 0.5) -> PFEMCut:
+             a_max: float = 2.5, gamma: float = 0.5, edge_nodes: bool = False) -> PFEMCut:
     """The cut of row ``case`` of the paper's Appendix B: dx = t_u / n_tu, ``travel`` t_u of cut on a workpiece
     ``length`` [m] long (default (travel + 12) t_u), dt = courant dx / v_c, contact penalties ``penalty`` G / dx;
     ``conduction``: the heat step (module text; False: adiabatic), ``chip_fraction`` of the frictional heat into
     the chip; ``refine``: node removal and insertion at each remeshing with ``r_min`` and ``a_max``
     (:class:`refsph.pfem.refine.NodeRule`; False: the nodes stay as they are); ``gamma``: Newmark's gamma, 0.5 the
     paper's trapezoidal rule (Eq. (21)), above it the damped rule of :class:`refsph.pfem.solid.Newmark` with
-    beta = (gamma + 1/2)^2 / 4 (a departure from the paper: it damps the chip's ringing, module text)."""
+    beta = (gamma + 1/2)^2 / 4 (a departure from the paper: it damps the chip's ringing, module text);
+    ``edge_nodes``: the mesh kept off the tool (:class:`PFEMCut`; with ``refine``)."""
     row = rla_cutting_case(int(case))
     mat = MATERIALS[row["material"]]
     vc, tu = row["vc_m_per_min"] / 60.0, row["tu_mm"] * 1e-3
@@ -263,10 +268,11 @@ def pfem_cut(case: int, n_tu: float = 10.0, travel: float = 16.0, length: float 
                 edge_radius_m=EDGE_RADIUS, apex0=apex.tolist(), measured=row, method="pfem", alpha=alpha,
                 courant=courant, penalty=penalty, conduction=bool(conduction), chip_fraction=float(chip_fraction),
                 h_int=None if heat is None else heat.h_int, refine=bool(refine), r_min=r_min, a_max=a_max,
-                newmark_gamma=float(gamma))
+                newmark_gamma=float(gamma), edge_nodes=bool(edge_nodes))
     return PFEMCut(nodes=nodes, h=h, fixed=fixed, law=law, shape=shape, shift0=centroid, v_tool=np.array([-vc, 0.0]),
                    contact=contact, alpha=alpha, dt=courant * dx / vc, t_end=travel * tu / vc, X0=x.copy(), info=info,
-                   heat=heat, node_rule=NodeRule(r_min=r_min, a_max=a_max) if refine else None, newmark=newmark)
+                   heat=heat, node_rule=NodeRule(r_min=r_min, a_max=a_max) if refine else None, newmark=newmark,
+                   edge_nodes=bool(edge_nodes) and bool(refine))
 
 
 class CutRun:
@@ -280,7 +286,7 @@ class CutRun:
         self.nodes = cut.nodes
         self.h, self.fixed, self.X0 = cut.h.copy(), cut.fixed.copy(), cut.X0.copy()   # per node: they change
         self.ids = np.arange(self.nodes.n, dtype=np.int64)                               # with the node rule
-        self.mesh = alpha_shape_mesh(self.nodes.x, cut.alpha, self.h)
+        self.mesh = self.new_mesh(self.nodes)
         self.hist_e = history_from_nodes(self.nodes, self.mesh)
         self.f_T = np.zeros(self.nodes.n)
         self.T_tool = None if cut.heat is None else np.full(len(cut.heat.x_tool), cut.heat.T_fixed)
@@ -333,7 +339,7 @@ class CutRun:
             old, hist = mesh, r.history                                 # Algorithm 1: "if remeshing is needed"
             if cut.node_rule is not None:
                 nodes, old, hist = refine_run(self, nodes, mesh, hist)
-            new = alpha_shape_mesh(nodes.x, cut.alpha, self.h)
+            new = self.new_mesh(nodes)
             self.hist_e, self.mesh = transfer_history(old, hist, new, nodes), new
             self.remeshes += 1
         else:
@@ -348,6 +354,15 @@ class CutRun:
         self.steps += 1
         self.wall += time.perf_counter() - t0
         return r
+
+    def new_mesh(self, nodes: Nodes) -> Mesh:
+        """Algorithm 1's mesh of the nodes (the alpha-shape), without the triangles whose centroid is inside the tool
+        where ``edge_nodes`` is set."""
+        mesh = alpha_shape_mesh(nodes.x, self.cut.alpha, self.h)
+        if not self.cut.edge_nodes:
+            return mesh
+        inside = self.cut.shape.gap(nodes.x[mesh.tri].mean(axis=1), self.cut.shift0 + self.cut.v_tool * nodes.t)[0] > 0
+        return mesh_of(mesh.tri[~inside], nodes.n, mesh.alpha) if inside.any() else mesh
 
     def tool_x(self, t: float) -> np.ndarray:
         """The tool's nodes at time t (moved rigidly)."""
@@ -426,9 +441,11 @@ def refine_run(run: "CutRun", nodes: Nodes, mesh: Mesh, hist: History):
     carry = dict(id=(run.ids, "keep"), X0=(run.X0, "keep"), f_T=(run.f_T, "sum"))
     if run.du_prev is not None:
         carry["du"] = (run.du_prev, "mean")
+    points = (tool_intrusions(nodes.x, mesh, lambda x: cut.shape.gap(x, shift), 0.1 * run.h) if cut.edge_nodes
+              else None)
     nodes, h, fixed, extra, change = refine_nodes(
         nodes, mesh, hist, run.h, run.fixed, cut.node_rule, extra=carry,
-        forbidden=lambda x: cut.shape.gap(x, shift)[0] > -0.5 * cut.info["dx"])
+        forbidden=lambda x: cut.shape.gap(x, shift)[0] > -0.5 * cut.info["dx"], points=points)
     if not change.changed:
         return nodes, mesh, hist
     run.h, run.fixed, run.ids, run.X0, run.f_T = h, fixed, extra["id"], extra["X0"], extra["f_T"]

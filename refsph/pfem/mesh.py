@@ -30,8 +30,8 @@ from scipy.spatial import Delaunay, cKDTree
 
 from ..surface import circumradius
 
-__all__ = ["Mesh", "nodal_spacing", "alpha_shape_mesh", "boundary_edges", "signed_areas", "triangle_quality",
-           "topology", "remesh_needed", "tributary_areas"]
+__all__ = ["Mesh", "nodal_spacing", "alpha_shape_mesh", "mesh_of", "boundary_edges", "signed_areas",
+           "triangle_quality", "topology", "remesh_needed", "tributary_areas"]
 
 
 @dataclass
@@ -99,9 +99,13 @@ def alpha_shape_mesh(x: np.ndarray, alpha: float | None, h: np.ndarray | None = 
     if body is not None:
         b = np.asarray(body)[tri]
         keep &= (b[:, 0] == b[:, 1]) & (b[:, 1] == b[:, 2])
-    tri = tri[keep]
+    return mesh_of(tri[keep], len(x), alpha)
+
+
+def mesh_of(tri: np.ndarray, n: int, alpha: float | None) -> Mesh:
+    """The :class:`Mesh` of the counter-clockwise triangles ``tri`` of n nodes, with their boundary."""
     edges = boundary_edges(tri)
-    boundary = np.zeros(len(x), dtype=bool)
+    boundary = np.zeros(n, dtype=bool)
     boundary[edges.ravel()] = True
     return Mesh(tri=tri, edges=edges, boundary=boundary, alpha=alpha)
 

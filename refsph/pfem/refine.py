@@ -34,7 +34,8 @@ from scipy.spatial import cKDTree
 from .mesh import Mesh, signed_areas, tributary_areas
 from .solid import History, Nodes
 
-__all__ = ["NodeRule", "NodeChange", "refine_nodes", "renumber_mesh", "close_pairs", "pick_merges", "pick_insertions"]
+__all__ = ["NodeRule", "NodeChange", "refine_nodes", "renumber_mesh", "close_pairs", "pick_merges", "pick_insertions",
+           "tool_intrusions", "owner_triangles"]
 
 NODAL = ("S", "S_zz", "eps_p", "W_p", "J", "p", "a", "eps_dot")     # mass-weighted in a merge
 ELEMENT = ("S", "S_zz", "eps_p", "W_p", "J", "eps_dot")              # an inserted node takes its triangle's
@@ -109,20 +110,80 @@ def pick_insertions(nodes: Nodes, mesh: Mesh, h: np.ndarray, used: np.ndarray, a
     return ins, rho[mesh.tri[ins]] * (A[ins] / 9.0)[:, None]
 
 
+def owner_triangles(tri: np.ndarray, edges: np.ndarray) -> np.ndarray:
+    """(K,) the triangle of ``tri`` each boundary edge (K, 2) belongs to (a boundary edge has one triangle; -1 for an
+    edge of no triangle)."""
+    n = int(max(tri.max(), edges.max())) + 1
+    own = np.concatenate([tri[:, [0, 1]], tri[:, [1, 2]], tri[:, [2, 0]]])
+    key = own[:, 0] * n + own[:, 1]
+    order = np.argsort(key, kind="stable")
+    want = edges[:, 0] * n + edges[:, 1]
+    pos = np.clip(np.searchsorted(key[order], want), 0, len(key) - 1)
+    hit = key[order][pos] == want
+    return np.where(hit, order[pos] % len(tri), -1)
+
+
+def tool_intrusions(x: np.ndarray, mesh: Mesh, gap, depth: np.ndarray, samples: int = 41):
+    """Where a convex tool's outline pokes through the body's boundary between two nodes (module text): (the
+    triangles (K,), the barycentric coordinates (K, 3) in them of the tool-surface points where a node goes).
+    ``gap(x) -> (g, n)`` the tool's penetration depth and outward normal at points x (:meth:`RoundedPolygon.gap`);
+    ``depth`` (N,) the least penetration, per node, that counts. A boundary edge (a, b) is poked where a point inside
+    it, sampled at ``samples`` points, lies deeper in the tool than ``depth`` (the mean of its nodes') and than
+    either end by as much; the node goes to the tool's surface above the deepest point, q = p + g n, if q lies
+    inside the edge's triangle (each coordinate above 0.05); one node per triangle, the deepest."""
+    e = mesh.edges
+    if len(e) == 0:
+        return np.zeros(0, np.int64), np.zeros((0, 3))
+    s = np.linspace(0.0, 1.0, samples)
+    P = x[e[:, 0], None, :] * (1.0 - s)[None, :, None] + x[e[:, 1], None, :] * s[None, :, None]
+    g, n = gap(P.reshape(-1, 2))
+    g, n = g.reshape(len(e), samples), n.reshape(len(e), samples, 2)
+    k = 1 + np.argmax(g[:, 1:-1], axis=1)
+    rows = np.arange(len(e))
+    g_in, d_min = g[rows, k], depth[e].mean(axis=1)
+    poked = (g_in > d_min) & (g_in > np.maximum(g[:, 0], g[:, -1]) + d_min)
+    tri_of = owner_triangles(mesh.tri, e)
+    poked &= tri_of >= 0
+    q = P[rows, k] + g_in[:, None] * n[rows, k]
+    t = tri_of[poked]
+    lam = barycentric(x[mesh.tri[t]], q[poked])
+    ok = np.all(lam > 0.05, axis=1)
+    t, lam, depth_in = t[ok], lam[ok], g_in[poked][ok]
+    order = np.argsort(-depth_in, kind="stable")
+    _, first = np.unique(t[order], return_index=True)
+    pick = order[first]
+    return t[pick], lam[pick]
+
+
+def barycentric(corners: np.ndarray, q: np.ndarray) -> np.ndarray:
+    """(K, 3) the barycentric coordinates of points q (K, 2) in triangles with ``corners`` (K, 3, 2)."""
+    a, b, c = corners[:, 0], corners[:, 1], corners[:, 2]
+    det = (b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (b[:, 1] - a[:, 1]) * (c[:, 0] - a[:, 0])
+    l1 = ((q[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (q[:, 1] - a[:, 1]) * (c[:, 0] - a[:, 0])) / det
+    l2 = ((b[:, 0] - a[:, 0]) * (q[:, 1] - a[:, 1]) - (b[:, 1] - a[:, 1]) * (q[:, 0] - a[:, 0])) / det
+    return np.stack([1.0 - l1 - l2, l1, l2], axis=1)
+
+
 def refine_nodes(nodes: Nodes, mesh: Mesh, hist: History, h: np.ndarray, fixed: np.ndarray, rule: NodeRule,
-                 extra: dict | None = None, forbidden=None, boundary: np.ndarray | None = None):
+                 extra: dict | None = None, forbidden=None, boundary: np.ndarray | None = None, points=None):
     """The nodes after the removals and insertions of ``rule`` (module text) on the mesh ``mesh`` with the
     triangles' history ``hist``. ``h`` (N,) the target spacings, ``fixed`` (N, 2) the held components; ``extra``: more
     per-node arrays to carry (name -> (array, how): how 'sum' (a force), 'keep' (the kept node's: an id, an initial
     position) or 'mean'; a new node's 'sum' is 0, its 'keep' and 'mean' the parents' mass-weighted mean, except the
-    key 'id', which counts on from the largest); ``forbidden(x) -> bool (K,)``: where no node may be inserted.
-    Returns (nodes, h, fixed, extra, :class:`NodeChange`); the inputs are not changed."""
+    key 'id', which counts on from the largest); ``forbidden(x) -> bool (K,)``: where no node may be inserted;
+    ``points``: (triangles (P,), barycentric coordinates (P, 3)) of more nodes to insert at those points rather than
+    at centroids (:func:`tool_intrusions`; each old node k of the triangle gives rho_k A lambda_k / 3, the rule of
+    the module text at any point; skipped where a node is in a merge or the triangle gets its centroid). Returns
+    (nodes, h, fixed, extra, :class:`NodeChange`); the inputs are not changed."""
     n = nodes.n
     extra = dict(extra or {})
     boundary = mesh.boundary if boundary is None else boundary
     held = np.asarray(fixed, bool).any(axis=1)
     merged, used = pick_merges(nodes.x, h, held, boundary, rule.r_min)
     ins, share = pick_insertions(nodes, mesh, h, used, rule.a_max, forbidden)
+    at = nodes.x[mesh.tri[ins]].mean(axis=1)
+    if points is not None and len(points[0]):
+        ins, share, at = _with_points(nodes, mesh, used, ins, share, at, *points)
     parents = mesh.tri[ins]
     m = nodes.m.copy()
     np.subtract.at(m, parents.ravel(), share.ravel())
@@ -158,7 +219,7 @@ def refine_nodes(nodes: Nodes, mesh: Mesh, hist: History, h: np.ndarray, fixed: 
         values = getattr(nodes, name)
         element = getattr(hist, name, None) if name in ELEMENT else None
         fields[name] = assemble(merge_mean(values), element[ins] if element is not None else new_mean(values))
-    out = replace(nodes, x=assemble(nodes.x, nodes.x[parents].mean(axis=1)), m=assemble(m_merged, m_new), **fields)
+    out = replace(nodes, x=assemble(nodes.x, at), m=assemble(m_merged, m_new), **fields)
     h_kept = h.copy()
     np.minimum.at(h_kept, keep, h[drop])
     fixed_kept = np.asarray(fixed, bool).copy()
@@ -181,6 +242,19 @@ def refine_nodes(nodes: Nodes, mesh: Mesh, hist: History, h: np.ndarray, fixed: 
             raise ValueError(f"refine_nodes: extra[{key!r}]: how must be 'sum', 'mean' or 'keep', got {how!r}")
         extra_out[key] = assemble(v, new)
     return out, h_out, fixed_out, extra_out, NodeChange(old_to_new=old_to_new, parents=parents, merged=merged)
+
+
+def _with_points(nodes, mesh, used, ins, share, at, tri_pts, lam):
+    """The centroid insertions (ins, share, at) and the point insertions of :func:`refine_nodes` together."""
+    tri_pts, lam = np.asarray(tri_pts, np.int64), np.asarray(lam, float)
+    ok = ~used[mesh.tri[tri_pts]].any(axis=1) & ~np.isin(tri_pts, ins)
+    tri_pts, lam = tri_pts[ok], lam[ok]
+    A = np.abs(signed_areas(nodes.x, mesh.tri[tri_pts]))
+    a = tributary_areas(nodes.x, mesh.tri, nodes.n)
+    rho = np.where(a > 0, nodes.m / np.where(a > 0, a, 1.0), 0.0)
+    pts = np.einsum("kp,kpd->kd", lam, nodes.x[mesh.tri[tri_pts]])
+    return (np.concatenate([ins, tri_pts]), np.concatenate([share, rho[mesh.tri[tri_pts]] * lam * (A / 3.0)[:, None]]),
+            np.concatenate([at, pts]))
 
 
 def renumber_mesh(mesh: Mesh, hist: History, change: NodeChange) -> tuple[Mesh, History]:

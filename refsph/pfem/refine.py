@@ -23,6 +23,19 @@ momentum and heat content are unchanged; kinetic energy is not (a merge is an in
 Nodes are not inserted where ``forbidden`` says (inside or within half a spacing of the tool), and held nodes are
 never removed. Each node carries a persistent ``id`` (new nodes take the next free ones), so a snapshot's particles
 can be followed across node changes.
+
+**The tool's edge between two nodes** (the cut's ``edge_nodes``; off by default). The contact keeps nodes out of the
+tool, not triangles: a convex corner of the tool (the 10 um cutting edge) can pass between two boundary nodes, and
+the triangle it pokes into resists nothing. On the sweep's cuts at t_u/10 one or two boundary edges are poked so, by
+0.2-0.5 spacings (``benchmarks/pfem_edge_phase.py`` measures it). :func:`tool_intrusions` finds them (41 points
+along each boundary edge; poked where a point inside lies deeper in the tool than a tenth of the spacing and than
+either end by as much) and puts a node on the tool's surface above the deepest point, q = p + g n, inside the
+edge's triangle, with the mass rule above at q's barycentric coordinates (rho_k A lambda_k / 3 from each node: A / 9
+at the centroid). Each new mesh then leaves out the triangles whose centroid is inside the tool, so the boundary
+runs a-q-b around the edge. refsph's own rule, after the adaptive insertion of particles near the tool of
+Rodriguez Prieto et al. 2018 ("Generation of segmental chips in metal cutting modeled with the PFEM", Comput. Mech.
+61, 639), whose rule is not reproduced; the other standard remedy, a second contact pass of the tool's corners
+against the boundary's segments (Wriggers 2006, Section 5.2), is not built.
 """
 from __future__ import annotations
 

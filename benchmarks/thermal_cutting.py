@@ -669,10 +669,28 @@ def status_lines(records: dict, todo: dict, quick: bool = False) -> list[str]:
         t, t_end, wall = s.get("t_final") or 0.0, s.get("t_end") or float("nan"), s.get("wall_time_s") or 0.0
         left = wall * (t_end / t - 1.0) if t > 0 else float("nan")
         age = (time.time() - path.stat().st_mtime) / 60
-        lines.append(f"{key:40s} {s.get('status')}: t = {t * 1e3:.3f} of {t_end * 1e3:.3f} ms "
-                     f"({100 * t / t_end:.0f} %), {s.get('n_steps')} steps, {wall / 60:.0f} min so far, "
-                     f"about {left / 60:.0f} min to go; summary written {age:.0f} min ago")
+        line = (f"{key:40s} {s.get('status')}: t = {t * 1e3:.3f} of {t_end * 1e3:.3f} ms "
+                f"({100 * t / t_end:.0f} %), {s.get('n_steps')} steps, {wall / 60:.0f} min so far, "
+                f"about {left / 60:.0f} min to go; summary written {age:.0f} min ago")
+        beat = _heartbeat(path.parent, path.stat().st_mtime) if s.get("status") == "running" else None
+        lines.append(line if beat is None else f"{key:40s} {s.get('status')}: {beat}")
     return lines
+
+
+def _heartbeat(folder: Path, summary_written: float) -> str | None:
+    """The run's progress from its heartbeat (:func:`refsph.io.write_progress`, every 30 s) where that is newer than
+    its summary: t, steps, this process's rate and the time to go; None without one."""
+    try:
+        b = json.loads((folder / "progress.json").read_text())
+    except (OSError, ValueError):
+        return None
+    if b.get("written", 0.0) <= summary_written:
+        return None
+    t, t_end, t0, wall = b["t"], b["t_end"], b.get("t_begin", 0.0), b["wall_s"]
+    left = wall * (t_end - t) / (t - t0) if t > t0 else float("nan")
+    return (f"t = {t * 1e3:.3f} of {t_end * 1e3:.3f} ms ({100 * t / t_end:.0f} %), {b['steps']} steps, this process "
+            f"{wall / 60:.0f} min, about {left / 60:.0f} min to go; heartbeat "
+            f"{(time.time() - b['written']) / 60:.0f} min ago")
 
 
 def backfill_cpu(st) -> list[str]:

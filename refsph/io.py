@@ -45,6 +45,7 @@ from __future__ import annotations
 import json
 import zipfile
 import os
+import time
 from pathlib import Path
 
 import numpy as np
@@ -241,7 +242,10 @@ def json_ready(o):
     return o
 
 
-RUN_FILE_PATTERNS = ("summary.json", "summary.json.tmp", "reaction_forces.csv", "reaction_forces.csv.tmp",
+PROGRESS = "progress.json"          # a run folder's heartbeat (write_progress) ...
+HEARTBEAT_S = 30.0                  # ... written this often [s of wall time] by the run loops
+RUN_FILE_PATTERNS = ("summary.json", "summary.json.tmp", PROGRESS, PROGRESS + ".tmp", "reaction_forces.csv",
+                     "reaction_forces.csv.tmp",
                      "snapshots/snap_[0-9][0-9][0-9][0-9][0-9].npz", "snapshots/*.tmp.npz", "snapshots/restart.npz",
                      "snapshots/restart_prev.npz", "snapshots/last_good.npz", f"snapshots/{UNITS_FILE}",
                      f"snapshots/{UNITS_FILE}.tmp",
@@ -301,6 +305,16 @@ def write_json(path, data: dict) -> None:
         json.dump(json_ready(data), f, indent=2, allow_nan=False)
         f.write("\n")
     os.replace(tmp, path)
+
+
+def write_progress(folder, t: float, t_end: float, steps: int, wall_s: float, t_begin: float) -> None:
+    """A run's heartbeat, ``<folder>/progress.json``: the simulated time t and t_end [s], the steps, the simulated
+    time this process began at (``t_begin``: a restart's) and its wall seconds so far, and when it was written
+    (Unix time). The run loops write it every ``HEARTBEAT_S`` (30 s), so a long run's
+    progress is known between its checkpoints (summary.json is written only at each snapshot); written atomically,
+    and not needed by anything that reads a run."""
+    write_json(Path(folder) / PROGRESS, dict(t=float(t), t_end=float(t_end), steps=int(steps), t_begin=float(t_begin),
+                                             wall_s=float(wall_s), written=time.time()))
 
 
 def save_reactions(path, reactions: dict, dim: int) -> None:

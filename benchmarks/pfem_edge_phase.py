@@ -12,6 +12,7 @@ pokes through a boundary edge between its nodes, in dx (the mean and largest ove
 
     python benchmarks/pfem_edge_phase.py              # t_u/5: 16 runs, about 10 min on one core
     python benchmarks/pfem_edge_phase.py --fine       # also t_u/10: 8 more, about 40 min
+    python benchmarks/pfem_edge_phase.py --full       # also case 1's whole cut (16 t_u) at t_u/5, both ways: 8 min
     python benchmarks/pfem_edge_phase.py --report     # the tables from the JSON
 
 Resumable: each finished run is kept in pfem_edge_phase.json (a rerun skips it; a run that fails is recorded as
@@ -53,12 +54,12 @@ def overlap(run) -> float:
     return float(max(inner.max(), 0.0) / cut.info["dx"])
 
 
-def run_one(n_tu: float, edge_nodes: bool) -> dict:
-    """The quick cut at this n_tu; its record."""
+def run_one(n_tu: float, edge_nodes: bool, full: bool = False) -> dict:
+    """The quick cut at this n_tu (``full``: case 1's whole cut); its record."""
     from refsph.pfem.cutting import CutRun, pfem_cut
     from refsph.pfem_run import one_blas_thread
     from refsph.simulate import provenance
-    cut = pfem_cut(n_tu=n_tu, edge_nodes=edge_nodes, **QUICK)
+    cut = pfem_cut(n_tu=n_tu, edge_nodes=edge_nodes, **(dict(case=1) if full else QUICK))
     t0, ov = time.process_time(), []
     run = CutRun(cut)
     with one_blas_thread():
@@ -67,7 +68,7 @@ def run_one(n_tu: float, edge_nodes: bool) -> dict:
             ov.append(overlap(run))
     r = run.result()
     m, ov = r["metrics"], np.asarray(ov[len(ov) // 2:])
-    return dict(n_tu=n_tu, edge_nodes=edge_nodes, status="ok", Fc=m["cutting_force_N_per_m"] / 1e3,
+    return dict(n_tu=n_tu, edge_nodes=edge_nodes, full=full, status="ok", Fc=m["cutting_force_N_per_m"] / 1e3,
                 Fp=m["passive_force_N_per_m"] / 1e3, ratio=m["force_ratio"], TRF=m["rake_face_temperature_K"],
                 TFCS=m["free_chip_surface_temperature_K"], chip=m["chip_thickness_mm"],
                 its=int(sum(r["newton_iterations"])), steps=r["steps"], halved=r["retries"],
@@ -76,8 +77,8 @@ def run_one(n_tu: float, edge_nodes: bool) -> dict:
                 commit=provenance(1).get("commit"))
 
 
-def key(n_tu: float, edge_nodes: bool) -> str:
-    return f"n_tu {n_tu:g} {'edge nodes' if edge_nodes else 'paper'}"
+def key(n_tu: float, edge_nodes: bool, full: bool = False) -> str:
+    return f"{'full cut ' if full else ''}n_tu {n_tu:g} {'edge nodes' if edge_nodes else 'paper'}"
 
 
 def load() -> dict:
@@ -101,18 +102,25 @@ def report(runs: dict) -> str:
              "Made by `python benchmarks/pfem_edge_phase.py` (module text): each row one run; then, per resolution and "
              "contact, the mean ± the sample standard deviation over the edge's places (the spread the lattice makes).",
              "", "| n_tu | contact | " + " | ".join(k[0] for k in KEYS) + " |", "|---" * (2 + len(KEYS)) + "|"]
-    ok = [r for r in runs.values() if r["status"] == "ok"]
+    ok = [r for r in runs.values() if r["status"] == "ok" and not r.get("full")]
     for r in sorted(ok, key=lambda r: (r["n_tu"] >= 10, r["edge_nodes"], r["n_tu"])):
         lines.append(f"| {r['n_tu']:g} | {'edge nodes' if r['edge_nodes'] else 'paper'} | "
                      + " | ".join(format(r[k], f) for _, k, f in KEYS) + " |")
-    lines += ["", "| resolution | contact | runs | " + " | ".join(k[0] for k in KEYS[:5]) + " | Newton its |",
-              "|---" * 9 + "|"]
+    lines += ["", "| resolution | contact | runs | " + " | ".join(k[0] for k in KEYS[:5])
+              + " | Newton its | overlap mean [dx] |", "|---" * 10 + "|"]
     for fine in (False, True):
         for en in (False, True):
             sel = [r for r in ok if (r["n_tu"] >= 10) == fine and r["edge_nodes"] == en]
             if sel:
                 lines.append(f"| t_u/{10 if fine else 5} | {'edge nodes' if en else 'paper'} | {len(sel)} | "
-                             + " | ".join(stats(sel, k) for _, k, _ in KEYS[:5]) + f" | {stats(sel, 'its')} |")
+                             + " | ".join(stats(sel, k) for _, k, _ in KEYS[:5])
+                             + f" | {stats(sel, 'its')} | {stats(sel, 'overlap_mean')} |")
+    full = sorted((r for r in runs.values() if r["status"] == "ok" and r.get("full")), key=lambda r: r["edge_nodes"])
+    if full:
+        lines += ["", "Case 1's whole cut (16 t_u, 2.8 mm workpiece) at t_u/5, means over its last quarter:", "",
+                  "| contact | " + " | ".join(k[0] for k in KEYS) + " | halved steps |", "|---" * (2 + len(KEYS)) + "|"]
+        lines += [f"| {'edge nodes' if r['edge_nodes'] else 'paper'} | "
+                  + " | ".join(format(r[k], f) for _, k, f in KEYS) + f" | {r['halved']} |" for r in full]
     failed = [k for k, r in runs.items() if r["status"] != "ok"]
     if failed:
         lines += ["", "Failed: " + ", ".join(failed)]
@@ -123,22 +131,25 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--report", action="store_true", help="only the tables from the JSON")
     ap.add_argument("--fine", action="store_true", help="also the runs at t_u/10")
+    ap.add_argument("--full", action="store_true", help="also case 1's whole cut at t_u/5, both ways")
     args = ap.parse_args(argv)
     runs = load()
     if not args.report:
-        todo = [(n, en) for n in COARSE + (FINE if args.fine else ()) for en in (False, True)]
-        for n, en in todo:
-            if runs.get(key(n, en), {}).get("status") == "ok":
+        todo = [(n, en, False) for n in COARSE + (FINE if args.fine else ()) for en in (False, True)]
+        todo += [(5.0, en, True) for en in (False, True)] if args.full else []
+        for n, en, full in todo:
+            k = key(n, en, full)
+            if runs.get(k, {}).get("status") == "ok":
                 continue
             try:
-                rec = run_one(n, en)
+                rec = run_one(n, en, full)
             except Exception as e:                                   # recorded, and the sweep goes on
-                rec = dict(n_tu=n, edge_nodes=en, status="failed", error=f"{type(e).__name__}: {e}"[:500])
+                rec = dict(n_tu=n, edge_nodes=en, full=full, status="failed", error=f"{type(e).__name__}: {e}"[:500])
             runs = load()                                            # another process may have added some
-            if rec["status"] == "ok" or key(n, en) not in runs:
-                runs[key(n, en)] = rec
+            if rec["status"] == "ok" or k not in runs:
+                runs[k] = rec
                 save(runs)
-            print(key(n, en), rec["status"], {k: rec.get(k) for _, k, _ in KEYS}, flush=True)
+            print(k, rec["status"], {q: rec.get(q) for _, q, _ in KEYS}, flush=True)
     if not runs:
         print(f"no {OUT_JSON.name}: run python benchmarks/pfem_edge_phase.py first", file=sys.stderr)
         return 2

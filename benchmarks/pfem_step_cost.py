@@ -148,7 +148,9 @@ def full_report(full: list, sweep: dict | None) -> list[str]:
     names = [name for name, _, _ in MEASURES]
     lines = ["", "# The whole cut: case 1 at t_u/10 (16 t_u of cut, the sweep's 'case 1 pfem'), from its start", "",
              "Made by `python benchmarks/pfem_step_cost.py --full`: CPU and wall seconds of one uninterrupted run "
-             "(other work ran beside it), its measures beside the sweep's record of the same cut.", "",
+             "(other work ran beside it, except in the row marked 'alone': the other runs on the machine stopped, "
+             "its second core idle; the tree then differed from a069aae in benchmark data files only, not in "
+             "refsph/), its measures beside the sweep's record of the same cut.", "",
              "| version | steps | halved | nodes | Newton iterations | CPU [min] | wall [min] | " + " | ".join(names)
              + " |", "|---" * (7 + len(names)) + "|"]
     for r in full:

@@ -286,7 +286,7 @@ class CutRun:
         self.nodes = cut.nodes
         self.h, self.fixed, self.X0 = cut.h.copy(), cut.fixed.copy(), cut.X0.copy()   # per node: they change
         self.ids = np.arange(self.nodes.n, dtype=np.int64)                               # with the node rule
-        self.mesh = self.new_mesh(self.nodes)
+        self.mesh = cut_mesh(cut, self.nodes, self.h)
         self.hist_e = history_from_nodes(self.nodes, self.mesh)
         self.f_T = np.zeros(self.nodes.n)
         self.T_tool = None if cut.heat is None else np.full(len(cut.heat.x_tool), cut.heat.T_fixed)
@@ -339,7 +339,7 @@ class CutRun:
             old, hist = mesh, r.history                                 # Algorithm 1: "if remeshing is needed"
             if cut.node_rule is not None:
                 nodes, old, hist = refine_run(self, nodes, mesh, hist)
-            new = self.new_mesh(nodes)
+            new = cut_mesh(cut, nodes, self.h)
             self.hist_e, self.mesh = transfer_history(old, hist, new, nodes), new
             self.remeshes += 1
         else:
@@ -354,15 +354,6 @@ class CutRun:
         self.steps += 1
         self.wall += time.perf_counter() - t0
         return r
-
-    def new_mesh(self, nodes: Nodes) -> Mesh:
-        """Algorithm 1's mesh of the nodes (the alpha-shape), without the triangles whose centroid is inside the tool
-        where ``edge_nodes`` is set."""
-        mesh = alpha_shape_mesh(nodes.x, self.cut.alpha, self.h)
-        if not self.cut.edge_nodes:
-            return mesh
-        inside = self.cut.shape.gap(nodes.x[mesh.tri].mean(axis=1), self.cut.shift0 + self.cut.v_tool * nodes.t)[0] > 0
-        return mesh_of(mesh.tri[~inside], nodes.n, mesh.alpha) if inside.any() else mesh
 
     def tool_x(self, t: float) -> np.ndarray:
         """The tool's nodes at time t (moved rigidly)."""
@@ -430,6 +421,16 @@ class CutRun:
         run.remeshes, run.wall, run.ledger = rec["remeshes"], rec["wall"], rec["ledger"]
         run.inserted, run.removed = rec.get("inserted", 0), rec.get("removed", 0)
         return run
+
+
+def cut_mesh(cut: PFEMCut, nodes: Nodes, h: np.ndarray) -> Mesh:
+    """Algorithm 1's mesh of the nodes (the alpha-shape with spacings h), without the triangles whose centroid is
+    inside the tool where ``cut.edge_nodes`` is set."""
+    mesh = alpha_shape_mesh(nodes.x, cut.alpha, h)
+    if not cut.edge_nodes:
+        return mesh
+    inside = cut.shape.gap(nodes.x[mesh.tri].mean(axis=1), cut.shift0 + cut.v_tool * nodes.t)[0] > 0
+    return mesh_of(mesh.tri[~inside], nodes.n, mesh.alpha) if inside.any() else mesh
 
 
 def refine_run(run: "CutRun", nodes: Nodes, mesh: Mesh, hist: History):

@@ -616,13 +616,8 @@ for case in (1, 10):
               f"T_FCS {c[f'TFCS_{t}_K']:.0f} K")
 
 # %% [markdown]
-# **Where it stands.** 17 of 18 cuts run at t_u/5 (mind chapter 11's scatter, Fc 17 %); case 16's chip rings under
-# the trapezoidal rule until Newton stalls (`gamma=0.6` damps it). At t_u/10 case 1 runs to the end in 27 minutes
-# on one core. **Where it fails:** Fp/Fc is 0.14-0.40 against 0.71-0.83 measured. Coulomb friction on a 10° rake
-# face cannot give more than tan(atan μ0 − 10°) = 0.55; the rest must come from the edge and the flank. The contact
-# keeps nodes out of the tool, not triangles, so the 10 µm edge slips between two boundary nodes (0.3-0.6 of a
-# spacing deep). `pfem_cut(..., edge_nodes=True)` puts a node on the tool there: the overlap falls fivefold, Fp/Fc
-# moves by 3-4 % (`benchmarks/pfem_edge_phase.py`). The edge is not what is missing.
+# **Where it stands.** 17 of 18 cuts at t_u/5 (case 16: `gamma=0.6`); case 1 at t_u/10: 27 min. **Fails:** Fp/Fc
+# 0.14-0.40 (measured 0.71-0.83); a 10° rake face gives at most 0.55; `edge_nodes=True` moves it 3-4 %.
 
 # %% [markdown]
 # ## Your turn

@@ -75,10 +75,11 @@ def _options(options: dict, quick: bool) -> dict:
         if name not in known:
             raise ValueError(f"option {name!r} is not an option of the PFEM cut; its options: {', '.join(known)}")
         default = known[name].default
+        if isinstance(default, bool):                       # friction, conduction, refine, edge_nodes
+            out[name] = parse_bool(value, f"option {name}")  # its own message: true or false
+            continue
         try:
-            if name in ("friction", "conduction", "refine", "edge_nodes"):
-                out[name] = parse_bool(value, f"option {name}")
-            elif name == "case":
+            if name == "case":
                 out[name] = int(float(value))
             elif name == "length" and value in (None, "none"):
                 out[name] = None

@@ -106,6 +106,7 @@ def test_export_gives_paraview_the_triangles(short_run):
     (("run", "thermal_cutting", "--method", "pfem", "--set", "beta1=1"), "--set"),
     (("run", "thermal_cutting", "--method", "pfem", "--option", "mass_scale=10"), "not an option of the PFEM cut"),
     (("run", "thermal_cutting", "--method", "pfem", "--option", "n_tu=abc"), "must be a number"),
+    (("run", "thermal_cutting", "--method", "pfem", "--option", "edge_nodes=maybe"), "must be true or false"),
 ])
 def test_cli_refuses_what_the_pfem_cannot_take(args, says, tmp_path, capsys):
     assert main(list(args) + ["--out", str(tmp_path / "o")]) == 2

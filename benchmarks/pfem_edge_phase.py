@@ -46,10 +46,9 @@ KEYS = (("Fc [N/mm]", "Fc", ".1f"), ("Fp [N/mm]", "Fp", ".1f"), ("Fp/Fc", "ratio
 def overlap(run) -> float:
     """How far the tool's outline pokes through a boundary edge between its two nodes, beyond them [dx] (41 points
     along each edge; 0 where it does not)."""
-    cut, x, e = run.cut, run.nodes.x, run.mesh.edges
-    s = np.linspace(0.0, 1.0, 41)
-    P = x[e[:, 0], None, :] * (1.0 - s)[None, :, None] + x[e[:, 1], None, :] * s[None, :, None]
-    g = cut.shape.gap(P.reshape(-1, 2), cut.shift0 + cut.v_tool * run.nodes.t)[0].reshape(len(e), -1)
+    from refsph.pfem.refine import gaps_along_edges
+    cut, shift = run.cut, run.cut.shift0 + run.cut.v_tool * run.nodes.t
+    g = gaps_along_edges(run.nodes.x, run.mesh.edges, lambda x: cut.shape.gap(x, shift), 41)[1]
     inner = g[:, 1:-1].max(axis=1) - np.maximum(np.maximum(g[:, 0], g[:, -1]), 0.0)
     return float(max(inner.max(), 0.0) / cut.info["dx"])
 

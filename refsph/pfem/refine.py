@@ -48,7 +48,7 @@ from .mesh import Mesh, signed_areas, tributary_areas
 from .solid import History, Nodes
 
 __all__ = ["NodeRule", "NodeChange", "refine_nodes", "renumber_mesh", "close_pairs", "pick_merges", "pick_insertions",
-           "tool_intrusions", "owner_triangles"]
+           "tool_intrusions", "gaps_along_edges", "owner_triangles"]
 
 NODAL = ("S", "S_zz", "eps_p", "W_p", "J", "p", "a", "eps_dot")     # mass-weighted in a merge
 ELEMENT = ("S", "S_zz", "eps_p", "W_p", "J", "eps_dot")              # an inserted node takes its triangle's
@@ -136,6 +136,15 @@ def owner_triangles(tri: np.ndarray, edges: np.ndarray) -> np.ndarray:
     return np.where(hit, order[pos] % len(tri), -1)
 
 
+def gaps_along_edges(x: np.ndarray, edges: np.ndarray, gap, samples: int = 41):
+    """(points (K, S, 2), g (K, S), n (K, S, 2)): ``samples`` points evenly along each edge (K, 2), its ends
+    included, and the tool's penetration depth and outward normal there (``gap(x) -> (g, n)``)."""
+    s = np.linspace(0.0, 1.0, samples)
+    P = x[edges[:, 0], None, :] * (1.0 - s)[None, :, None] + x[edges[:, 1], None, :] * s[None, :, None]
+    g, n = gap(P.reshape(-1, 2))
+    return P, g.reshape(len(edges), samples), n.reshape(len(edges), samples, 2)
+
+
 def tool_intrusions(x: np.ndarray, mesh: Mesh, gap, depth: np.ndarray, samples: int = 41):
     """Where a convex tool's outline pokes through the body's boundary between two nodes (module text): (the
     triangles (K,), the barycentric coordinates (K, 3) in them of the tool-surface points where a node goes).
@@ -147,10 +156,7 @@ def tool_intrusions(x: np.ndarray, mesh: Mesh, gap, depth: np.ndarray, samples: 
     e = mesh.edges
     if len(e) == 0:
         return np.zeros(0, np.int64), np.zeros((0, 3))
-    s = np.linspace(0.0, 1.0, samples)
-    P = x[e[:, 0], None, :] * (1.0 - s)[None, :, None] + x[e[:, 1], None, :] * s[None, :, None]
-    g, n = gap(P.reshape(-1, 2))
-    g, n = g.reshape(len(e), samples), n.reshape(len(e), samples, 2)
+    P, g, n = gaps_along_edges(x, e, gap, samples)
     k = 1 + np.argmax(g[:, 1:-1], axis=1)
     rows = np.arange(len(e))
     g_in, d_min = g[rows, k], depth[e].mean(axis=1)

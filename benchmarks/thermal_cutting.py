@@ -683,14 +683,16 @@ def status_lines(records: dict, todo: dict, quick: bool = False) -> list[str]:
         except (OSError, ValueError):
             lines.append(f"{key:40s} to run")
             continue
+        beat = _heartbeat(path.parent, path.stat().st_mtime) if s.get("status") == "running" else None
+        if beat is not None:
+            lines.append(f"{key:40s} {s.get('status')}: {beat}")
+            continue
         t, t_end, wall = s.get("t_final") or 0.0, s.get("t_end") or float("nan"), s.get("wall_time_s") or 0.0
         left = wall * (t_end / t - 1.0) if t > 0 else float("nan")
         age = (time.time() - path.stat().st_mtime) / 60
-        line = (f"{key:40s} {s.get('status')}: t = {t * 1e3:.3f} of {t_end * 1e3:.3f} ms "
-                f"({100 * t / t_end:.0f} %), {s.get('n_steps')} steps, {wall / 60:.0f} min so far, "
-                f"about {left / 60:.0f} min to go; summary written {age:.0f} min ago")
-        beat = _heartbeat(path.parent, path.stat().st_mtime) if s.get("status") == "running" else None
-        lines.append(line if beat is None else f"{key:40s} {s.get('status')}: {beat}")
+        lines.append(f"{key:40s} {s.get('status')}: t = {t * 1e3:.3f} of {t_end * 1e3:.3f} ms "
+                     f"({100 * t / t_end:.0f} %), {s.get('n_steps')} steps, {wall / 60:.0f} min so far, "
+                     f"about {left / 60:.0f} min to go; summary written {age:.0f} min ago")
     return lines
 
 

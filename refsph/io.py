@@ -310,11 +310,27 @@ def write_json(path, data: dict) -> None:
 def write_progress(folder, t: float, t_end: float, steps: int, wall_s: float, t_begin: float) -> None:
     """A run's heartbeat, ``<folder>/progress.json``: the simulated time t and t_end [s], the steps, the simulated
     time this process began at (``t_begin``: a restart's) and its wall seconds so far, and when it was written
-    (Unix time). The run loops write it every ``HEARTBEAT_S`` (30 s), so a long run's
-    progress is known between its checkpoints (summary.json is written only at each snapshot); written atomically,
-    and not needed by anything that reads a run."""
+    (Unix time). :class:`Heartbeat` writes it every ``HEARTBEAT_S`` (30 s) of a run, so a long run's progress is
+    known between its checkpoints (summary.json is written only at each snapshot); written atomically, and not
+    needed by anything that reads a run."""
     write_json(Path(folder) / PROGRESS, dict(t=float(t), t_end=float(t_end), steps=int(steps), t_begin=float(t_begin),
                                              wall_s=float(wall_s), written=time.time()))
+
+
+class Heartbeat:
+    """The run loops' heartbeat: called after every step with (t, steps), it writes :func:`write_progress` into
+    ``folder`` once ``HEARTBEAT_S`` of wall time have passed since the last (or since it was made); ``folder``
+    None: nothing. ``t_end`` and ``t_begin`` (the simulated time this process starts at) as there."""
+
+    def __init__(self, folder, t_end: float, t_begin: float):
+        self.folder, self.t_end, self.t_begin = folder, t_end, t_begin
+        self.start = self.last = time.perf_counter()
+
+    def __call__(self, t: float, steps: int) -> None:
+        now = time.perf_counter()
+        if self.folder is not None and now - self.last >= HEARTBEAT_S:
+            self.last = now
+            write_progress(self.folder, t, self.t_end, steps, now - self.start, self.t_begin)
 
 
 def save_reactions(path, reactions: dict, dim: int) -> None:

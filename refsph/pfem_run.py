@@ -35,8 +35,7 @@ from pathlib import Path
 
 import numpy as np
 
-from . import io as rio
-from .io import claim_run_folder, read_npz, save_reactions, write_json, write_progress, write_snapshot
+from .io import Heartbeat, claim_run_folder, read_npz, save_reactions, write_json, write_snapshot
 from .material import von_mises
 from .pfem.cutting import CutRun, pfem_cut
 from .scenes.base import parse_bool
@@ -182,8 +181,8 @@ def _run_pfem(scene_name, out, options, quick, progress, restart, overwrite, max
                                                   None, prov))
     if not restart:
         running_summary()
-    status, error, t_start, steps0, t_begin = "ok", None, time.perf_counter(), run.steps, run.nodes.t
-    last_print = last_beat = 0.0
+    status, error, t_start, steps0 = "ok", None, time.perf_counter(), run.steps
+    beat, last_print = Heartbeat(out, cut.t_end, run.nodes.t), 0.0
     try:
         while not run.done and (max_steps is None or run.steps - steps0 < max_steps):
             run.step()
@@ -197,10 +196,8 @@ def _run_pfem(scene_name, out, options, quick, progress, restart, overwrite, max
                     next_snap += 1
                 _checkpoint(snaps_dir, run, snapshots, next_snap)
                 running_summary()
+            beat(run.nodes.t, run.steps)                    # the heartbeat between checkpoints
             now = time.perf_counter()
-            if now - last_beat >= rio.HEARTBEAT_S:          # the heartbeat between checkpoints
-                last_beat = now
-                write_progress(out, run.nodes.t, cut.t_end, run.steps, now - t_start, t_begin)
             if progress and now - last_print > 2.0:
                 last_print = now
                 F = run.reaction["tool"][-1]

@@ -46,9 +46,8 @@ from .stability import warnings_for
 from .strength import heat_capacity, heats
 from .thermal import HeatFlow
 from .boundaries import Clamp
-from . import io as rio
-from .io import (claim_run_folder, json_ready, save_reactions, save_snapshot, state_from_particles,
-                 state_from_snapshot, write_json, write_progress)
+from .io import (Heartbeat, claim_run_folder, json_ready, save_reactions, save_snapshot, state_from_particles,
+                 state_from_snapshot, write_json)
 from .kernels import get_kernel
 from .neighbours import check_threads
 from .scenes import Scene, Setup, get_scene
@@ -443,18 +442,16 @@ def _warn_fixed_dt(setup: Setup, dt: float | None, state: State) -> None:
 
 
 class _Progress:
-    """A progress line on stderr every 2 s; with a run ``folder``, its heartbeat every ``refsph.io.HEARTBEAT_S``
-    (:func:`refsph.io.write_progress`)."""
+    """A progress line on stderr every 2 s; with a run ``folder``, its heartbeat (:class:`refsph.io.Heartbeat`)."""
 
     def __init__(self, tag: str, t_end: float, on: bool, folder: Path | None = None, t_begin: float = 0.0):
-        self.tag, self.t_end, self.on, self.folder, self.t_begin = tag, t_end, on, folder, t_begin
-        self.t0 = self.last = self.beat = time.perf_counter()
+        self.tag, self.t_end, self.on = tag, t_end, on
+        self.beat = Heartbeat(folder, t_end, t_begin)
+        self.t0 = self.last = time.perf_counter()
 
     def __call__(self, n_steps: int, t: float, dt: float) -> None:
+        self.beat(t, n_steps)
         now = time.perf_counter()
-        if self.folder is not None and now - self.beat >= rio.HEARTBEAT_S:
-            self.beat = now
-            write_progress(self.folder, t, self.t_end, n_steps, now - self.t0, self.t_begin)
         if self.on and now - self.last > 2.0:
             frac, el = t / self.t_end, now - self.t0
             print(f"[{self.tag}] step {n_steps:6d}  t = {t:.3e} s ({100 * frac:5.1f} %)  dt = {dt:.2e} s  "

@@ -685,7 +685,7 @@ def status_lines(records: dict, todo: dict, quick: bool = False) -> list[str]:
             continue
         beat = _heartbeat(path.parent, path.stat().st_mtime) if s.get("status") == "running" else None
         if beat is not None:
-            lines.append(f"{key:40s} {s.get('status')}: {beat}")
+            lines.append(f"{key:40s} {beat}")
             continue
         t, t_end, wall = s.get("t_final") or 0.0, s.get("t_end") or float("nan"), s.get("wall_time_s") or 0.0
         left = wall * (t_end / t - 1.0) if t > 0 else float("nan")
@@ -697,8 +697,9 @@ def status_lines(records: dict, todo: dict, quick: bool = False) -> list[str]:
 
 
 def _heartbeat(folder: Path, summary_written: float) -> str | None:
-    """The run's progress from its heartbeat (:func:`refsph.io.write_progress`, every 30 s) where that is newer than
-    its summary: t, steps, this process's rate and the time to go; None without one."""
+    """The run's state from its heartbeat (:func:`refsph.io.write_progress`, every 30 s) where that is newer than
+    its summary: 'running: ' t, steps, this process's rate and the time to go; or 'stopped: ' where the process that
+    wrote it is gone (:func:`refsph.io.writer_alive`: a killed run, or a machine restarted); None without one."""
     try:
         b = json.loads((folder / "progress.json").read_text())
     except (OSError, ValueError):
@@ -706,10 +707,15 @@ def _heartbeat(folder: Path, summary_written: float) -> str | None:
     if b.get("written", 0.0) <= summary_written:
         return None
     t, t_end, t0, wall = b["t"], b["t_end"], b.get("t_begin", 0.0), b["wall_s"]
+    age = (time.time() - b["written"]) / 60
+    from refsph.io import writer_alive
+    if writer_alive(b) is False:
+        return (f"stopped: its process ({b['pid']}) is gone, last heard of {age:.0f} min ago at t = {t * 1e3:.3f} of "
+                f"{t_end * 1e3:.3f} ms ({100 * t / t_end:.0f} %); a rerun of the key continues from its last "
+                "checkpoint")
     left = wall * (t_end - t) / (t - t0) if t > t0 else float("nan")
-    return (f"t = {t * 1e3:.3f} of {t_end * 1e3:.3f} ms ({100 * t / t_end:.0f} %), {b['steps']} steps, this process "
-            f"{wall / 60:.0f} min, about {left / 60:.0f} min to go; heartbeat "
-            f"{(time.time() - b['written']) / 60:.0f} min ago")
+    return (f"running: t = {t * 1e3:.3f} of {t_end * 1e3:.3f} ms ({100 * t / t_end:.0f} %), {b['steps']} steps, "
+            f"this process {wall / 60:.0f} min, about {left / 60:.0f} min to go; heartbeat {age:.0f} min ago")
 
 
 def backfill_cpu(st) -> list[str]:

@@ -45,6 +45,7 @@ from __future__ import annotations
 import json
 import zipfile
 import os
+import socket
 import time
 from pathlib import Path
 
@@ -309,12 +310,30 @@ def write_json(path, data: dict) -> None:
 
 def write_progress(folder, t: float, t_end: float, steps: int, wall_s: float, t_begin: float) -> None:
     """A run's heartbeat, ``<folder>/progress.json``: the simulated time t and t_end [s], the steps, the simulated
-    time this process began at (``t_begin``: a restart's) and its wall seconds so far, and when it was written
-    (Unix time). :class:`Heartbeat` writes it every ``HEARTBEAT_S`` (30 s) of a run, so a long run's progress is
-    known between its checkpoints (summary.json is written only at each snapshot); written atomically, and not
-    needed by anything that reads a run."""
+    time this process began at (``t_begin``: a restart's) and its wall seconds so far, when it was written (Unix
+    time), and the process that wrote it (``pid``, ``host``: a reader on that machine can tell a run whose process is
+    gone, :func:`writer_alive`). :class:`Heartbeat` writes it every ``HEARTBEAT_S`` (30 s) of a run, so a long run's
+    progress is known between its checkpoints (summary.json is written only at each snapshot); written atomically,
+    and not needed by anything that reads a run."""
     write_json(Path(folder) / PROGRESS, dict(t=float(t), t_end=float(t_end), steps=int(steps), t_begin=float(t_begin),
-                                             wall_s=float(wall_s), written=time.time()))
+                                             wall_s=float(wall_s), written=time.time(), pid=os.getpid(),
+                                             host=socket.gethostname()))
+
+
+def writer_alive(beat: dict) -> bool | None:
+    """Whether the process that wrote the heartbeat ``beat`` (:func:`write_progress`'s fields) still runs: None
+    where that cannot be told (written elsewhere, or by a version without ``pid``). A process id can be taken again
+    by another process after a restart of the machine, so True means only "some process has that id"."""
+    pid = beat.get("pid")
+    if pid is None or beat.get("host") != socket.gethostname():
+        return None
+    try:
+        os.kill(int(pid), 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:                 # alive, another user's
+        return True
+    return True
 
 
 class Heartbeat:

@@ -44,3 +44,24 @@ def test_the_sweep_status_reads_a_newer_heartbeat(tmp_path, monkeypatch):
     line, = tc.status_lines({}, {"case 1 pfem": None})
     assert "t = 0.800 of 1.600 ms (50 %), 400 steps" in line and "about 27 min to go" in line
     assert "heartbeat 0 min ago" in line
+
+
+def test_the_sweep_status_says_a_run_whose_process_is_gone_stopped(tmp_path, monkeypatch):
+    import subprocess
+    import sys
+    import thermal_cutting as tc
+    monkeypatch.setattr(tc, "RUNS", tmp_path)
+    folder = tc.run_folder("case 1 pfem")
+    folder.mkdir(parents=True)
+    (folder / "summary.json").write_text(json.dumps(dict(status="running", t_final=0.2e-3, t_end=1.6e-3)))
+    old = time.time() - 3600
+    os.utime(folder / "summary.json", (old, old))
+    rio.write_progress(folder, 0.8e-3, 1.6e-3, 400, 1200.0, 0.2e-3)
+    beat = json.loads((folder / "progress.json").read_text())
+    assert beat["pid"] == os.getpid() and rio.writer_alive(beat) is True
+    gone = subprocess.Popen([sys.executable, "-c", "pass"])
+    gone.wait()                                                         # a process id that no process has now
+    (folder / "progress.json").write_text(json.dumps(dict(beat, pid=gone.pid)))
+    line, = tc.status_lines({}, {"case 1 pfem": None})
+    assert f"stopped: its process ({gone.pid}) is gone" in line and "t = 0.800 of 1.600 ms (50 %)" in line
+    assert rio.writer_alive(dict(beat, host="another machine")) is None

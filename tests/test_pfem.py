@@ -384,6 +384,28 @@ def test_a_frozen_slip_turned_against_its_direction_sticks():
     assert c.slip[0] == 0.0 and c.slip[1] == first[1]
 
 
+def test_a_kept_slip_turned_against_its_direction_sticks_when_sets_grow():
+    """StepContact.freeze with ``grow``: a node kept sliding whose trial force now points against its slip is made to
+    stick for the step at once (kept sliding, its friction would push it the way it goes: case 8 at t_u/10 spent 80
+    Newton corrections so, every second step, before stick_reversed caught it); a kept slip whose trial force still
+    points its way stays."""
+    from refsph.contact import CoulombFriction
+    from refsph.penalty import RoundedPolygon
+    from refsph.pfem.contact import StepContact, ToolContact
+    flat = RoundedPolygon.from_polygon([[-1e-3, -1e-3], [3e-3, -1e-3], [3e-3, 0.0], [-1e-3, 0.0]], 0.0, [0.0, 0.0])
+    params = ToolContact(k_normal=1e12, k_tangent=1e12,
+                         friction=CoulombFriction(mu0=0.3, q=1.0, T_room=293.0, T_melt=1800.0))
+    x_n = np.array([[0.0, -1e-7], [1e-4, -1e-7]])                      # both 1e-7 deep: cap 3 N/m
+    c = StepContact(params, flat, [0.0, 0.0], [0.0, 0.0], x_n, np.zeros(2), np.full(2, 293.0), np.full(2, 1e-4),
+                    np.arange(2))
+    c.freeze(x_n + [[1e-7, 0.0], [1e-7, 0.0]])                          # both slide one way (trial -10 N/m)
+    first = c.slip.copy()
+    assert np.all(first != 0)
+    assert c.freeze(x_n + [[-1e-8, 0.0], [2e-7, 0.0]], grow=True)      # the first's trial turned (+1 N/m, in the cap)
+    assert c.slip[0] == 0.0 and c.stuck[0] and c.slip[1] == first[1] and not c.stuck[1]
+    assert not c.freeze(x_n + [[-1e-8, 0.0], [2e-7, 0.0]], grow=True)  # and nothing changes after that
+
+
 def test_solve_linear_fast_path_and_fallback():
     """solve_linear: the diagonal-pivot SuperLU path solves a PFEM-like matrix; a matrix whose diagonal vanishes
     (where diagonal pivots fail) falls back to partial pivoting and is still solved."""

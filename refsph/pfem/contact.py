@@ -79,7 +79,10 @@ class StepContact:
         grazing the tool, or at the friction cap, in and out on alternate solves) settle. A node that slipped one
         way and whose trial force now points the other way beyond the cap sticks (slip 0) rather than slips back,
         as a return map from a slip state would: neither slip direction may be consistent (the stagnation node at
-        the tool's edge radius, where the chip and the machined surface part, flipped between them forever)."""
+        the tool's edge radius, where the chip and the machined surface part, flipped between them forever). With
+        ``grow``, a slip kept whose trial force now points against it sticks for the step at once (as
+        :meth:`stick_reversed` does after a failed solve: kept sliding, its friction pushes it the way it goes and the
+        solve stalls; case 8 at t_u/10 spent 80 Newton corrections so on every second step)."""
         idx = self.nodes
         saved, self.active, self.slip = (self.active, self.slip), None, None
         res = self.forces(x_new[idx], idx)
@@ -92,6 +95,9 @@ class StepContact:
             slip[(saved[1] != 0) & (slip == -saved[1])] = 0.0         # a slip that reverses sticks first
         if grow and saved[0] is not None:
             active |= saved[0]
+            turned = np.zeros(len(x_new), bool)                   # a kept slip whose trial force turned against it
+            turned[idx] = (saved[1][idx] != 0) & (np.sign(trial) == -saved[1][idx])
+            self.stuck |= turned                                  # sticks for the step (stick_reversed's rule)
             slip = np.where(saved[1] != 0, saved[1], slip)
         slip[self.stuck] = 0.0
         changed = saved[0] is None or not (np.array_equal(saved[0], active) and np.array_equal(saved[1], slip))

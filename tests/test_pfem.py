@@ -406,6 +406,28 @@ def test_a_kept_slip_turned_against_its_direction_sticks_when_sets_grow():
     assert not c.freeze(x_n + [[-1e-8, 0.0], [2e-7, 0.0]], grow=True)  # and nothing changes after that
 
 
+def test_a_frozen_contact_node_off_the_tool_is_pulled_back_without_friction():
+    """StepContact.forces with frozen sets: a node of the contact set that has left the tool (g < 0) gets the
+    penalty's pull f_N = k_N l g < 0 and no friction (cap mu max(f_N, 0)); with the cap mu f_N a frozen slip's
+    friction turned and pushed the node along (case 8 at t_u/10)."""
+    from refsph.contact import CoulombFriction
+    from refsph.penalty import RoundedPolygon
+    from refsph.pfem.contact import StepContact, ToolContact
+    flat = RoundedPolygon.from_polygon([[-1e-3, -1e-3], [3e-3, -1e-3], [3e-3, 0.0], [-1e-3, 0.0]], 0.0, [0.0, 0.0])
+    params = ToolContact(k_normal=1e12, k_tangent=1e12,
+                         friction=CoulombFriction(mu0=0.3, q=1.0, T_room=293.0, T_melt=1800.0))
+    x_n = np.array([[0.0, -1e-7]])
+    c = StepContact(params, flat, [0.0, 0.0], [0.0, 0.0], x_n, np.zeros(1), np.full(1, 293.0), np.full(1, 1e-4),
+                    np.arange(1))
+    c.freeze(x_n + [[1e-7, 0.0]])                                       # in contact, sliding
+    assert c.active[0] and c.slip[0] != 0
+    inside = c.forces(x_n + [[1e-7, 0.0]], np.arange(1))
+    assert inside["f_N"][0] > 0 and np.isclose(abs(inside["f_T"][0]), 0.3 * inside["f_N"][0])
+    off = c.forces(x_n + [[1e-7, 2e-7]], np.arange(1))                 # 1e-7 off the tool, still frozen active
+    assert off["f_N"][0] < 0 and off["f_T"][0] == 0.0
+    assert np.allclose(off["f"][0], [0.0, off["f_N"][0]])              # the pull along the normal only
+
+
 def test_solve_linear_fast_path_and_fallback():
     """solve_linear: the diagonal-pivot SuperLU path solves a PFEM-like matrix; a matrix whose diagonal vanishes
     (where diagonal pivots fail) falls back to partial pivoting and is still solved."""

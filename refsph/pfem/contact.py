@@ -14,6 +14,12 @@ boundary node i with penetration g_i > 0 (inside the tool), outward tool normal 
             = mu(T_i) f_N,i sign(f_T,i*)        otherwise                         (slip: the return map)
     f_i     = f_N,i n_i + f_T,i t_i,            the force on the tool: -sum_i f_i
 
+Within a solve with frozen sets (:func:`solve_with_active_set`) a node of the contact set that has left the tool
+(g_i < 0) is pulled back by the same f_N,i < 0 (the active set's constraint, until the sets are looked at again),
+but carries no friction: the cap is mu(T_i) max(f_N,i, 0). With mu f_N,i itself the cap's sign turned, and a frozen
+slip's friction pushed the node the way it went (seen in case 8 at t_u/10, 0.568 ms, where Newton stalls: a node
+flung 48 um in a step of 1.25 us; the stall itself outlived this mend, chapter 12).
+
 k_N, k_T [Pa/m] are penalties per unit penetration and per unit length of boundary; a few hundred times G / h
 keeps the penetration below 1 % of the spacing. mu(T) is :class:`refsph.contact.CoulombFriction` (the second
 paper's Eqs. (10)-(11)) at the node's temperature of the last heat step (the staggered scheme of Section 2.3.3).
@@ -129,7 +135,7 @@ class StepContact:
         fN = np.where(on, self.p.k_normal * li * g, 0.0)
         s = np.einsum("nd,nd->n", x - self.x_n[idx] - self.du_tool, t)
         trial = self.f_T_n[idx] - self.p.k_tangent * li * s
-        cap = self.mu[idx] * fN
+        cap = self.mu[idx] * np.maximum(fN, 0.0)            # no friction from a pull (module text)
         if self.slip is None:
             fT = np.where(on, np.clip(trial, -cap, cap), 0.0)
         else:

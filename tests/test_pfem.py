@@ -318,18 +318,25 @@ def test_graded_workpiece_is_held_along_its_bottom_and_left(n_tu):
     assert held[cut.nodes.x[:, 1] == 0.0].sum() > 10
 
 
-def test_contact_sets_that_grow_end_a_cycle():
-    """StepContact.freeze: a node grazing the tool that leaves the contact set on the next solve changes the sets
-    (a cycle can follow); with ``grow`` it keeps its place, so the sets stop changing."""
+def flat_tool_contact(x_n):
+    """The contact of one step between nodes at x_n (N, 2) and a rigid flat tool below y = 0 at rest: penalties 1e12
+    Pa/m, mu 0.3 at 293 K, tributary lengths 1e-4 m, no tangential force at t_n."""
     from refsph.contact import CoulombFriction
     from refsph.penalty import RoundedPolygon
     from refsph.pfem.contact import StepContact, ToolContact
     flat = RoundedPolygon.from_polygon([[-1e-3, -1e-3], [3e-3, -1e-3], [3e-3, 0.0], [-1e-3, 0.0]], 0.0, [0.0, 0.0])
     params = ToolContact(k_normal=1e12, k_tangent=1e12,
                          friction=CoulombFriction(mu0=0.3, q=1.0, T_room=293.0, T_melt=1800.0))
+    n = len(x_n)
+    return StepContact(params, flat, [0.0, 0.0], [0.0, 0.0], x_n, np.zeros(n), np.full(n, 293.0), np.full(n, 1e-4),
+                       np.arange(n))
+
+
+def test_contact_sets_that_grow_end_a_cycle():
+    """StepContact.freeze: a node grazing the tool that leaves the contact set on the next solve changes the sets
+    (a cycle can follow); with ``grow`` it keeps its place, so the sets stop changing."""
     x = np.array([[0.0, 1e-4], [1e-4, 1e-4]])
-    c = StepContact(params, flat, [0.0, 0.0], [0.0, 0.0], x, np.zeros(2), np.full(2, 293.0), np.full(2, 1e-4),
-                    np.arange(2))
+    c = flat_tool_contact(x)
     inside, outside = x - [0.0, 1e-4 + 1e-9], x - [0.0, 1e-4 - 1e-9]
     assert c.freeze(inside) and c.active.all()
     assert c.freeze(outside) and not c.active.any()                  # plain: the grazing nodes leave, then return
@@ -342,15 +349,8 @@ def test_a_slip_that_reverses_sticks_first():
     way beyond the cap sticks (slip 0) rather than slips back; the solve after that decides. Without the rule the
     stagnation node at the tool's edge radius flipped between slipping forwards and backwards on alternate solves
     (case 1's short cut at t_u / 10, step 28: 297 Newton iterations and three halved steps, now 33)."""
-    from refsph.contact import CoulombFriction
-    from refsph.penalty import RoundedPolygon
-    from refsph.pfem.contact import StepContact, ToolContact
-    flat = RoundedPolygon.from_polygon([[-1e-3, -1e-3], [3e-3, -1e-3], [3e-3, 0.0], [-1e-3, 0.0]], 0.0, [0.0, 0.0])
-    params = ToolContact(k_normal=1e12, k_tangent=1e12,
-                         friction=CoulombFriction(mu0=0.3, q=1.0, T_room=293.0, T_melt=1800.0))
     x_n = np.array([[0.0, -1e-7]])                                      # 1e-7 deep: f_N = 10 N/m, cap 3 N/m
-    c = StepContact(params, flat, [0.0, 0.0], [0.0, 0.0], x_n, np.zeros(1), np.full(1, 293.0), np.full(1, 1e-4),
-                    np.arange(1))
+    c = flat_tool_contact(x_n)
     forwards, backwards = x_n + [1e-7, 0.0], x_n - [1e-7, 0.0]           # trial forces +-10 N/m, beyond the cap
     c.freeze(forwards)
     first = c.slip[0]
@@ -364,15 +364,8 @@ def test_a_frozen_slip_turned_against_its_direction_sticks():
     solve's last iterate points the other way is made to stick for the step (its frozen friction would push it the
     way it goes, and the solve cannot settle: case 1 at t_u/10, 1.393 ms); a node whose trial force still points
     its way, and a contact with no frozen sets, are left alone."""
-    from refsph.contact import CoulombFriction
-    from refsph.penalty import RoundedPolygon
-    from refsph.pfem.contact import StepContact, ToolContact
-    flat = RoundedPolygon.from_polygon([[-1e-3, -1e-3], [3e-3, -1e-3], [3e-3, 0.0], [-1e-3, 0.0]], 0.0, [0.0, 0.0])
-    params = ToolContact(k_normal=1e12, k_tangent=1e12,
-                         friction=CoulombFriction(mu0=0.3, q=1.0, T_room=293.0, T_melt=1800.0))
     x_n = np.array([[0.0, -1e-7], [1e-4, -1e-7]])                      # both 1e-7 deep: cap 3 N/m
-    c = StepContact(params, flat, [0.0, 0.0], [0.0, 0.0], x_n, np.zeros(2), np.full(2, 293.0), np.full(2, 1e-4),
-                    np.arange(2))
+    c = flat_tool_contact(x_n)
     assert not c.stick_reversed(x_n)                                    # no frozen sets: nothing to do
     c.freeze(x_n + [[1e-7, 0.0], [1e-7, 0.0]])                          # both slide one way (trial -10 N/m)
     first = c.slip.copy()
@@ -389,15 +382,8 @@ def test_a_kept_slip_turned_against_its_direction_sticks_when_sets_grow():
     stick for the step at once (kept sliding, its friction would push it the way it goes: case 8 at t_u/10 spent 80
     Newton corrections so, every second step, before stick_reversed caught it); a kept slip whose trial force still
     points its way stays."""
-    from refsph.contact import CoulombFriction
-    from refsph.penalty import RoundedPolygon
-    from refsph.pfem.contact import StepContact, ToolContact
-    flat = RoundedPolygon.from_polygon([[-1e-3, -1e-3], [3e-3, -1e-3], [3e-3, 0.0], [-1e-3, 0.0]], 0.0, [0.0, 0.0])
-    params = ToolContact(k_normal=1e12, k_tangent=1e12,
-                         friction=CoulombFriction(mu0=0.3, q=1.0, T_room=293.0, T_melt=1800.0))
     x_n = np.array([[0.0, -1e-7], [1e-4, -1e-7]])                      # both 1e-7 deep: cap 3 N/m
-    c = StepContact(params, flat, [0.0, 0.0], [0.0, 0.0], x_n, np.zeros(2), np.full(2, 293.0), np.full(2, 1e-4),
-                    np.arange(2))
+    c = flat_tool_contact(x_n)
     c.freeze(x_n + [[1e-7, 0.0], [1e-7, 0.0]])                          # both slide one way (trial -10 N/m)
     first = c.slip.copy()
     assert np.all(first != 0)
@@ -410,15 +396,8 @@ def test_a_frozen_contact_node_off_the_tool_is_pulled_back_without_friction():
     """StepContact.forces with frozen sets: a node of the contact set that has left the tool (g < 0) gets the
     penalty's pull f_N = k_N l g < 0 and no friction (cap mu max(f_N, 0)); with the cap mu f_N a frozen slip's
     friction turned and pushed the node along (case 8 at t_u/10)."""
-    from refsph.contact import CoulombFriction
-    from refsph.penalty import RoundedPolygon
-    from refsph.pfem.contact import StepContact, ToolContact
-    flat = RoundedPolygon.from_polygon([[-1e-3, -1e-3], [3e-3, -1e-3], [3e-3, 0.0], [-1e-3, 0.0]], 0.0, [0.0, 0.0])
-    params = ToolContact(k_normal=1e12, k_tangent=1e12,
-                         friction=CoulombFriction(mu0=0.3, q=1.0, T_room=293.0, T_melt=1800.0))
     x_n = np.array([[0.0, -1e-7]])
-    c = StepContact(params, flat, [0.0, 0.0], [0.0, 0.0], x_n, np.zeros(1), np.full(1, 293.0), np.full(1, 1e-4),
-                    np.arange(1))
+    c = flat_tool_contact(x_n)
     c.freeze(x_n + [[1e-7, 0.0]])                                       # in contact, sliding
     assert c.active[0] and c.slip[0] != 0
     inside = c.forces(x_n + [[1e-7, 0.0]], np.arange(1))

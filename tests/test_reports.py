@@ -187,3 +187,20 @@ def test_thermal_cutting_takes_a_failed_case_again_at_half_the_step():
     assert rows[7]["status"] == "to run"
     del res["runs"]["case 9" + mod.RETRY]
     assert {r["case"]: r for r in mod.comparison(res)}[9]["status"] == "error"
+
+
+def test_thermal_cutting_takes_a_failed_pfem_case_with_the_damped_rule():
+    """thermal_cutting.comparison of the PFEM at t_u/10: a case that failed with the trapezoidal rule takes its run
+    with gamma 0.6 ('case N pfem' + DAMPED) where that one is 'ok', and its row says so; the t_u/5 PFEM table and
+    the SPH table do not take it."""
+    mod = _script("thermal_cutting")
+    runs = json.loads((ROOT / "benchmarks" / "thermal_cutting.json").read_text())["runs"]
+    ok = next(r for r in runs.values() if r["status"] == "ok" and r.get("metrics"))
+    res = dict(runs={"case 8 pfem": dict(status="failed", error="NewtonFailed"), "case 8 pfem" + mod.DAMPED: ok,
+                     "case 8 pfem n_tu 5": dict(status="failed"), "case 8 pfem n_tu 5" + mod.DAMPED: ok})
+    rows = {r["case"]: r for r in mod.comparison(res, mod.PFEM10)}
+    assert rows[8]["status"] == "ok" and rows[8]["key"] == "case 8 pfem" + mod.DAMPED
+    assert "ok (gamma 0.6)" in mod._case_line(rows[8])
+    assert {r["case"]: r for r in mod.comparison(res, mod.PFEM)}[8]["status"] == "failed"
+    del res["runs"]["case 8 pfem" + mod.DAMPED]
+    assert {r["case"]: r for r in mod.comparison(res, mod.PFEM10)}[8]["status"] == "failed"

@@ -709,12 +709,13 @@ def _heartbeat(folder: Path, summary_written: float) -> str | None:
         b = json.loads((folder / "progress.json").read_text())
     except (OSError, ValueError):
         return None
-    if b.get("written", 0.0) <= summary_written:
+    from refsph.io import writer_alive
+    gone = writer_alive(b) is False                          # also where the summary is newer (killed after it)
+    if b.get("written", 0.0) <= summary_written and not gone:
         return None
     t, t_end, t0, wall = b["t"], b["t_end"], b.get("t_begin", 0.0), b["wall_s"]
     age = (time.time() - b["written"]) / 60
-    from refsph.io import writer_alive
-    if writer_alive(b) is False:
+    if gone:
         return (f"stopped: its process ({b['pid']}) is gone, last heard of {age:.0f} min ago at t = {t * 1e3:.3f} of "
                 f"{t_end * 1e3:.3f} ms ({100 * t / t_end:.0f} %); a rerun of the key continues from its last "
                 "checkpoint")

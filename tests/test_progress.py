@@ -64,4 +64,8 @@ def test_the_sweep_status_says_a_run_whose_process_is_gone_stopped(tmp_path, mon
     (folder / "progress.json").write_text(json.dumps(dict(beat, pid=gone.pid)))
     line, = tc.status_lines({}, {"case 1 pfem": None})
     assert f"stopped: its process ({gone.pid}) is gone" in line and "t = 0.800 of 1.600 ms (50 %)" in line
+    later = time.time() + 10                                            # killed just after writing its summary
+    os.utime(folder / "summary.json", (later, later))
+    line, = tc.status_lines({}, {"case 1 pfem": None})
+    assert "stopped: its process" in line
     assert rio.writer_alive(dict(beat, host="another machine")) is None

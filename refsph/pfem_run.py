@@ -38,8 +38,13 @@ import numpy as np
 from .io import Heartbeat, claim_run_folder, read_npz, save_reactions, write_json, write_snapshot
 from .material import von_mises
 from .pfem.cutting import CutRun, pfem_cut
+from .pfem.solid import TRAPEZOIDAL, NewtonFailed
 from .scenes.base import parse_bool
 from .simulate import SimulationError, earlier_commits, provenance
+
+RINGING_HINT = (" [with the paper's trapezoidal rule the chip's ringing is undamped late in a cut, and Newton can "
+                "stall there (README, PFEM: cases 8 and 16); Newmark's damped rule, --option gamma=0.6 (a departure "
+                "from the paper), ran case 16 at t_u/5 to its end]")
 
 __all__ = ["run_pfem", "restart_pfem", "one_blas_thread", "is_pfem_run", "pfem_options", "PFEM_SCENES", "QUICK",
            "N_SNAPSHOTS", "PFEMRunResult"]
@@ -205,7 +210,8 @@ def _run_pfem(scene_name, out, options, quick, progress, restart, overwrite, max
                       f"({100 * run.nodes.t / cut.t_end:5.1f} %)  Fc = {F[0] / 1e3:7.1f} N/mm  "
                       f"Newton {run.iterations[-1]:3d}  elapsed {now - t_start:7.1f} s", file=sys.stderr, flush=True)
     except Exception as e:                                  # a failed Newton, a non-finite state: kept, not lost
-        status, error = "failed", f"{type(e).__name__}: {e}"
+        status, error = "failed", f"{type(e).__name__}: {e}" + (RINGING_HINT if isinstance(e, NewtonFailed)
+                                                                 and run.cut.newmark is TRAPEZOIDAL else "")
         _snapshot(snaps_dir / "last_good.npz", run)
     res = run.result()
     reaction = {k: np.asarray(v, dtype=float) for k, v in run.reaction.items()}

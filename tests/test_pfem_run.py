@@ -200,3 +200,27 @@ def test_a_pfem_run_holds_blas_at_one_thread(monkeypatch):
     monkeypatch.setattr(builtins, "__import__", lambda name, *a, **k: (_ for _ in ()).throw(ImportError(name))
                         if name == "threadpoolctl" else real_import(name, *a, **k))
     assert isinstance(pr.one_blas_thread(), contextlib.nullcontext)
+
+
+def test_a_stalled_newton_with_the_trapezoidal_rule_names_the_damped_rule(tmp_path, monkeypatch):
+    """A run whose Newton fails with the paper's trapezoidal rule says, in its error and summary, that the damped
+    rule (--option gamma=0.6, a departure) exists; with the damped rule the same failure does not repeat the hint."""
+    from refsph.pfem.cutting import CutRun
+    from refsph.pfem.solid import NewtonFailed
+    from refsph.simulate import SimulationError
+
+    step, calls = CutRun.step, []
+
+    def stalls(self):
+        calls.append(1)
+        if len(calls) % 3 == 0:
+            raise NewtonFailed("PFEM cut: Newton failed (a test)", [], None)
+        return step(self)
+    monkeypatch.setattr(CutRun, "step", stalls)
+    for gamma, hinted in ((0.5, True), (0.6, False)):
+        out = tmp_path / f"gamma_{gamma}"
+        with pytest.raises(SimulationError) as info:
+            run_pfem("thermal_cutting", out=out, options=dict(SHORT, gamma=gamma), quick=True, progress=False)
+        s = json.loads((out / "summary.json").read_text())
+        assert s["status"] == "failed" and "Newton failed (a test)" in s["error"]
+        assert ("--option gamma=0.6" in str(info.value)) == hinted and ("--option gamma=0.6" in s["error"]) == hinted

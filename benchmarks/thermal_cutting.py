@@ -97,7 +97,8 @@ RETRY = f" courant {RETRY_COURANT:g}"        # under the key 'case N' + RETRY
 DAMPED_GAMMA = 0.6                         # a PFEM case of the t_u / 10 table that failed with the trapezoidal rule,
 DAMPED = f" n_tu 10 gamma {DAMPED_GAMMA:g}"  # again with Newmark's damped rule, under 'case N pfem' + DAMPED
 RETRIES = {"": RETRY, PFEM10: DAMPED}      # the tables that take such a run for a failed case's row
-PFEM_OPTIONS = ("case", "n_tu", "travel", "length", "gamma")   # the sweep's options the PFEM cut takes (tool: TOOL)
+PFEM_OPTIONS = ("case", "n_tu", "travel", "length", "gamma", "remesh_when_needed")   # those the PFEM cut takes
+REMESH = " remesh when needed"              # the key suffix of a PFEM cut that remeshes only where the quality asks
 
 
 def sweep_numerics(n_tu: float = N_TU, **more) -> dict:
@@ -163,11 +164,8 @@ def jobs(studies=STUDY_NAMES, only=None) -> dict:
         add("cases", f"case {n}", converged(n), sweep_numerics())
     for n in (1, 2):                                          # the scene's step at t_u/10 (the first runs)
         add("timestep", f"case {n} courant 0.3", converged(n))
-    add("timestep", f"case 10{COARSE} courant 0.15", converged(10, n_tu=5.0), dict(courant=COURANT))
-    add("timestep", f"case 1{COARSE} courant 0.15", converged(1, n_tu=5.0), dict(courant=0.15))
-    add("timestep", f"case 2{COARSE} courant 0.15", converged(2, n_tu=5.0), dict(courant=0.15))
-    add("timestep", f"case 10{COARSE} courant 0.075", converged(10, n_tu=5.0), dict(courant=0.075))
-    add("timestep", f"case 1{COARSE} courant 0.075", converged(1, n_tu=5.0), dict(courant=0.075))
+    for n, c in ((10, COURANT), (1, 0.15), (2, 0.15), (10, 0.075), (1, 0.075)):   # the step at t_u/5
+        add("timestep", f"case {n}{COARSE} courant {c:g}", converged(n, n_tu=5.0), dict(courant=c))
     # the tool and workpiece checks (the first sweep's tool 5 x 3 t_u and 4 t_u uncut, one change at a time)
     add("tool", "case 1 n_tu 5 tool 5x3, 4 t_u uncut", converged(1, n_tu=5.0, uncut=4.0, **SMALL))
     add("tool", "case 1 n_tu 5 tool 5x3, 8 t_u uncut", converged(1, n_tu=5.0, uncut=8.0, **SMALL))
@@ -185,7 +183,17 @@ def jobs(studies=STUDY_NAMES, only=None) -> dict:
         add("pfem", f"case {n}{PFEM10}", converged(n, n_tu=10.0), dict(method="pfem"))
     for n in (16, 8):                                        # the trapezoidal rule rings and Newton stalls (DAMPED)
         add("pfem", f"case {n}{PFEM10}{DAMPED}", dict(converged(n, n_tu=10.0), gamma=DAMPED_GAMMA), dict(method="pfem"))
+    for key, options in remesh_jobs():                       # Algorithm 1's "if remeshing is needed", literally
+        add("pfem", key, options, dict(method="pfem"))
     return todo
+
+
+def remesh_jobs() -> list[tuple[str, dict]]:
+    """(key, options) of the PFEM cuts that remesh only where a triangle's quality falls below 0.3
+    (``remesh_when_needed``), beside the sweep's (a remeshing after every step): cases 1, 5 and 10 at t_u / 5, then
+    case 1 at t_u / 10."""
+    return ([(f"case {n}{PFEM}{REMESH}", dict(converged(n, n_tu=5.0), remesh_when_needed=True)) for n in (1, 5, 10)]
+            + [(f"case 1{PFEM10}{REMESH}", dict(converged(1, n_tu=10.0), remesh_when_needed=True))])
 
 
 QUICK = dict(length=1.2e-3, travel=4.0, n_tu=5.0)   # --quick: chapter 11's short cut at the quick resolution
@@ -561,6 +569,12 @@ STUDIES = (
      "case 8 at 0.568 of 0.8 ms); the damped Newmark rule gamma = 0.6 (a departure from the paper)",
      ("case 16 pfem n_tu 5", "case 16 pfem gamma 0.6", "case 16 pfem", "case 16 pfem n_tu 10 gamma 0.6",
       "case 8 pfem", "case 8 pfem n_tu 10 gamma 0.6"),
+     BASIC + (("steps", "n_steps", "d"), ("wall [s]", "wall", ".0f"))),
+    ("The PFEM's remeshing: after every step (the sweep's) or only where a triangle's quality falls below 0.3 "
+     "(Algorithm 1's 'if remeshing is needed' read literally; key suffix 'remesh when needed'); the 'every step' rows "
+     "are the sweep's records, made by earlier versions of the solver (the PFEM's path moves its forces by up to 12 %)",
+     tuple(k for n in (1, 5, 10) for k in (f"case {n}{PFEM}", f"case {n}{PFEM}{REMESH}"))
+     + ("case 1 pfem", f"case 1{PFEM10}{REMESH}"),
      BASIC + (("steps", "n_steps", "d"), ("wall [s]", "wall", ".0f"))),
     ("Contact and heat split (case 1: penalty contact, half the frictional heat into the chip)",
      ("case 1", "case 1 pinball", "case 1 all friction heat to the chip"),

@@ -224,3 +224,19 @@ def test_a_stalled_newton_with_the_trapezoidal_rule_names_the_damped_rule(tmp_pa
         s = json.loads((out / "summary.json").read_text())
         assert s["status"] == "failed" and "Newton failed (a test)" in s["error"]
         assert ("--option gamma=0.6" in str(info.value)) == hinted and ("--option gamma=0.6" in s["error"]) == hinted
+
+
+def test_remeshing_when_needed_is_an_option():
+    """--option remesh_when_needed=true: Algorithm 1's "if remeshing is needed" read literally (a remeshing only
+    where a triangle's quality falls below 0.3); by default the cut remeshes after every step."""
+    from refsph.pfem.cutting import pfem_cut, run_pfem_cut
+    from refsph.pfem_run import _options
+
+    kw = _options(dict(SHORT, remesh_when_needed="true"), quick=True)
+    assert kw["remesh_when_needed"] is True
+    lazy, every = pfem_cut(**kw), pfem_cut(**_options(SHORT, quick=True))
+    assert lazy.remesh_every is None and lazy.info["remesh_when_needed"] and every.remesh_every == 1
+    a, b = run_pfem_cut(lazy), run_pfem_cut(every)
+    assert b["remeshes"] == b["steps"] and a["remeshes"] < a["steps"] and a["steps"] == b["steps"]
+    with pytest.raises(ValueError, match="true or false"):
+        _options(dict(remesh_when_needed="sometimes"), quick=True)

@@ -22,7 +22,7 @@
 # 2. the α-shape: keep the triangles that are small enough, and find the boundary;
 # 3. solve the mechanical step implicitly (a mixed displacement–pressure element, Newton–Raphson);
 # 4. move the particles and update their velocity, acceleration, pressure and temperature;
-# 5. move the tool, and go to 1 (remesh) or 3.
+# 5. move the tool, and go to 1 (remesh, "if remeshing is needed"; refsph: every step) or 3.
 #
 # The heat step follows the mechanics on the same mesh (a staggered scheme). No kernel, no neighbour sums, no
 # stability limit on the step: the step is set by how far the tool may move between remeshings, not by the speed
@@ -516,7 +516,7 @@ assert abs(ledger.residual) < 1e-12 * ledger.source
 # $J$. The new triangles of a remeshing do not match the old, so refsph projects the history to the nodes
 # (area-weighted means) and gives each new triangle the mean of its three nodes: a smoothing, at every remeshing.
 # Its effect on the simplest case: section 3's elastic cantilever ($\nu$ = 0.3, 4 elements deep) under its constant
-# tip load, stepped quasi-statically, remeshed after every step as Algorithm 1 does in the cut, and not remeshed.
+# tip load, stepped quasi-statically, remeshed after every step as refsph's cut does, and not remeshed.
 
 # %%
 def held_cantilever(ny, steps, transfer, nu=0.3):

@@ -699,8 +699,9 @@ def status_lines(records: dict, todo: dict, quick: bool = False) -> list[str]:
         path = run_folder(key, quick) / "summary.json"
         try:
             s = json.loads(path.read_text())
-        except (OSError, ValueError):
-            lines.append(f"{key:40s} to run")
+        except (OSError, ValueError):                        # before its first snapshot: its heartbeat, if any
+            beat = _heartbeat(path.parent, 0.0)
+            lines.append(f"{key:40s} {beat or 'to run'}")
             continue
         beat = _heartbeat(path.parent, path.stat().st_mtime) if s.get("status") == "running" else None
         if beat is not None:

@@ -34,6 +34,12 @@ def test_the_sweep_status_reads_a_newer_heartbeat(tmp_path, monkeypatch):
     monkeypatch.setattr(tc, "RUNS", tmp_path)
     folder = tc.run_folder("case 1 pfem")
     folder.mkdir(parents=True)
+    line, = tc.status_lines({}, {"case 1 pfem": None})
+    assert line.endswith("to run")
+    rio.write_progress(folder, 0.1e-3, 1.6e-3, 50, 300.0, 0.0)          # before its first summary: running
+    line, = tc.status_lines({}, {"case 1 pfem": None})
+    assert "running: t = 0.100 of 1.600 ms" in line
+    (folder / "progress.json").unlink()
     summary = dict(status="running", t_final=0.2e-3, t_end=1.6e-3, n_steps=100, wall_time_s=600.0)
     (folder / "summary.json").write_text(json.dumps(summary))
     old = time.time() - 3600

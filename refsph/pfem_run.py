@@ -5,7 +5,9 @@ The folder (:mod:`refsph.io` documents the common files):
 
     summary.json              scene, method 'pfem', dim 2, dp (the finest spacing dx), n_particles (nodes),
                               n_steps, t_end, status, metrics (the SPH scene's keys), scene_info, heat_balance,
-                              newton (iterations, halved steps, remeshings), run_args, wall_time_s, provenance;
+                              newton (iterations, halved steps, remeshings), run_args, wall_time_s, cpu_time_s
+                              (the steps' CPU seconds, over restarts; null where a restart continued a checkpoint
+                              that did not keep them), provenance;
                               written at the start and at each checkpoint with status 'running' (so a killed run
                               can be continued, and read), at the end with the run's status
     snapshots/snap_NNNNN.npz  the nodes as particles (t, id, x, v, m, rho, p, S, S_zz, sigma_vm, eps_p, eps_dot_p,
@@ -247,7 +249,7 @@ def _summary(scene_name: str, run: CutRun, res: dict, kwargs: dict, args: dict, 
                                halved_steps=run.retries, remeshes=run.remeshes, max_move=cut.max_move,
                                max_iter=cut.max_iter, settle=cut.settle,
                                max_outer=cut.max_outer, nodes_inserted=run.inserted, nodes_removed=run.removed),
-                   options=kwargs, run_args=args, wall_time_s=run.wall, snapshots=snapshots,
+                   options=kwargs, run_args=args, wall_time_s=run.wall, cpu_time_s=run.cpu, snapshots=snapshots,
                    particle_steps_per_s=run.nodes.n * run.steps / run.wall if run.wall > 0 else 0.0,
                    reaction_forces_file="reaction_forces.csv", provenance=prov)
     if error:

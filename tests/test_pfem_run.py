@@ -171,6 +171,9 @@ def test_a_killed_run_can_be_continued_from_the_command_line(short_run, tmp_path
     done = json.loads((out / "summary.json").read_text())
     assert done["status"] == "ok" and done["n_steps"] == short_run[1].summary["n_steps"]
     assert done["metrics"]["cutting_force_N_per_m"] == short_run[1].summary["metrics"]["cutting_force_N_per_m"]
+    full = short_run[1].summary                             # CPU seconds of the steps, kept across the restart
+    assert 0 < full["cpu_time_s"] <= 1.5 * full["wall_time_s"] + 1.0
+    assert 0 < s["cpu_time_s"] < done["cpu_time_s"]
 
 
 def test_a_pfem_run_holds_blas_at_one_thread(monkeypatch):
@@ -240,3 +243,25 @@ def test_remeshing_when_needed_is_an_option():
     assert b["remeshes"] == b["steps"] and a["remeshes"] < a["steps"] and a["steps"] == b["steps"]
     with pytest.raises(ValueError, match="true or false"):
         _options(dict(remesh_when_needed="sometimes"), quick=True)
+
+
+def test_a_checkpoint_without_cpu_seconds_continues_with_them_unknown():
+    """CutRun.restore of a checkpoint written before the CPU seconds were kept: the run goes on and says it does
+    not know them (None), rather than counting from zero; a checkpoint that kept them goes on counting."""
+    import json as js
+
+    from refsph.pfem.cutting import CutRun, pfem_cut
+
+    cut = pfem_cut(1, n_tu=5.0, travel=0.3, length=1.2e-3)
+    run = CutRun(cut)
+    run.step()
+    ck = run.checkpoint()
+    assert js.loads(str(ck["record"]))["cpu"] > 0
+    again = CutRun.restore(cut, dict(ck))
+    again.step()
+    assert again.cpu > run.cpu
+    rec = js.loads(str(ck["record"]))
+    del rec["cpu"]
+    old = CutRun.restore(cut, dict(ck, record=np.array(js.dumps(rec))))
+    old.step()
+    assert old.cpu is None and old.result()["cpu_time_s"] is None

@@ -297,7 +297,7 @@ class CutRun:
         self.T_tool = None if cut.heat is None else np.full(len(cut.heat.x_tool), cut.heat.T_fixed)
         self.hist = {k: [] for k in HISTORY_KEYS}
         self.reaction = dict(t=[], dt=[], tool=[])
-        self.iterations, self.retries, self.steps, self.remeshes, self.wall = [], 0, 0, 0, 0.0
+        self.iterations, self.retries, self.steps, self.remeshes, self.wall, self.cpu = [], 0, 0, 0, 0.0, 0.0
         self.inserted = self.removed = 0
         self.ledger = {k: 0.0 for k in LEDGER}
         self.du_prev, self.dt_prev = None, None                                  # the warm start
@@ -309,7 +309,7 @@ class CutRun:
     def step(self):
         """One step: the mechanics with the contact (halving the step up to four times if Newton fails), the heat
         step, the remeshing and the measures; returns the converged :class:`refsph.pfem.solid.StepResult`."""
-        t0 = time.perf_counter()
+        t0, c0 = time.perf_counter(), time.process_time()
         cut, nodes, mesh = self.cut, self.nodes, self.mesh
         dt = min(cut.dt, cut.t_end - nodes.t)
         zero = np.zeros_like(nodes.x)
@@ -359,6 +359,7 @@ class CutRun:
             self.hist[k].append(v)
         self.steps += 1
         self.wall += time.perf_counter() - t0
+        self.cpu = None if self.cpu is None else self.cpu + time.process_time() - c0    # None: not kept before
         return r
 
     def tool_x(self, t: float) -> np.ndarray:
@@ -382,8 +383,8 @@ class CutRun:
         hist["reaction"] = {k: np.asarray(v) for k, v in self.reaction.items()}
         metrics = thermal_cutting_metrics(hist, self.cut.info, self.cut.t_end) if self.steps else {}
         return dict(nodes=self.nodes, mesh=self.mesh, history=hist, metrics=metrics, newton_iterations=self.iterations,
-                    retries=self.retries, wall_time_s=self.wall, steps=self.steps, remeshes=self.remeshes,
-                    nodes_inserted=self.inserted, nodes_removed=self.removed,
+                    retries=self.retries, wall_time_s=self.wall, cpu_time_s=self.cpu, steps=self.steps,
+                    remeshes=self.remeshes, nodes_inserted=self.inserted, nodes_removed=self.removed,
                     heat_balance=self.heat_balance(), T_tool=self.T_tool)
 
     def checkpoint(self) -> dict:
@@ -400,7 +401,7 @@ class CutRun:
         out["record"] = np.array(json.dumps(dict(
             hist=self.hist, reaction={k: np.asarray(v).tolist() for k, v in self.reaction.items()},
             iterations=self.iterations, retries=self.retries, steps=self.steps, remeshes=self.remeshes, wall=self.wall,
-            ledger=self.ledger, inserted=self.inserted, removed=self.removed)))
+            ledger=self.ledger, inserted=self.inserted, removed=self.removed, cpu=self.cpu)))
         return out
 
     @classmethod
@@ -424,7 +425,7 @@ class CutRun:
         run.hist = rec["hist"]
         run.reaction = {k: [np.asarray(row) if k == "tool" else row for row in v] for k, v in rec["reaction"].items()}
         run.iterations, run.retries, run.steps = rec["iterations"], rec["retries"], rec["steps"]
-        run.remeshes, run.wall, run.ledger = rec["remeshes"], rec["wall"], rec["ledger"]
+        run.remeshes, run.wall, run.ledger, run.cpu = rec["remeshes"], rec["wall"], rec["ledger"], rec.get("cpu")
         run.inserted, run.removed = rec.get("inserted", 0), rec.get("removed", 0)
         return run
 

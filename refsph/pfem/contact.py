@@ -101,9 +101,7 @@ class StepContact:
             slip[(saved[1] != 0) & (slip == -saved[1])] = 0.0         # a slip that reverses sticks first
         if grow and saved[0] is not None:
             active |= saved[0]
-            turned = np.zeros(len(x_new), bool)                   # a kept slip whose trial force turned against it
-            turned[idx] = (saved[1][idx] != 0) & (np.sign(trial) == -saved[1][idx])
-            self.stuck |= turned                                  # sticks for the step (stick_reversed's rule)
+            self._stick_turned(saved[1][idx], trial)              # a kept slip turned against its trial force
             slip = np.where(saved[1] != 0, saved[1], slip)
         slip[self.stuck] = 0.0
         changed = saved[0] is None or not (np.array_equal(saved[0], active) and np.array_equal(saved[1], slip))
@@ -119,11 +117,17 @@ class StepContact:
         if self.slip is None:
             return False
         idx = self.nodes
-        sl = self.slip[idx]
-        turned = (sl != 0) & (np.sign(self.forces(x_new[idx], idx)["trial"]) == -sl)
+        turned = self._stick_turned(self.slip[idx], self.forces(x_new[idx], idx)["trial"])
         self.slip[idx[turned]] = 0.0
-        self.stuck[idx[turned]] = True
         return bool(np.any(turned))
+
+    def _stick_turned(self, slip: np.ndarray, trial: np.ndarray) -> np.ndarray:
+        """The rule of :meth:`stick_reversed` and of :meth:`freeze` with ``grow``: of the nodes ``self.nodes``
+        with slip directions ``slip`` and trial forces ``trial``, those sliding against their trial force stick for
+        the rest of the step (``self.stuck``); returns them (a mask over ``self.nodes``)."""
+        turned = (slip != 0) & (np.sign(trial) == -slip)
+        self.stuck[self.nodes[turned]] = True
+        return turned
 
     def forces(self, x: np.ndarray, idx: np.ndarray) -> dict:
         """The forces on nodes ``idx`` at positions x (len(idx), 2): f (.., 2), f_N, f_T, slip s, g, and the trial

@@ -99,6 +99,7 @@ DAMPED = f" n_tu 10 gamma {DAMPED_GAMMA:g}"  # again with Newmark's damped rule,
 RETRIES = {"": RETRY, PFEM10: DAMPED}      # the tables that take such a run for a failed case's row
 PFEM_OPTIONS = ("case", "n_tu", "travel", "length", "gamma", "remesh_when_needed")   # those the PFEM cut takes
 REMESH = " remesh when needed"              # the key suffix of a PFEM cut that remeshes only where the quality asks
+REMESH_RUNS = ((1, PFEM, 5.0), (5, PFEM, 5.0), (10, PFEM, 5.0), (1, PFEM10, 10.0))   # (case, suffix, n_tu) of those
 
 
 def sweep_numerics(n_tu: float = N_TU, **more) -> dict:
@@ -123,7 +124,7 @@ def jobs(studies=STUDY_NAMES, only=None) -> dict:
     # one at t_u/10): the cost of a converged case (issue 22: under 40 min on one core), beside 'case 1'
     add("timestep", "case 1 heat every 8", converged(1), sweep_numerics(heat_every=8))
     # the scatter: first at t_u/5 (an eighth of the cost); Ti6Al4V's too (its time-step runs differ by more)
-    for n, seed in [(1, k) for k in (1, 2, 3)] + [(10, k) for k in (1, 2, 3)]:
+    for n, seed in [(c, k) for c in (1, 10) for k in (1, 2, 3)]:
         add("scatter", f"case {n} n_tu 5 jitter {seed}", converged(n, n_tu=5.0, jitter=0.01, seed=seed))
     for n in range(1, 19):                                   # all 18 at t_u/5 (Ti6Al4V's case 10 fails at t_u/10)
         if n == 1 or n == 10:
@@ -190,10 +191,9 @@ def jobs(studies=STUDY_NAMES, only=None) -> dict:
 
 def remesh_jobs() -> list[tuple[str, dict]]:
     """(key, options) of the PFEM cuts that remesh only where a triangle's quality falls below 0.3
-    (``remesh_when_needed``), beside the sweep's (a remeshing after every step): cases 1, 5 and 10 at t_u / 5, then
-    case 1 at t_u / 10."""
-    return ([(f"case {n}{PFEM}{REMESH}", dict(converged(n, n_tu=5.0), remesh_when_needed=True)) for n in (1, 5, 10)]
-            + [(f"case 1{PFEM10}{REMESH}", dict(converged(1, n_tu=10.0), remesh_when_needed=True))])
+    (``remesh_when_needed``), beside the sweep's 'case N' + suffix (a remeshing after every step): REMESH_RUNS."""
+    return [(f"case {n}{suffix}{REMESH}", dict(converged(n, n_tu=n_tu), remesh_when_needed=True))
+            for n, suffix, n_tu in REMESH_RUNS]
 
 
 QUICK = dict(length=1.2e-3, travel=4.0, n_tu=5.0)   # --quick: chapter 11's short cut at the quick resolution
@@ -573,8 +573,7 @@ STUDIES = (
     ("The PFEM's remeshing: after every step (the sweep's) or only where a triangle's quality falls below 0.3 "
      "(Algorithm 1's 'if remeshing is needed' read literally; key suffix 'remesh when needed'); the 'every step' rows "
      "are the sweep's records, made by earlier versions of the solver (the PFEM's path moves its forces by up to 12 %)",
-     tuple(k for n in (1, 5, 10) for k in (f"case {n}{PFEM}", f"case {n}{PFEM}{REMESH}"))
-     + ("case 1 pfem", f"case 1{PFEM10}{REMESH}"),
+     tuple(k for n, suffix, _ in REMESH_RUNS for k in (f"case {n}{suffix}", f"case {n}{suffix}{REMESH}")),
      BASIC + (("steps", "n_steps", "d"), ("wall [s]", "wall", ".0f"))),
     ("Contact and heat split (case 1: penalty contact, half the frictional heat into the chip)",
      ("case 1", "case 1 pinball", "case 1 all friction heat to the chip"),

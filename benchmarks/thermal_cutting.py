@@ -316,21 +316,34 @@ def _rising(values) -> bool | None:
 
 def trends(rows) -> dict:
     """Per material: does Fc (Fp) rise with t_u at every v_c, and T_RF with v_c at every t_u (refsph and
-    measured)."""
+    measured)? The verdict is None where a case is missing; '<key>_lines' counts (lines that rise, lines with every
+    case recorded, lines), so that a partial sweep still shows the lines it has."""
     out = {}
     for mat in ("AISI1045", "Ti6Al4V"):
         get = {(r["vc"], r["tu"]): r for r in rows if r["material"] == mat}
         vcs, tus = sorted({k[0] for k in get}), sorted({k[1] for k in get})
-
-        def every(key, along_tu):
-            lines = [[get[(v, t)][key] for t in tus] for v in vcs] if along_tu else \
-                [[get[(v, t)][key] for v in vcs] for t in tus]
-            verdicts = [_rising(vals) for vals in lines]
-            return None if None in verdicts or not verdicts else all(verdicts)
-        out[mat] = dict(Fc_rises_with_tu=every("Fc_N_per_mm", True), Fc_exp_rises_with_tu=every("Fc_exp", True),
-                        Fp_rises_with_tu=every("Fp_N_per_mm", True), Fp_exp_rises_with_tu=every("Fp_exp", True),
-                        TRF_rises_with_vc=every("TRF", False), TRF_exp_rises_with_vc=every("TRF_exp", False))
+        t = out[mat] = {}
+        for name, key, exp, along_tu in (("Fc_rises_with_tu", "Fc_N_per_mm", "Fc_exp", True),
+                                         ("Fp_rises_with_tu", "Fp_N_per_mm", "Fp_exp", True),
+                                         ("TRF_rises_with_vc", "TRF", "TRF_exp", False)):
+            for label, k in ((name, key), (name.replace("_rises", "_exp_rises"), exp)):
+                lines = [[get[(v, u)][k] for u in tus] for v in vcs] if along_tu else \
+                    [[get[(v, u)][k] for v in vcs] for u in tus]
+                verdicts = [_rising(vals) for vals in lines]
+                known = [v for v in verdicts if v is not None]
+                t[label] = None if None in verdicts or not verdicts else all(verdicts)
+                t[label + "_lines"] = (sum(known), len(known), len(verdicts))
     return out
+
+
+def _trend_cell(t: dict, name: str) -> str:
+    """'yes' / 'no (k of n rise)' for refsph, with 'on n of m lines' where cases are missing; then the measured."""
+    rising, known, total = t[name + "_lines"]
+    exp = {True: "yes", False: "no", None: "-"}[t[name.replace("_rises", "_exp_rises")]]
+    if not known:
+        return f"- / {exp}"
+    cell = "yes" if rising == known else f"no ({rising} of {known} rise)"
+    return f"{cell}{'' if known == total else f', {known} of {total} lines recorded'} / {exp}"
 
 
 def _f(v, fmt: str) -> str:
@@ -369,13 +382,10 @@ def report(res: dict, before: dict | None = None) -> str:
         v = _values(res["runs"][r["key"]]) if r["status"] == "ok" else {}
         lines.append(_row([(r["case"], "d")] + [(v.get(key), fmt) for _, key, fmt in STEADY_COLUMNS]))
     lines += ["", P("trends")]
-    yes = {True: "yes", False: "no", None: "-"}
-    for label, sel in (("SPH, t_u/10", rows), ("SPH, t_u/5", coarse), ("PFEM, t_u/5", pfem)):
+    for label, sel in (("SPH, t_u/10", rows), ("SPH, t_u/5", coarse), ("PFEM, t_u/5", pfem), ("PFEM, t_u/10", pfem10)):
         for mat, t in trends(sel).items():
-            lines.append(f"| {mat} | {label} | " + " | ".join(f"{yes[t[q + '_rises_with_' + x]]} / "
-                                                               f"{yes[t[q + '_exp_rises_with_' + x]]}"
-                                                               for q, x in (("Fc", "tu"), ("Fp", "tu"), ("TRF", "vc")))
-                         + " |")
+            lines.append(f"| {mat} | {label} | " + " | ".join(_trend_cell(t, n) for n in (
+                "Fc_rises_with_tu", "Fp_rises_with_tu", "TRF_rises_with_vc")) + " |")
     lines += _study_lines(res)
     todo = [k for k in jobs() if k not in res["runs"]]
     recorded = [r for r in res["runs"].values() if r.get("wall_time_s")]

@@ -75,6 +75,12 @@ def test_thermal_cutting_trends_read_every_line():
     rows[4]["Fp_N_per_mm"] = None                                      # not recorded
     assert mod.trends(rows)["AISI1045"]["Fp_rises_with_tu"] is None
     assert mod.trends(rows)["Ti6Al4V"]["Fc_rises_with_tu"] is None     # no Ti6Al4V rows at all
+    t = mod.trends(rows)["AISI1045"]                                   # the line at vc 60 is still read
+    assert t["Fp_rises_with_tu_lines"] == (1, 1, 2) and t["Fc_rises_with_tu_lines"] == (2, 2, 2)
+    assert mod._trend_cell(t, "Fp_rises_with_tu") == "yes, 1 of 2 lines recorded / yes"
+    rows[4]["Fp_N_per_mm"] = 0.0
+    assert mod._trend_cell(mod.trends(rows)["AISI1045"], "Fp_rises_with_tu") == "no (1 of 2 rise) / yes"
+    assert mod._trend_cell(mod.trends(rows)["Ti6Al4V"], "Fc_rises_with_tu") == "- / -"
 
 
 def test_pfem_time_step_report_is_generated_from_the_json():

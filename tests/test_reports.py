@@ -107,6 +107,23 @@ def test_pfem_step_cost_report_is_generated_from_the_json_and_the_versions_agree
             assert f == pytest.approx(forces[0], rel=1e-6), (n_tu, forces)
 
 
+def test_thermal_cutting_single_run_against_a_scatter_group():
+    """One run against the mean and standard deviation of a scatter group, from the records: a group made of one
+    run's copies has no spread (no z), and a run 10 % above a group of two at 100 +- 10 % is z = +1."""
+    mod = _script("thermal_cutting")
+    rec = lambda fc: dict(status="ok", dp=1e-5, scene_info=dict(tu_m=1e-4),        # noqa: E731
+                          metrics=dict(cutting_force_N_per_m=1e3 * fc, passive_force_N_per_m=5e4, force_ratio=50 / fc,
+                                       rake_face_temperature_K=600.0, rake_face_temperature_max_K=650.0,
+                                       free_chip_surface_temperature_K=500.0, chip_thickness_mm=0.3,
+                                       contact_length_mm=0.3))
+    res = dict(runs={"a": rec(90.0), "b": rec(110.0), "one": rec(110.0)})
+    line = mod._single_run_line(res, "one", ("a", "b"))
+    sd = np.std([90.0, 110.0], ddof=1)
+    assert f"Fc [N/mm] +10.0 % (z = {10.0 / sd:+.1f})" in line and "Fp [N/mm] +0.0 %," in line
+    assert "not recorded yet" in mod._single_run_line(res, "missing", ("a", "b"))
+    assert "not recorded yet" in mod._single_run_line(res, "one", ("a",))
+
+
 def test_thermal_cutting_status_reads_records_and_run_folders(tmp_path, monkeypatch):
     """thermal_cutting --status: a recorded job shows its record's status, a job whose run folder has a summary
     shows how far it got (simulated time against the end), any other is 'to run'."""

@@ -5,7 +5,8 @@ Scene: the workpiece 3 t_u high, its bottom row and left column held, graded (th
 dx = t_u / n_tu in a band 2 t_u deep under the top surface (the uncut layer and the shear zones under it), 2 dx
 below; the tool of the SPH scene (10 deg rake, 10 deg clearance, 10 um edge radius; rigid, at -v_c) as the exact
 rounded polygon of :mod:`refsph.pfem.contact`. Real density: the implicit step has no stability limit, so nothing
-is mass-scaled (the SPH runs scale the density by s; here s = 1).
+is mass-scaled (the SPH runs scale the density by s; here s = 1). Eq. (13)'s thermal expansion is left out
+(alpha_T = 0): the paper's tables give no coefficient, and the SPH scene has none, so both see the same mechanics.
 
 Each step (Algorithm 1): the tool moves by -v_c dt; Newton-Raphson solves the mechanical step with the contact
 inside it (:func:`refsph.pfem.solid.newton_step`); the nodes move; the plastic work heats the nodes (chi dW_p of

@@ -29,54 +29,84 @@ KEYS = (("Fc [N/mm]", "cutting_force_N_per_m", 1e-3, ".1f"), ("Fp [N/mm]", "pass
         ("T_FCS [K]", "free_chip_surface_temperature_K", 1.0, ".0f"), ("chip [mm]", "chip_thickness_mm", 1.0, ".3f"))
 
 
-def run_one(courant: float) -> dict:
-    """The quick cut at this courant number (continued if a run folder is there); its record."""
+def run_one(value: float, option: str = "courant", runs: Path = RUNS, cut: str = "") -> dict:
+    """The cut ``cut`` (a key of CUTS: '' the quick cut) with the PFEM option ``option`` (a number) at ``value``
+    (continued if a run folder is there); its record, the value under the option's name."""
     from refsph.pfem_run import run_pfem
-    out = RUNS / f"courant_{courant:g}"
+    base, quick = CUTS[cut]
+    out = runs / f"{cut.replace(' ', '_').replace('/', '') + '_' if cut else ''}{option}_{value:g}"
     restart = (out / "snapshots" / "restart.npz").exists()
     if (out / "summary.json").exists() and json.loads((out / "summary.json").read_text()).get("status") == "ok":
         s = json.loads((out / "summary.json").read_text())
     else:
-        s = run_pfem("thermal_cutting", out=out, options=dict(courant=courant), quick=True, progress=False,
-                     restart=restart).summary
-    return dict(courant=courant, status=s["status"], n_steps=s["n_steps"], wall_time_s=s["wall_time_s"],
-                newton=s["newton"], metrics={k: s["metrics"].get(k) for _, k, _, _ in KEYS})
+        s = run_pfem("thermal_cutting", out=out, options=dict(base, **{option: value}), quick=quick,
+                     progress=False, restart=restart).summary
+    rec = {option: value, "status": s["status"], "n_steps": s["n_steps"], "wall_time_s": s["wall_time_s"],
+           "newton": s["newton"], "metrics": {k: s["metrics"].get(k) for _, k, _, _ in KEYS}}
+    return dict(rec, cut=cut) if cut else rec
 
 
-def report(rows: list) -> str:
-    """The table, with each quantity's change against the next smaller step (percent)."""
-    rows = sorted(rows, key=lambda r: -r["courant"])
-    head = "| courant | steps | halved | Newton iterations | " + " | ".join(k[0] for k in KEYS) + " |"
-    lines = ["# The PFEM cut's time step (quick cut: case 1, t_u/5, 4 t_u)", "",
-             "Made by `python benchmarks/pfem_time_step.py` (module text). In brackets: the change against the next "
-             "smaller step, percent.", "", head, "|---" * (4 + len(KEYS)) + "|"]
+# the cuts a scan may run: '' the quick cut (case 1, t_u/5, 4 t_u on 1.2 mm), 'case 1 t_u/5' the whole cut of the
+# sweep's 'case 1 n_tu 5 pfem' (16 t_u of cut, 12 t_u left uncut)
+CUTS = {"": ({}, True), "case 1 t_u/5": (dict(case=1, n_tu=5.0, travel=16.0, length=28 * 1e-4), False)}
+
+
+TITLE = "# The PFEM cut's time step (quick cut: case 1, t_u/5, 4 t_u)"
+MADE_BY = ("Made by `python benchmarks/pfem_time_step.py` (module text). In brackets: the change against the next "
+           "smaller step, percent.")
+
+
+def report(rows: list, option: str = "courant", title: str = TITLE, made_by: str = MADE_BY,
+           reference: float | None = None) -> str:
+    """The table, from the largest value of ``option`` down, with each quantity's change (percent) against the next
+    smaller value, or against the row at ``reference`` where one is given."""
+    rows = sorted(rows, key=lambda r: -r[option])
+    ref = next((r["metrics"] for r in rows if r[option] == reference), None)
+    head = f"| {option} | steps | halved | Newton iterations | " + " | ".join(k[0] for k in KEYS) + " |"
+    lines = [title, "", made_by, "", head, "|---" * (4 + len(KEYS)) + "|"]
     for i, r in enumerate(rows):
-        finer = rows[i + 1]["metrics"] if i + 1 < len(rows) else None
+        base = ref if reference is not None else (rows[i + 1]["metrics"] if i + 1 < len(rows) else None)
+        if reference is not None and r[option] == reference:
+            base = None
         cells = []
         for _, key, scale, fmt in KEYS:
             v = r["metrics"][key]
-            d = "" if finer is None or not finer[key] else f" ({100 * (v / finer[key] - 1):+.1f})"
-            cells.append(f"{format(v * scale, fmt)}{d}")
-        lines.append(f"| {r['courant']:g} | {r['n_steps']} | {r['newton']['halved_steps']} | "
+            d = "" if base is None or not base[key] or v is None else f" ({100 * (v / base[key] - 1):+.1f})"
+            cells.append("-" if v is None else f"{format(v * scale, fmt)}{d}")
+        lines.append(f"| {r[option]:g} | {r['n_steps']} | {r['newton']['halved_steps']} | "
                      f"{r['newton']['iterations']} | " + " | ".join(cells) + " |")
     return "\n".join(lines) + "\n"
 
 
-def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+def scan_main(argv, doc: str, values, option: str, runs: Path, out_json: Path, report_fn, cuts=("",)) -> int:
+    """The command of a scan over one option of the cuts ``cuts`` (keys of CUTS): run what is missing (a committed
+    row that was 'ok' is kept where its rerun is not), write the JSON and its page, print the page; --report: the
+    page only."""
+    ap = argparse.ArgumentParser(description=doc.split("\n\n")[0])
     ap.add_argument("--report", action="store_true", help="only the table from the JSON")
     args = ap.parse_args(argv)
+    script = f"python benchmarks/{out_json.stem}.py"
     if not args.report:
-        rows = [run_one(c) for c in COURANTS]
-        OUT_JSON.write_text(json.dumps(dict(rows=rows, made_by="python benchmarks/pfem_time_step.py"), indent=1)
-                            + "\n")
-    if not OUT_JSON.exists():
-        print(f"no {OUT_JSON.name}: run python benchmarks/pfem_time_step.py first", file=sys.stderr)
+        old = {(r.get("cut", ""), r[option]): r for r in json.loads(out_json.read_text())["rows"]} \
+            if out_json.exists() else {}
+        rows = []
+        for cut in cuts:
+            for v in values:
+                r = run_one(v, option=option, runs=runs, cut=cut)
+                keep = r["status"] != "ok" and old.get((cut, v), {}).get("status") == "ok"
+                rows.append(old[(cut, v)] if keep else r)
+        out_json.write_text(json.dumps(dict(rows=rows, made_by=script), indent=1) + "\n")
+    if not out_json.exists():
+        print(f"no {out_json.name}: run {script} first", file=sys.stderr)
         return 2
-    text = report(json.loads(OUT_JSON.read_text())["rows"])
-    (OUT_JSON.parent / "pfem_time_step_report.md").write_text(text)
+    text = report_fn(json.loads(out_json.read_text())["rows"])
+    (out_json.parent / f"{out_json.stem}_report.md").write_text(text)
     print(text)
     return 0
+
+
+def main(argv=None) -> int:
+    return scan_main(argv, __doc__, COURANTS, "courant", RUNS, OUT_JSON, report)
 
 
 if __name__ == "__main__":

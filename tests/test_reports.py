@@ -62,6 +62,17 @@ def test_pfem_rake_friction_record_keeps_its_bound():
         assert 0.0 <= r["slipping_fraction"] <= 1.0
 
 
+def test_pfem_alpha_report_is_generated_from_the_json():
+    """benchmarks/pfem_alpha_report.md is what pfem_alpha.report writes from the committed JSON: both cuts, each
+    with the default alpha (the reference of its changes) and a value on either side of it."""
+    mod = _script("pfem_alpha")
+    rows = json.loads((ROOT / "benchmarks" / "pfem_alpha.json").read_text())["rows"]
+    assert mod.report(rows) == (ROOT / "benchmarks" / "pfem_alpha_report.md").read_text()
+    for cut in mod.TITLES:
+        alphas = {r["alpha"] for r in rows if r.get("cut", "") == cut and r["status"] == "ok"}
+        assert mod.DEFAULT in alphas and min(alphas) < mod.DEFAULT < max(alphas), cut
+
+
 def test_thermal_cutting_trends_read_every_line():
     """thermal_cutting.trends: a quantity 'rises with t_u' only if it rises at every v_c (one dip says no), and a
     missing case makes the verdict '-' (None)."""

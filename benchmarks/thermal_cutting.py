@@ -192,6 +192,20 @@ def jobs(studies=STUDY_NAMES, only=None) -> dict:
     return todo
 
 
+def retry_jobs(records: dict, studies=STUDY_NAMES) -> dict:
+    """The retries (RETRIES) of the t_u/10 tables' cases whose record failed and whose retry is not in jobs(): an
+    SPH case 'case N' again at RETRY_COURANT, a PFEM case 'case N pfem' with the damped rule; the sweep adds them,
+    so that a failed case is taken again without a new line in jobs()."""
+    out = {}
+    for n in range(1, 19):
+        sph, pfem = f"case {n}", f"case {n}{PFEM10}"
+        if "cases" in studies and records.get(sph, {}).get("status", "ok") != "ok":
+            out[sph + RETRY] = (converged(n), sweep_numerics(courant=RETRY_COURANT))
+        if "pfem" in studies and records.get(pfem, {}).get("status", "ok") != "ok":
+            out[pfem + DAMPED] = (dict(converged(n, n_tu=10.0), gamma=DAMPED_GAMMA), dict(method="pfem"))
+    return out
+
+
 def remesh_jobs() -> list[tuple[str, dict]]:
     """(key, options) of the PFEM cuts that remesh only where a triangle's quality falls below 0.3
     (``remesh_when_needed``), beside the sweep's 'case N' + suffix (a remeshing after every step): REMESH_RUNS."""
@@ -390,7 +404,7 @@ def report(res: dict, before: dict | None = None) -> str:
             lines.append(f"| {mat} | {label} | " + " | ".join(_trend_cell(t, n) for n in (
                 "Fc_rises_with_tu", "Fp_rises_with_tu", "TRF_rises_with_vc")) + " |")
     lines += _study_lines(res)
-    todo = [k for k in jobs() if k not in res["runs"]]
+    todo = [k for k in dict(jobs(), **retry_jobs(res["runs"])) if k not in res["runs"]]
     recorded = [r for r in res["runs"].values() if r.get("wall_time_s")]
     lines += ["", P("total", n=len(recorded), minutes=f"{sum(r['wall_time_s'] for r in recorded) / 60:.1f}",
                     todo=len(todo), keys=", ".join(f"'{k}'" for k in todo) or "none"), ""]
@@ -797,6 +811,8 @@ def main(argv=None) -> int:
     if args.quick and args.json == OUT_JSON:
         _parser().error("--quick writes try-out records: give them their own --json file")
     todo = jobs(args.study or STUDY_NAMES, args.only)
+    todo.update({k: v for k, v in retry_jobs(store(args.json).records(), args.study or STUDY_NAMES).items()
+                 if k not in todo and (args.only is None or v[0]["case"] in args.only)})
     if args.keys is not None:
         unknown = [k for k in args.keys if k not in todo]
         if unknown:

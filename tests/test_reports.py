@@ -223,6 +223,20 @@ def test_thermal_cutting_takes_a_failed_case_again_at_half_the_step():
     assert {r["case"]: r for r in mod.comparison(res)}[9]["status"] == "error"
 
 
+def test_thermal_cutting_queues_the_retry_of_a_failed_case():
+    """retry_jobs: a failed t_u/10 case gets its retry (SPH at half the step, PFEM with the damped rule), an ok or
+    missing one none, and a study not asked for none."""
+    mod = _script("thermal_cutting")
+    recs = {"case 3": dict(status="blow-up"), "case 4": dict(status="ok"), "case 12 pfem": dict(status="error")}
+    out = mod.retry_jobs(recs)
+    assert set(out) == {"case 3" + mod.RETRY, "case 12 pfem" + mod.DAMPED}
+    options, numerics = out["case 12 pfem" + mod.DAMPED]
+    assert options["case"] == 12 and options["n_tu"] == 10.0 and options["gamma"] == mod.DAMPED_GAMMA
+    assert numerics == dict(method="pfem")
+    assert out["case 3" + mod.RETRY][1]["courant"] == mod.RETRY_COURANT
+    assert set(mod.retry_jobs(recs, studies=("pfem",))) == {"case 12 pfem" + mod.DAMPED}
+
+
 def test_thermal_cutting_takes_a_failed_pfem_case_with_the_damped_rule():
     """thermal_cutting.comparison of the PFEM at t_u/10: a case that failed with the trapezoidal rule takes its run
     with gamma 0.6 ('case N pfem' + DAMPED) where that one is 'ok', and its row says so; the t_u/5 PFEM table and

@@ -199,3 +199,23 @@ def test_the_dissipation_heat_is_split_into_contact_damping_and_viscosity(short_
                    options=dict(case=1, length=0.5e-3, travel=0.25), numerics=dict(threads=1, penalty_damping=0.0))
     assert undamped.summary["heat_dissipation"]["contact_damping_J"] == 0.0
     assert undamped.summary["heat_dissipation"]["viscosity_J"] > 0
+
+
+def test_side_by_side_table_names_the_method_and_the_measurement_of_a_case0_run():
+    """refsph run thermal_cutting --method both: each row names its method, spacing and length of cut; a case-0 run
+    at case 1's material, v_c and t_u (the SPH scene's defaults) shows case 1's measurement, marked; one at
+    conditions of no case shows none."""
+    from refsph.scenes.thermal_cutting import thermal_cutting_table
+    m = dict(cutting_force_N_per_m=3.0e5, passive_force_N_per_m=1.2e5, force_ratio=0.4, cut_length_mm=0.8)
+    sph = dict(method="tlsph", status="ok", dp=25e-6, metrics=m,
+               scene_info=dict(case=0, material="AISI1045", vc_m_s=1.0, tu_m=1e-4))
+    other = dict(sph, scene_info=dict(case=0, material="AISI1045", vc_m_s=1.5, tu_m=1e-4))
+    pfem = dict(sph, method="pfem", dp=20e-6, scene_info=dict(case=1, material="AISI1045", vc_m_s=1.0, tu_m=1e-4),
+                metrics=dict(m, measured=dict(force_ratio=489 / 622, T_RF_K=668.0, T_FCS_K=647.0)))
+    lines = thermal_cutting_table([sph, pfem, other]).splitlines()
+    assert lines[1].split()[:2] == ["1*", "tlsph"] and lines[2].split()[:2] == ["1", "pfem"]
+    for k in (1, 2):                                   # the measured ratio, 668 K and 647 K on both rows
+        cells = lines[k].split()
+        assert cells[9] == "0.79" and cells[11] == "668" and cells[13] == "647"
+    assert lines[1].split()[-3:-1] == ["25.0", "0.80"] and lines[2].split()[-3] == "20.0"
+    assert lines[3].split()[0] == "0" and lines[3].split()[9] == "-" and "*: case 0" in lines[-1]

@@ -347,26 +347,48 @@ def _metrics(hist, state, setup):
     return thermal_cutting_metrics(hist, setup.info, setup.t_end)
 
 
+def _matching_case(info: dict) -> int | None:
+    """The paper's case (1-18) with a case-0 run's material, v_c and t_u, or None."""
+    for n in range(1, 19):
+        row = rla_cutting_case(n)
+        if (row["material"] == info.get("material") and abs(row["vc_m_per_min"] / 60.0 - info.get("vc_m_s", -1)) < 1e-9
+                and abs(row["tu_mm"] * 1e-3 - info.get("tu_m", -1)) < 1e-12):
+            return n
+    return None
+
+
 def thermal_cutting_table(summaries: list) -> str:
     """The runs side by side with the measurement of their case (forces per mm of width; the measured forces'
-    width is not stated, so their ratio is what compares)."""
-    rows = [f"{'case':>4s} {'mat':8s} {'vc':>5s} {'tu':>5s} {'status':8s} {'Fc[N/mm]':>8s} {'Fp[N/mm]':>8s} "
-            f"{'Fp/Fc':>5s} {'meas':>5s} {'T_RF':>5s} {'meas':>5s} {'T_FCS':>5s} {'meas':>5s} {'chip':>5s} "
-            f"{'l_c':>5s} {'wall[s]':>7s}"]
+    width is not stated, so their ratio is what compares). A case-0 run at the conditions of one of the paper's
+    cases (the SPH scene's defaults are case 1's) shows that case's measurement, its case marked '*'. The spacing
+    and the length of cut are shown: the SPH scene and the PFEM cut have their own defaults (``--method both``)."""
+    rows = [f"{'case':>4s} {'method':6s} {'mat':8s} {'vc':>5s} {'tu':>5s} {'status':8s} {'Fc[N/mm]':>8s} "
+            f"{'Fp[N/mm]':>8s} {'Fp/Fc':>5s} {'meas':>5s} {'T_RF':>5s} {'meas':>5s} {'T_FCS':>5s} {'meas':>5s} "
+            f"{'chip':>5s} {'l_c':>5s} {'dx[um]':>6s} {'cut':>5s} {'wall[s]':>7s}"]
+    marked = False
     for s in summaries:
         i, m = s.get("scene_info", {}), s.get("metrics") or {}
-        meas = m.get("measured") or {}
+        meas, case = m.get("measured") or {}, f"{i.get('case', 0):4d}"
+        n = _matching_case(i) if not meas and i.get("case", 0) == 0 else None
+        if n is not None:
+            row = rla_cutting_case(n)
+            meas = dict(force_ratio=row["Fp_exp_N"] / row["Fc_exp_N"], T_RF_K=row["TRF_exp_K"],
+                        T_FCS_K=row["TFCS_exp_K"])
+            case, marked = f"{n:3d}*", True
         f = lambda v, w, p: f"{v:{w}.{p}f}" if isinstance(v, (int, float)) and math.isfinite(v) else f"{'-':>{w}s}"  # noqa: E731
-        rows.append(f"{i.get('case', 0):4d} {i.get('material', '?'):8s} {60 * i.get('vc_m_s', 0):5.0f} "
+        rows.append(f"{case} {s.get('method', '?'):6s} {i.get('material', '?'):8s} {60 * i.get('vc_m_s', 0):5.0f} "
                     f"{1e3 * i.get('tu_m', 0):5.2f} {s.get('status', '?'):8s} "
                     f"{f(1e-3 * m.get('cutting_force_N_per_m', math.nan), 8, 1)} "
                     f"{f(1e-3 * m.get('passive_force_N_per_m', math.nan), 8, 1)} {f(m.get('force_ratio'), 5, 2)} "
                     f"{f(meas.get('force_ratio'), 5, 2)} {f(m.get('rake_face_temperature_K'), 5, 0)} "
                     f"{f(meas.get('T_RF_K'), 5, 0)} {f(m.get('free_chip_surface_temperature_K'), 5, 0)} "
                     f"{f(meas.get('T_FCS_K'), 5, 0)} {f(m.get('chip_thickness_mm'), 5, 3)} "
-                    f"{f(m.get('contact_length_mm'), 5, 3)} {f(s.get('wall_time_s'), 7, 0)}")
-    rows.append("(vc in m/min, tu and chip thickness, contact length l_c in mm, temperatures in K; means over the "
-                "last quarter of the cut)")
+                    f"{f(m.get('contact_length_mm'), 5, 3)} {f(1e6 * (s.get('dp') or math.nan), 6, 1)} "
+                    f"{f(m.get('cut_length_mm'), 5, 2)} {f(s.get('wall_time_s'), 7, 0)}")
+    star = "; *: case 0 at that case's material, vc and tu, its measurement shown" if marked else ""
+    rows.append("(vc in m/min, tu, chip thickness, contact length l_c and the length of cut in mm, temperatures in "
+                "K; means over the last quarter of the cut; each method at its own defaults unless the options say"
+                f" otherwise: compare runs at the same dx and cut{star})")
     return "\n".join(rows)
 
 

@@ -48,7 +48,8 @@ def row(folder: Path) -> dict | None:
         return None
     summary = json.loads((folder / "summary.json").read_text()) if (folder / "summary.json").exists() else {}
     return dict(alternation=alternation(d[:, 2]), steps=len(d), t_ms=float(d[-1, 0] * 1e3),
-                status=summary.get("status"), gamma=summary.get("scene_info", {}).get("newmark_gamma"))
+                status=summary.get("status"), gamma=summary.get("scene_info", {}).get("newmark_gamma"),
+                **({"alpha_B": a} if (a := summary.get("scene_info", {}).get("newmark_alpha_B")) else {}))
 
 
 def report(rows: dict) -> str:
@@ -58,7 +59,8 @@ def report(rows: dict) -> str:
              "|---|---|---|---|---|---|---|---|---|"]
     for key, r in rows.items():
         q = " | ".join(f"{v:.3f}" for v in r["alternation"])
-        lines.append(f"| {key} | {r['gamma']} | {r['status']} | {r['steps']} | {r['t_ms']:.3f} | {q} |")
+        rule = f"{r['gamma']}" + (f" (Bossak {r['alpha_B']:g})" if r.get("alpha_B") else "")
+        lines.append(f"| {key} | {rule} | {r['status']} | {r['steps']} | {r['t_ms']:.3f} | {q} |")
     return "\n".join(lines) + "\n"
 
 

@@ -97,7 +97,9 @@ RETRY = f" courant {RETRY_COURANT:g}"        # under the key 'case N' + RETRY
 DAMPED_GAMMA = 0.6                         # a PFEM case of the t_u / 10 table that failed with the trapezoidal rule,
 DAMPED = f" n_tu 10 gamma {DAMPED_GAMMA:g}"  # again with Newmark's damped rule, under 'case N pfem' + DAMPED
 RETRIES = {"": RETRY, PFEM10: DAMPED}      # the tables that take such a run for a failed case's row
-PFEM_OPTIONS = ("case", "n_tu", "travel", "length", "gamma", "remesh_when_needed")   # those the PFEM cut takes
+BOSSAK_ALPHA = -0.1                        # the Bossak-Newmark rule (second order, damped) beside the damped rule:
+BOSSAK = f" bossak {BOSSAK_ALPHA:g}"         # its key suffix (gamma 0.6 too, beta 0.3025; inertia 1.1 a_n+1 - 0.1 a_n)
+PFEM_OPTIONS = ("case", "n_tu", "travel", "length", "gamma", "remesh_when_needed", "bossak")   # what the PFEM takes
 REMESH = " remesh when needed"              # the key suffix of a PFEM cut that remeshes only where the quality asks
 REMESH_RUNS = ((1, PFEM, 5.0), (5, PFEM, 5.0), (10, PFEM, 5.0), (1, PFEM10, 10.0))   # (case, suffix, n_tu) of those
 
@@ -189,6 +191,13 @@ def jobs(studies=STUDY_NAMES, only=None) -> dict:
         add("pfem", f"case {n}{PFEM10}{DAMPED}", dict(converged(n, n_tu=10.0), gamma=DAMPED_GAMMA), dict(method="pfem"))
     for key, options in remesh_jobs():                       # Algorithm 1's "if remeshing is needed", literally
         add("pfem", key, options, dict(method="pfem"))
+    # the damped rule is first-order accurate, Bossak-Newmark second: both on case 1's whole cut at t_u/5 (beside its
+    # trapezoidal record), then on case 8 at t_u/10 (where the trapezoidal rule stalled), against the damped run
+    for key, opts in ((f"case 1{PFEM} gamma {DAMPED_GAMMA:g}", dict(gamma=DAMPED_GAMMA)),
+                      (f"case 1{PFEM}{BOSSAK}", dict(bossak=BOSSAK_ALPHA))):
+        add("pfem", key, dict(converged(1, n_tu=5.0), **opts), dict(method="pfem"))
+    add("pfem", f"case 8{PFEM10} n_tu 10{BOSSAK}", dict(converged(8, n_tu=10.0), bossak=BOSSAK_ALPHA),
+        dict(method="pfem"))
     return todo
 
 
@@ -594,11 +603,15 @@ STUDIES = (
       "case 10", "case 1 n_tu 5", "case 1 n_tu 5 courant 0.15", "case 1 n_tu 5 courant 0.075", "case 1 courant 0.3",
       "case 1", "case 2 n_tu 5", "case 2 n_tu 5 courant 0.15", "case 2 courant 0.3", "case 2"),
      BASIC + (("max T [K]", "max_temperature_K", ".0f"), ("steps", "n_steps", "d"), ("wall [s]", "wall", ".0f"))),
-    ("The PFEM's time rule (case 16, Ti6Al4V, 60 m/min, 0.10 mm, t_u/5 and t_u/10; case 8, AISI 1045, 180 m/min, "
-     "0.15 mm, t_u/10): the paper's trapezoidal rule rings in the chip and Newton stalls (case 16 at 0.85 ms at t_u/5, "
-     "case 8 at 0.568 of 0.8 ms); the damped Newmark rule gamma = 0.6 (a departure from the paper)",
-     ("case 16 pfem n_tu 5", "case 16 pfem gamma 0.6", "case 16 pfem", "case 16 pfem n_tu 10 gamma 0.6",
-      "case 8 pfem", "case 8 pfem n_tu 10 gamma 0.6"),
+    ("The PFEM's time rule (case 16, Ti6Al4V, 60 m/min, 0.10 mm, t_u/5 and t_u/10; cases 8 and 9, AISI 1045, 180 "
+     "m/min, 0.15 and 0.20 mm, t_u/10; case 1 at t_u/5, where every rule runs): the paper's trapezoidal rule rings in "
+     "the chip and Newton stalls (case 16 at 0.85 ms at t_u/5, case 8 at 0.568 of 0.8 ms, case 9 at 0.758 of 1.067 "
+     "ms); the damped Newmark rule gamma = 0.6 (first order) and the Bossak-Newmark rule alpha_B = -0.1 (second "
+     "order, the same gamma), both departures from the paper",
+     ("case 1 pfem n_tu 5", "case 1 pfem n_tu 5 gamma 0.6", "case 1 pfem n_tu 5 bossak -0.1", "case 16 pfem n_tu 5",
+      "case 16 pfem gamma 0.6", "case 16 pfem", "case 16 pfem n_tu 10 gamma 0.6", "case 8 pfem",
+      "case 8 pfem n_tu 10 gamma 0.6", "case 8 pfem n_tu 10 bossak -0.1", "case 9 pfem",
+      "case 9 pfem n_tu 10 gamma 0.6"),
      BASIC + (("steps", "n_steps", "d"), ("wall [s]", "wall", ".0f"))),
     ("The PFEM's remeshing: after every step (the sweep's) or only where a triangle's quality falls below 0.3 "
      "(Algorithm 1's 'if remeshing is needed' read literally; key suffix 'remesh when needed'); the 'every step' rows "

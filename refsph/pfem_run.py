@@ -46,7 +46,8 @@ from .simulate import SimulationError, earlier_commits, provenance
 
 RINGING_HINT = (" [with the paper's trapezoidal rule the chip's ringing is undamped late in a cut, and Newton can "
                 "stall there (README, PFEM: cases 8 and 16); Newmark's damped rule, --option gamma=0.6 (a departure "
-                "from the paper), ran case 16 at t_u/5 and case 8 at t_u/10 to their ends]")
+                "from the paper), ran case 16 at t_u/5 and case 8 at t_u/10 to their ends; --option bossak=-0.1, "
+                "Bossak-Newmark, damps the same frequencies at second order]")
 
 __all__ = ["run_pfem", "restart_pfem", "one_blas_thread", "is_pfem_run", "pfem_options", "PFEM_SCENES", "QUICK",
            "N_SNAPSHOTS", "PFEMRunResult"]

@@ -212,14 +212,15 @@ def pfem_cut(case: int, n_tu: float = 10.0, travel: float = 16.0, length: float 
              courant: float = 0.25, alpha: float = 1.4, penalty: float = 20.0, friction: bool = True,
              conduction: bool = True, chip_fraction: float = 0.5, refine: bool = True, r_min: float = 0.5,
              a_max: float = 2.5, gamma: float = 0.5, edge_nodes: bool = False,
-             remesh_when_needed: bool = False) -> PFEMCut:
+             remesh_when_needed: bool = False, bossak: float = 0.0) -> PFEMCut:
     """The cut of row ``case`` of the paper's Appendix B: dx = t_u / n_tu, ``travel`` t_u of cut on a workpiece
     ``length`` [m] long (default (travel + 12) t_u), dt = courant dx / v_c, contact penalties ``penalty`` G / dx;
     ``conduction``: the heat step (module text; False: adiabatic), ``chip_fraction`` of the frictional heat into
     the chip; ``refine``: node removal and insertion at each remeshing with ``r_min`` and ``a_max``
     (:class:`refsph.pfem.refine.NodeRule`; False: the nodes stay as they are); ``gamma``: Newmark's gamma, 0.5 the
     paper's trapezoidal rule (Eq. (21)), above it the damped rule of :class:`refsph.pfem.solid.Newmark` with
-    beta = (gamma + 1/2)^2 / 4 (a departure from the paper: it damps the chip's ringing, module text);
+    beta = (gamma + 1/2)^2 / 4 (a departure from the paper: it damps the chip's ringing, module text); ``bossak``:
+    instead, Bossak's alpha_B in [-1/3, 0) (:meth:`refsph.pfem.solid.Newmark.bossak`: damped at second order);
     ``edge_nodes``: the mesh kept off the tool (:class:`PFEMCut`; with ``refine``); ``remesh_when_needed``:
     Algorithm 1's "if remeshing is needed" read literally, a remeshing only where a triangle's quality falls below
     ``remesh_quality`` (False: after every step as well, refsph's default; module text)."""
@@ -234,7 +235,11 @@ def pfem_cut(case: int, n_tu: float = 10.0, travel: float = 16.0, length: float 
                          f"penalty > 0 and 0 <= chip_fraction <= 1; got n_tu = {n_tu!r}, travel = {travel!r} tu, "
                          f"length = {length!r} m, courant = {courant!r}, penalty = {penalty!r}, "
                          f"chip_fraction = {chip_fraction!r}")
-    newmark = TRAPEZOIDAL if gamma == 0.5 else Newmark((gamma + 0.5) ** 2 / 4.0, gamma)   # raises outside [1/2, 1]
+    if bossak != 0.0 and gamma != 0.5:
+        raise ValueError(f"PFEM cut: give gamma (damped Newmark) or bossak (Bossak-Newmark), not both; got gamma = "
+                         f"{gamma!r}, bossak = {bossak!r}")
+    newmark = (Newmark.bossak(bossak) if bossak != 0.0 else TRAPEZOIDAL if gamma == 0.5      # raise out of range
+               else Newmark((gamma + 0.5) ** 2 / 4.0, gamma))
     x, h = graded_workpiece(length, tu, dx)
     H = 3.0 * tu
     y0 = H - tu
@@ -274,7 +279,8 @@ def pfem_cut(case: int, n_tu: float = 10.0, travel: float = 16.0, length: float 
                 edge_radius_m=EDGE_RADIUS, apex0=apex.tolist(), measured=row, method="pfem", alpha=alpha,
                 courant=courant, penalty=penalty, conduction=bool(conduction), chip_fraction=float(chip_fraction),
                 h_int=None if heat is None else heat.h_int, refine=bool(refine), r_min=r_min, a_max=a_max,
-                newmark_gamma=float(gamma), edge_nodes=bool(edge_nodes), remesh_when_needed=bool(remesh_when_needed))
+                newmark_gamma=float(newmark.gamma), edge_nodes=bool(edge_nodes),
+                remesh_when_needed=bool(remesh_when_needed), **({"newmark_alpha_B": float(bossak)} if bossak else {}))
     return PFEMCut(nodes=nodes, h=h, fixed=fixed, law=law, shape=shape, shift0=centroid, v_tool=np.array([-vc, 0.0]),
                    contact=contact, alpha=alpha, dt=courant * dx / vc, t_end=travel * tu / vc, X0=x.copy(), info=info,
                    heat=heat, node_rule=NodeRule(r_min=r_min, a_max=a_max) if refine else None, newmark=newmark,

@@ -221,19 +221,36 @@ class Newmark:
     """Newmark's rule (beta, gamma): a_{n+1} = (du - dt v_n - dt^2 (1/2 - beta) a_n) / (beta dt^2),
     v_{n+1} = v_n + dt ((1 - gamma) a_n + gamma a_{n+1}). beta = 1/4, gamma = 1/2 is the paper's trapezoidal rule
     (Eq. (21): it damps nothing); gamma > 1/2 with beta = (gamma + 1/2)^2 / 4 damps the high frequencies (an
-    impact's ringing) at first-order accuracy. ``dynamic=True`` in the functions below is the trapezoidal rule."""
+    impact's ringing) at first-order accuracy. ``dynamic=True`` in the functions below is the trapezoidal rule.
+
+    ``alpha_B`` (-1/3..0; 0: Newmark's rule itself) is Wood, Bossak & Zienkiewicz's (1980) alpha: the inertia
+    M ((1 - alpha_B) a_{n+1} + alpha_B a_n) in the equation of motion, with gamma = 1/2 - alpha_B and beta =
+    (1 - alpha_B)^2 / 4 (:meth:`bossak`), damps the high frequencies at second-order accuracy (the Bossak-Newmark
+    rule of implicit codes, e.g. Kratos' structural solvers; the paper names none)."""
 
     beta: float
     gamma: float
+    alpha_B: float = 0.0
 
     def __post_init__(self):
+        if not -1.0 / 3.0 <= self.alpha_B <= 0.0:
+            raise ValueError(f"Bossak's alpha_B must lie in [-1/3, 0], got {self.alpha_B!r}")
         if not (0.0 < self.beta <= 0.5 and 0.5 <= self.gamma <= 1.0 and self.beta >= 0.25 * (self.gamma + 0.5) ** 2
                 - 1e-12):
             raise ValueError(f"Newmark(beta, gamma) must be unconditionally stable: 1/2 <= gamma <= 1, "
                              f"(gamma + 1/2)^2 / 4 <= beta <= 1/2; got {self.beta!r}, {self.gamma!r}")
 
+    @classmethod
+    def bossak(cls, alpha_B: float) -> "Newmark":
+        """The Bossak-Newmark rule: gamma = 1/2 - alpha_B, beta = (1 - alpha_B)^2 / 4 (second order, damped)."""
+        return cls((1.0 - alpha_B) ** 2 / 4.0, 0.5 - alpha_B, alpha_B)
+
     def acceleration(self, du, v, a, dt):
         return (du - dt * v - dt * dt * (0.5 - self.beta) * a) / (self.beta * dt * dt)
+
+    def inertia(self, a_new, a):
+        """The acceleration the inertia of the equation of motion takes: (1 - alpha_B) a_{n+1} + alpha_B a_n."""
+        return a_new if self.alpha_B == 0.0 else (1.0 - self.alpha_B) * a_new + self.alpha_B * a
 
 
 TRAPEZOIDAL = Newmark(0.25, 0.5)
@@ -554,13 +571,14 @@ def _assemble(nodes, mesh, hist, law, du, p, dt, dynamic, tangent=True, known=No
     if dynamic:
         nm = newmark_of(dynamic)
         a_new = nm.acceleration(du, nodes.v, nodes.a, dt)                  # Eq. (21)
-        R[:2 * n] += (nodes.m[:, None] * a_new).ravel()
-        scale = scale + np.abs(nodes.m[:, None] * a_new).ravel()
+        inertia = nodes.m[:, None] * nm.inertia(a_new, nodes.a)
+        R[:2 * n] += inertia.ravel()
+        scale = scale + np.abs(inertia).ravel()
     parts = None
     if tangent:
         parts = TangentParts(_element_tangent(xe, due, pe, hist, Te, dt, law, resp, r_u, r_p), dofs, n)
         if dynamic:
-            parts.diag = np.concatenate([np.repeat(nodes.m / (nm.beta * dt**2), 2), np.zeros(n)])
+            parts.diag = np.concatenate([np.repeat(nodes.m * (1.0 - nm.alpha_B) / (nm.beta * dt**2), 2), np.zeros(n)])
     return R, parts, resp, (float(np.linalg.norm(scale)), float(scale_p))
 
 

@@ -70,7 +70,7 @@ def main(argv=None) -> int:
                     help="folders of the sweep's run folders, looked in in order (default runs/thermal_cutting)")
     args = ap.parse_args(argv)
     rows = json.loads(OUT_JSON.read_text()) if OUT_JSON.exists() else {}
-    for key, (_, numerics) in tc.jobs().items():
+    for key, (_, numerics) in dict(tc.jobs(), **tc.retry_jobs(tc.load()["runs"])).items():   # retries too
         if numerics.get("method") == "pfem":
             r = next((r for r in (row(d / tc.run_folder(key).name) for d in args.runs) if r is not None), None)
             if r is not None:

@@ -616,8 +616,8 @@ for case in (1, 10):
               f"T_FCS {c[f'TFCS_{t}_K']:.0f} K")
 
 # %% [markdown]
-# **Where it stands.** 17 of 18 cuts at t_u/5 (16: `gamma=0.6`); case 1 at t_u/10: 27 min. **Fails:** Fp/Fc 0.14-0.40
-# (measured 0.71-0.83; a 10° rake allows 0.55; `edge_nodes=True`: 3-4 %); the trapezoidal rule rings (8, 16 stall).
+# **Where it stands.** 17 of 18 cuts at t_u/5; case 1 at t_u/10: 27 min. **Fails:** Fp/Fc 0.14-0.40 (measured 0.71-0.83;
+# a 10° rake allows 0.55; α 1.25-2 moves it ≤ 9 %); the trapezoidal rule rings (8, 9, 16 stall): `gamma=0.6` damps it.
 
 # %% [markdown]
 # ## Your turn

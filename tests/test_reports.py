@@ -229,12 +229,13 @@ def test_thermal_cutting_queues_the_retry_of_a_failed_case():
     mod = _script("thermal_cutting")
     recs = {"case 3": dict(status="blow-up"), "case 4": dict(status="ok"), "case 12 pfem": dict(status="error")}
     out = mod.retry_jobs(recs)
-    assert set(out) == {"case 3" + mod.RETRY, "case 12 pfem" + mod.DAMPED}
-    options, numerics = out["case 12 pfem" + mod.DAMPED]
-    assert options["case"] == 12 and options["n_tu"] == 10.0 and options["gamma"] == mod.DAMPED_GAMMA
+    bossak = "case 12 pfem n_tu 10" + mod.BOSSAK
+    assert set(out) == {"case 3" + mod.RETRY, bossak}
+    options, numerics = out[bossak]
+    assert options["case"] == 12 and options["n_tu"] == 10.0 and options["bossak"] == mod.BOSSAK_ALPHA
     assert numerics == dict(method="pfem")
     assert out["case 3" + mod.RETRY][1]["courant"] == mod.RETRY_COURANT
-    assert set(mod.retry_jobs(recs, studies=("pfem",))) == {"case 12 pfem" + mod.DAMPED}
+    assert set(mod.retry_jobs(recs, studies=("pfem",))) == {bossak}
 
 
 def test_thermal_cutting_takes_a_failed_pfem_case_with_the_damped_rule():
@@ -250,5 +251,10 @@ def test_thermal_cutting_takes_a_failed_pfem_case_with_the_damped_rule():
     assert rows[8]["status"] == "ok" and rows[8]["key"] == "case 8 pfem" + mod.DAMPED
     assert "ok (gamma 0.6)" in mod._case_line(rows[8])
     assert {r["case"]: r for r in mod.comparison(res, mod.PFEM)}[8]["status"] == "failed"
+    res["runs"]["case 8 pfem n_tu 10" + mod.BOSSAK] = ok                # Bossak-Newmark before the damped rule
+    rows = {r["case"]: r for r in mod.comparison(res, mod.PFEM10)}
+    assert rows[8]["key"] == "case 8 pfem n_tu 10" + mod.BOSSAK and "ok (Bossak -0.1)" in mod._case_line(rows[8])
+    res["runs"]["case 8 pfem n_tu 10" + mod.BOSSAK] = dict(status="failed")
+    assert {r["case"]: r for r in mod.comparison(res, mod.PFEM10)}[8]["key"] == "case 8 pfem" + mod.DAMPED
     del res["runs"]["case 8 pfem" + mod.DAMPED]
     assert {r["case"]: r for r in mod.comparison(res, mod.PFEM10)}[8]["status"] == "failed"

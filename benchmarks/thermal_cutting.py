@@ -190,17 +190,8 @@ def jobs(studies=STUDY_NAMES, only=None) -> dict:
     add("resolution", "case 10 n_tu 15", converged(10, n_tu=15.0), sweep_numerics(15.0))
     for n in range(2, 19):                                   # the PFEM's 18 cases at t_u/10 ('case 1 pfem' above)
         add("pfem", f"case {n}{PFEM10}", converged(n, n_tu=10.0), dict(method="pfem"))
-    for n in (16, 8, 9):                                     # the trapezoidal rule rings and Newton stalls (DAMPED)
-        add("pfem", f"case {n}{PFEM10}{DAMPED}", dict(converged(n, n_tu=10.0), gamma=DAMPED_GAMMA), dict(method="pfem"))
-    for key, options in remesh_jobs():                       # Algorithm 1's "if remeshing is needed", literally
+    for key, options in time_rule_jobs() + remesh_jobs():   # damped rules; Algorithm 1's "if remeshing is needed"
         add("pfem", key, options, dict(method="pfem"))
-    # the damped rule is first-order accurate, Bossak-Newmark second: both on case 1's whole cut at t_u/5 (beside its
-    # trapezoidal record), then on case 8 at t_u/10 (where the trapezoidal rule stalled), against the damped run
-    for key, opts in ((f"case 1{PFEM} gamma {DAMPED_GAMMA:g}", dict(gamma=DAMPED_GAMMA)),
-                      (f"case 1{PFEM}{BOSSAK}", dict(bossak=BOSSAK_ALPHA))):
-        add("pfem", key, dict(converged(1, n_tu=5.0), **opts), dict(method="pfem"))
-    add("pfem", f"case 8{PFEM10} n_tu 10{BOSSAK}", dict(converged(8, n_tu=10.0), bossak=BOSSAK_ALPHA),
-        dict(method="pfem"))
     return todo
 
 
@@ -218,6 +209,17 @@ def retry_jobs(records: dict, studies=STUDY_NAMES) -> dict:
             out[pfem + RETRIES[PFEM10][0]] = (dict(converged(n, n_tu=10.0), bossak=BOSSAK_ALPHA),
                                               dict(method="pfem"))
     return out
+
+
+def time_rule_jobs() -> list[tuple[str, dict]]:
+    """(key, options) of the PFEM cuts with a damped time rule: the damped Newmark rule (DAMPED) for the cases where
+    the trapezoidal rule rang and Newton stalled (16, 8, 9 at t_u/10); the damped rule is first-order accurate and
+    Bossak-Newmark second, so both on case 1's whole cut at t_u/5 (beside its trapezoidal record), then Bossak on
+    case 8 at t_u/10 (beside its damped run)."""
+    out = [(f"case {n}{PFEM10}{DAMPED}", dict(converged(n, n_tu=10.0), gamma=DAMPED_GAMMA)) for n in (16, 8, 9)]
+    out += [(f"case 1{PFEM} gamma {DAMPED_GAMMA:g}", dict(converged(1, n_tu=5.0), gamma=DAMPED_GAMMA)),
+            (f"case 1{PFEM}{BOSSAK}", dict(converged(1, n_tu=5.0), bossak=BOSSAK_ALPHA))]
+    return out + [(f"case 8{PFEM10} n_tu 10{BOSSAK}", dict(converged(8, n_tu=10.0), bossak=BOSSAK_ALPHA))]
 
 
 def remesh_jobs() -> list[tuple[str, dict]]:

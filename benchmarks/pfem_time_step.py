@@ -19,6 +19,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))      # benchmarks/study
 import study  # noqa: E402
 
 study.pin_threads()
+import thermal_cutting as tc  # noqa: E402  (the sweep's cuts)
 
 ROOT = Path(__file__).resolve().parents[1]
 OUT_JSON = Path(__file__).resolve().parent / "pfem_time_step.json"
@@ -47,8 +48,9 @@ def run_one(value: float, option: str = "courant", runs: Path = RUNS, cut: str =
 
 
 # the cuts a scan may run: '' the quick cut (case 1, t_u/5, 4 t_u on 1.2 mm), 'case 1 t_u/5' the whole cut of the
-# sweep's 'case 1 n_tu 5 pfem' (16 t_u of cut, 12 t_u left uncut)
-CUTS = {"": ({}, True), "case 1 t_u/5": (dict(case=1, n_tu=5.0, travel=16.0, length=28 * 1e-4), False)}
+# sweep's 'case 1 pfem n_tu 5' (its options as the sweep gives them: 16 t_u of cut, 12 t_u left uncut)
+CUTS = {"": ({}, True), "case 1 t_u/5": ({k: v for k, v in tc.converged(1, n_tu=5.0).items() if k in tc.PFEM_OPTIONS},
+                                         False)}
 
 
 TITLE = "# The PFEM cut's time step (quick cut: case 1, t_u/5, 4 t_u)"

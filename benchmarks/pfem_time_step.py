@@ -67,9 +67,10 @@ def report(rows: list, option: str = "courant", title: str = TITLE, made_by: str
     head = f"| {option} | steps | halved | Newton iterations | " + " | ".join(k[0] for k in KEYS) + " |"
     lines = [title, "", made_by, "", head, "|---" * (4 + len(KEYS)) + "|"]
     for i, r in enumerate(rows):
-        base = ref if reference is not None else (rows[i + 1]["metrics"] if i + 1 < len(rows) else None)
-        if reference is not None and r[option] == reference:
-            base = None
+        if reference is None:                       # against the next smaller value
+            base = rows[i + 1]["metrics"] if i + 1 < len(rows) else None
+        else:                                       # against the reference row (itself: no change shown)
+            base = None if r[option] == reference else ref
         cells = []
         for _, key, scale, fmt in KEYS:
             v = r["metrics"][key]

@@ -104,6 +104,7 @@ BOSSAK = f" bossak {BOSSAK_ALPHA:g}"         # its key suffix (gamma 0.6 too, be
 RETRIES = {"": (RETRY,), PFEM10: (f" n_tu 10{BOSSAK}", DAMPED)}
 PFEM_OPTIONS = ("case", "n_tu", "travel", "length", "gamma", "remesh_when_needed", "bossak")   # what the PFEM takes
 REMESH = " remesh when needed"              # the key suffix of a PFEM cut that remeshes only where the quality asks
+PFEM_FINE = ((1, 15.0), (2, 15.0), (3, 20.0))   # (case, nodes across t_u) of the PFEM finer than t_u/10
 REMESH_RUNS = ((1, PFEM, 5.0), (5, PFEM, 5.0), (10, PFEM, 5.0), (1, PFEM10, 10.0))   # (case, suffix, n_tu) of those
 
 
@@ -190,8 +191,8 @@ def jobs(studies=STUDY_NAMES, only=None) -> dict:
     add("resolution", "case 10 n_tu 15", converged(10, n_tu=15.0), sweep_numerics(15.0))
     for n in range(2, 19):                                   # the PFEM's 18 cases at t_u/10 ('case 1 pfem' above)
         add("pfem", f"case {n}{PFEM10}", converged(n, n_tu=10.0), dict(method="pfem"))
-    for key, options in time_rule_jobs() + remesh_jobs():   # damped rules; Algorithm 1's "if remeshing is needed"
-        add("pfem", key, options, dict(method="pfem"))
+    for key, options in time_rule_jobs() + remesh_jobs() + pfem_resolution_jobs():   # damped rules; Algorithm 1's
+        add("pfem", key, options, dict(method="pfem"))                  # "if remeshing is needed"; finer nodes
     return todo
 
 
@@ -229,6 +230,14 @@ def remesh_jobs() -> list[tuple[str, dict]]:
     (``remesh_when_needed``), beside the sweep's 'case N' + suffix (a remeshing after every step): REMESH_RUNS."""
     return [(f"case {n}{suffix}{REMESH}", dict(converged(n, n_tu=n_tu), remesh_when_needed=True))
             for n, suffix, n_tu in REMESH_RUNS]
+
+
+def pfem_resolution_jobs() -> list[tuple[str, dict]]:
+    """(key, options) of the PFEM cuts finer than the sweep's t_u/10 (PFEM_FINE): case 1 at t_u/15 (from t_u/5 to
+    t_u/10 its Fp/Fc rose from 0.33 to 0.40: whether it converges, and to what), and cases 2 and 3 at the paper's
+    node spacing, 10 um near the tool (15 and 20 nodes across t_u = 0.15 and 0.20 mm, where t_u/10 is 15 and
+    20 um)."""
+    return [(f"case {n}{PFEM10} n_tu {n_tu:g}", converged(n, n_tu=n_tu)) for n, n_tu in PFEM_FINE]
 
 
 QUICK = dict(length=1.2e-3, travel=4.0, n_tu=5.0)   # --quick: chapter 11's short cut at the quick resolution
@@ -602,8 +611,10 @@ STUDIES = (
      ("case 1 heat every 8",) + SCATTER_KEYS,
      BASIC + (("steps", "n_steps", "d"), ("CPU [min]", "cpu_min", ".1f"), ("wall [s]", "wall", ".0f"))),
     ("The PFEM's resolution (case 1: the short cut of --quick, 4 t_u on a workpiece 1.2 mm long, and the full cut "
-     "of 16 t_u)",
-     ("case 1 pfem short n_tu 5", "case 1 pfem short n_tu 10", "case 1 pfem n_tu 5", "case 1 pfem"),
+     "of 16 t_u; cases 2 and 3 at t_u/5, t_u/10 and the paper's 10 um near the tool, 15 and 20 nodes across t_u)",
+     ("case 1 pfem short n_tu 5", "case 1 pfem short n_tu 10", "case 1 pfem n_tu 5", "case 1 pfem",
+      "case 1 pfem n_tu 15", "case 2 pfem n_tu 5", "case 2 pfem", "case 2 pfem n_tu 15", "case 3 pfem n_tu 5",
+      "case 3 pfem", "case 3 pfem n_tu 20"),
      (("across t_u", "across", ".0f"), ("dx [um]", "dx_um", ".1f"), ("nodes", "n_particles", "d")) + BASIC
      + (("steps", "n_steps", "d"), ("wall [s]", "wall", ".0f"))),
     ("The time step (the sweep at t_u/10 runs at courant 0.15: at the scene's 0.3 a particle on the torn surface "

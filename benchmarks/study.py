@@ -120,6 +120,28 @@ class RunStore:
         self.update(change)
         return bool(kept)
 
+    def merge(self, other: Path) -> dict:
+        """Take the records of another store's file (a sweep run in another worktree or on another machine): a key
+        not here is added, a good record there replaces a failed one here; a key good here, or failed in both, stays
+        as it is. {'added': keys, 'replaced': keys, 'kept': keys that differ there and stayed}."""
+        theirs = RunStore(other, self.section, self.good).records()
+        out = {"added": [], "replaced": [], "kept": []}
+
+        def change(doc):
+            mine = doc[self.section]
+            for key, rec in theirs.items():
+                if key not in mine:
+                    mine[key] = rec
+                    out["added"].append(key)
+                elif rec != mine[key] and self.good(rec) and not self.good(mine[key]):
+                    doc.setdefault("failed", {})[key] = mine[key]
+                    mine[key] = rec
+                    out["replaced"].append(key)
+                elif rec != mine[key]:
+                    out["kept"].append(key)
+        self.update(change)
+        return out
+
     def set(self, **fields) -> dict:
         """Store top-level fields of the document beside the records (e.g. a machine description)."""
         return self.update(lambda doc: doc.update(fields))

@@ -857,6 +857,10 @@ def main(argv=None) -> int:
     if args.status:
         print("\n".join(status_lines(store(args.json).records(), todo, args.quick)))
         return 0
+    if args.merge is not None:
+        merged = store(args.json).merge(args.merge)
+        print("\n".join(f"{what}: {', '.join(keys) or 'none'}" for what, keys in merged.items()))
+        args.report = True                                  # then the page, not a sweep
     if args.backfill_cpu:
         print(f"CPU seconds from the run folders: {', '.join(backfill_cpu(store(args.json))) or 'none'}")
         args.report = True                                  # then the page, not a sweep
@@ -890,6 +894,9 @@ def _parser():
     ap.add_argument("--json", type=Path, default=OUT_JSON, help="the records (default: the committed JSON)")
     ap.add_argument("--backfill-cpu", action="store_true",
                     help="records without CPU seconds get them from their run folder's summary (then the report)")
+    ap.add_argument("--merge", type=Path, default=None, metavar="JSON",
+                    help="take the records of another sweep's JSON (another worktree or machine) that are missing "
+                         "here, or good there and failed here (never the other way), then write the page")
     ap.add_argument("--status", action="store_true",
                     help="no runs: each job's record, or how far its run folder has got, or 'to run'")
     return ap

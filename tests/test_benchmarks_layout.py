@@ -109,6 +109,26 @@ def test_run_store_keeps_good_records_and_reads_the_committed_format(tmp_path):
     assert not list(tmp_path.glob("*.tmp"))                       # written atomically: no temporary file left
 
 
+def test_run_store_merges_another_sweeps_records_without_losing_a_good_one(tmp_path):
+    """--merge: a key missing here is added, a good record there replaces a failed one here (which is kept under
+    'failed'), and a good record here is never replaced, by a failed one or by a different good one."""
+    study = _study()
+    here, there = study.RunStore(tmp_path / "here.json"), study.RunStore(tmp_path / "there.json")
+    for key, rec in (("good", dict(status="ok", v=1)), ("failed", dict(status="failed: x")),
+                     ("good vs failed", dict(status="ok", v=2)), ("same", dict(status="ok", v=3))):
+        here.commit(key, rec)
+    for key, rec in (("new", dict(status="ok", v=4)), ("failed", dict(status="ok", v=5)),
+                     ("good vs failed", dict(status="failed: y")), ("good", dict(status="ok", v=6)),
+                     ("same", dict(status="ok", v=3))):
+        there.commit(key, rec)
+    out = here.merge(tmp_path / "there.json")
+    assert out == {"added": ["new"], "replaced": ["failed"], "kept": ["good", "good vs failed"]}
+    doc = here.load()
+    assert doc["runs"]["new"]["v"] == 4 and doc["runs"]["failed"]["v"] == 5 and doc["runs"]["good"]["v"] == 1
+    assert doc["runs"]["good vs failed"]["v"] == 2 and doc["failed"]["failed"]["status"] == "failed: x"
+    assert here.merge(tmp_path / "there.json") == {"added": [], "replaced": [], "kept": ["good", "good vs failed"]}
+
+
 def test_execute_runs_each_task_and_records_a_crash():
     """Fresh processes: every task's result comes back under its key; a task that raises gives a failed record."""
     import math

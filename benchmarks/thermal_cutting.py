@@ -104,6 +104,9 @@ BOSSAK = f" bossak {BOSSAK_ALPHA:g}"         # its key suffix (gamma 0.6 too, be
 RETRIES = {"": (RETRY,), PFEM10: (f" n_tu 10{BOSSAK}", DAMPED)}
 PFEM_OPTIONS = ("case", "n_tu", "travel", "length", "gamma", "remesh_when_needed", "bossak")   # what the PFEM takes
 REMESH = " remesh when needed"              # the key suffix of a PFEM cut that remeshes only where the quality asks
+PAPER_CUT = (1.5e-3, 2.0e-3)   # m of tool travel: the last quarter of the paper's PFEM cut, 2/3 of its 3 mm workpiece
+TO_2MM = " 2 mm"               # key suffix: a t_u = 0.1 mm case cut to 2 mm (20 t_u) on the paper's 3 mm workpiece
+TU_01 = (1, 4, 7, 10, 13, 16)   # the cases at t_u = 0.1 mm
 PFEM_FINE = ((1, 15.0), (2, 15.0), (3, 20.0))   # (case, nodes across t_u) of the PFEM finer than t_u/10
 REMESH_RUNS = ((1, PFEM, 5.0), (5, PFEM, 5.0), (10, PFEM, 5.0), (1, PFEM10, 10.0))   # (case, suffix, n_tu) of those
 
@@ -191,9 +194,22 @@ def jobs(studies=STUDY_NAMES, only=None) -> dict:
     add("resolution", "case 10 n_tu 15", converged(10, n_tu=15.0), sweep_numerics(15.0))
     for n in range(2, 19):                                   # the PFEM's 18 cases at t_u/10 ('case 1 pfem' above)
         add("pfem", f"case {n}{PFEM10}", converged(n, n_tu=10.0), dict(method="pfem"))
-    for key, options in time_rule_jobs() + remesh_jobs() + pfem_resolution_jobs():   # damped rules; Algorithm 1's
-        add("pfem", key, options, dict(method="pfem"))                  # "if remeshing is needed"; finer nodes
+    for study_name, key, options, numerics in more_jobs():   # time rules, remeshing, finer nodes, the paper's cut
+        add(study_name, key, options, numerics)
     return todo
+
+
+def more_jobs() -> list[tuple[str, str, dict, dict]]:
+    """(study, key, options, numerics) of the sweep's later runs: the PFEM's damped time rules (time_rule_jobs),
+    its remeshing only where needed (remesh_jobs) and finer nodes (pfem_resolution_jobs), then the t_u = 0.1 mm
+    cases cut to the paper's 2 mm (20 t_u; the sweep's 16 t_u is 1.6 mm) on its 3 mm workpiece (TO_2MM), the
+    PFEM's first."""
+    pfem = dict(method="pfem")
+    out = [("pfem", key, options, pfem) for key, options in time_rule_jobs() + remesh_jobs() + pfem_resolution_jobs()]
+    out += [("pfem", f"case {n}{PFEM10}{TO_2MM}", converged(n, n_tu=10.0, travel=20.0, length=3e-3), pfem)
+            for n in TU_01]
+    return out + [("cases", f"case {n}{TO_2MM}", converged(n, travel=20.0, length=3e-3), sweep_numerics())
+                  for n in TU_01]
 
 
 def retry_jobs(records: dict, studies=STUDY_NAMES) -> dict:

@@ -431,6 +431,9 @@ def report(res: dict, before: dict | None = None) -> str:
     lines += ["", P("pfem10", done=sum(r["status"] == "ok" for r in pfem10))] + [_case_line(r) for r in pfem10]
     lines += ["", P("pfem10_errors")] + _mean_error_lines(pfem10, old)
     lines += ["", P("pfem10_same")] + _same_cases_lines(pfem10)
+    at2 = {m: paper_length_rows(res, sfx) for m, sfx in (("PFEM", PFEM10), ("SPH", ""))}
+    lines += ["", P("paper_length")] + [x for m, rows_ in at2.items() for x in _paper_length_lines(rows_, m)]
+    lines += ["", P("paper_length_errors")] + [x for m, rows_ in at2.items() for x in _paper_length_errors(rows_, m)]
     lines += ["", P("pfem_forces")] + [_pfem_force_line(r, res) for r in pfem]
     lines += ["", P("dof")] + _dof_lines(pfem, coarse, res)
     lines += ["", P("forces")]
@@ -514,6 +517,66 @@ def _same_cases_lines(rows: list) -> list[str]:
             diff = f"{np.mean(d):+.1f} ({min(d):+.0f} to {max(d):+.0f})" if d else "-"
             lines.append(f"| {mat} | {name} | {len(ran)} | {_f(_mean(ran, f'{q}_err'), '.1f')} | "
                          f"{_f(_mean(ran, f'{q}_pfem_err'), '.1f')} | {diff} |")
+    return lines
+
+
+def window_means(rec: dict | None, vc: float, a: float, b: float) -> dict | None:
+    """Means over the tool's travel a..b [m] (v_c t) of a record's histories (about 100 points over its cut): T_RF,
+    T_FCS [K] and Fp/Fc (the ratio of the mean forces, as the metrics); None where the run is not 'ok' or did not
+    reach b."""
+    h = rec.get("histories") if rec and rec.get("status") == "ok" else None
+    if not h:
+        return None
+    T = np.array(h["temperature_history"], dtype=float)          # rows (t, T_RF, T_FCS); None -> nan
+    Fc, Fp = (np.array(h[k], dtype=float) for k in ("cutting_force_history", "passive_force_history"))
+    if vc * T[-1, 0] < b * (1.0 - 1e-6):
+        return None
+
+    def mean(rows, col):
+        s = vc * rows[:, 0]
+        v = rows[(s >= a) & (s <= b * (1.0 + 1e-9)), col]
+        return float(v[np.isfinite(v)].mean()) if np.isfinite(v).any() else float("nan")
+    return dict(TRF=mean(T, 1), TFCS=mean(T, 2), ratio=mean(Fp, 1) / mean(Fc, 1))
+
+
+def paper_length_rows(res: dict, suffix: str) -> list[dict]:
+    """The comparison rows (``suffix``: "" the SPH, PFEM10 the PFEM, both at t_u / 10) with each quantity also at
+    the paper's length of cut: means over PAPER_CUT of the tool's travel, from the case's own run where its cut is
+    longer (t_u = 0.15, 0.20 mm), else from its run cut to 2 mm ('case N' + suffix + TO_2MM); '2mm' the values
+    (None where neither has run), 'key2' the run they come from."""
+    rows = comparison(res, suffix)
+    for r in rows:
+        longer = f"case {r['case']}{suffix}{TO_2MM}"
+        key2 = longer if res["runs"].get(longer, {}).get("status") == "ok" else r["key"]
+        w = window_means(res["runs"].get(key2), r["vc"] / 60.0, *PAPER_CUT)
+        r["key2"] = key2 if w else None
+        r["2mm"] = {q: (v, _err(v, r[f"{q}_exp"])) for q, v in w.items()} if w else None
+    return rows
+
+
+def _paper_length_lines(rows: list, method: str) -> list[str]:
+    """The table of :func:`paper_length_rows` (``method``: 'SPH' or 'PFEM', whose paper column it shows)."""
+    src, lines = f"_{method.lower()}", []
+    for r in rows:
+        w = r["2mm"] or {}
+        cells = [f"{r['case']}", r["material"], f"{r['tu']:.2f}", f"'{r['key2']}'" if r["key2"] else "-"]
+        for q, fmt in (("TRF", ".0f"), ("TFCS", ".0f"), ("ratio", ".2f")):
+            v, e = w.get(q, (None, float("nan")))
+            cells += [f"{_f(v, fmt)} ({_f(e, '.0f')} %)", f"{_f(r[q], fmt)} ({_f(r[f'{q}_err'], '.0f')} %)",
+                      format(r[f"{q}_exp"], fmt), f"{format(r[q + src], fmt)} ({r[q + src + '_err']:.0f} %)"]
+        lines.append(f"| {method} | " + " | ".join(cells) + " |")
+    return lines
+
+
+def _paper_length_errors(rows: list, method: str) -> list[str]:
+    """Mean errors per material over the cases with a value at 2 mm: at 2 mm, at 16 t_u, the paper's method."""
+    lines, src = [], f"_{method.lower()}"
+    for mat in ("AISI1045", "Ti6Al4V"):
+        got = [r for r in rows if r["material"] == mat and r["2mm"] and r["status"] == "ok"]
+        for q, name in (("TRF", "T_RF, contact mean"), ("TFCS", "T_FCS"), ("ratio", "Fp/Fc")):
+            at2 = float(np.mean([r["2mm"][q][1] for r in got])) if got else float("nan")
+            lines.append(f"| {method} | {mat} | {name} | {len(got)} of 9 | {_f(at2, '.1f')} | "
+                         f"{_f(_mean(got, f'{q}_err'), '.1f')} | {_f(_mean(got, f'{q}{src}_err'), '.1f')} |")
     return lines
 
 

@@ -258,3 +258,24 @@ def test_thermal_cutting_takes_a_failed_pfem_case_with_the_damped_rule():
     assert {r["case"]: r for r in mod.comparison(res, mod.PFEM10)}[8]["key"] == "case 8 pfem" + mod.DAMPED
     del res["runs"]["case 8 pfem" + mod.DAMPED]
     assert {r["case"]: r for r in mod.comparison(res, mod.PFEM10)}[8]["status"] == "failed"
+
+
+def test_thermal_cutting_means_at_the_paper_length_of_cut():
+    """window_means: means over a stretch of the tool's travel from a record's histories (a linear history's mean is
+    its midpoint value; None before the run reaches the window's end); over the last quarter of a committed run's cut
+    it gives that run's recorded metrics (the same window, from 100 points instead of every step)."""
+    mod = _script("thermal_cutting")
+    t = np.linspace(0.0, 2e-3, 201)                                 # 2 mm at 1 m/s
+    rec = dict(status="ok", histories=dict(temperature_history=[[s, 300.0 + 1e5 * s, None] for s in t],
+                                           cutting_force_history=[[s, 2.0] for s in t],
+                                           passive_force_history=[[s, 1e3 * s] for s in t]))
+    w = mod.window_means(rec, 1.0, 1.5e-3, 2.0e-3)
+    assert w["TRF"] == pytest.approx(300.0 + 1e5 * 1.75e-3) and w["ratio"] == pytest.approx(1.75e-3 / 2.0 * 1e3)
+    assert np.isnan(w["TFCS"]) and mod.window_means(rec, 0.5, 1.5e-3, 2.0e-3) is None
+    assert mod.window_means(dict(rec, status="failed: x"), 1.0, 1.5e-3, 2.0e-3) is None
+    runs = mod.load()["runs"]
+    for key, vc in (("case 3 pfem", 1.0), ("case 11", 20 / 60)):
+        m, end = runs[key]["metrics"], vc * runs[key]["histories"]["temperature_history"][-1][0]
+        w = mod.window_means(runs[key], vc, 0.75 * end, end)
+        assert w["TRF"] == pytest.approx(m["rake_face_temperature_K"], rel=0.01)
+        assert w["ratio"] == pytest.approx(m["force_ratio"], rel=0.03)

@@ -48,9 +48,13 @@ def run_one(value: float, option: str = "courant", runs: Path = RUNS, cut: str =
 
 
 # the cuts a scan may run: '' the quick cut (case 1, t_u/5, 4 t_u on 1.2 mm), 'case 1 t_u/5' the whole cut of the
-# sweep's 'case 1 pfem n_tu 5' (its options as the sweep gives them: 16 t_u of cut, 12 t_u left uncut)
+# sweep's 'case 1 pfem n_tu 5' (its options as the sweep gives them: 16 t_u of cut, 12 t_u left uncut), 'case 1
+# t_u/5 8 t_u' its first half (the same workpiece)
 CUTS = {"": ({}, True), "case 1 t_u/5": ({k: v for k, v in tc.converged(1, n_tu=5.0).items() if k in tc.PFEM_OPTIONS},
-                                         False)}
+                                         False),
+        "case 1 t_u/5 8 t_u": ({k: v for k, v in tc.converged(1, n_tu=5.0, travel=8.0).items()
+                                if k in tc.PFEM_OPTIONS and k != "length"} | {"length": tc.converged(1)["length"]},
+                               False)}
 
 
 TITLE = "# The PFEM cut's time step (quick cut: case 1, t_u/5, 4 t_u)"

@@ -107,6 +107,7 @@ def test_export_gives_paraview_the_triangles(short_run):
     (("run", "thermal_cutting", "--method", "pfem", "--option", "mass_scale=10"), "not an option of the PFEM cut"),
     (("run", "thermal_cutting", "--method", "pfem", "--option", "n_tu=abc"), "must be a number"),
     (("run", "thermal_cutting", "--method", "pfem", "--option", "edge_nodes=maybe"), "must be true or false"),
+    (("run", "thermal_cutting", "--method", "pfem", "--option", "edge_radius=0"), "edge radius must be positive"),
 ])
 def test_cli_refuses_what_the_pfem_cannot_take(args, says, tmp_path, capsys):
     assert main(list(args) + ["--out", str(tmp_path / "o")]) == 2
@@ -265,3 +266,20 @@ def test_a_checkpoint_without_cpu_seconds_continues_with_them_unknown():
     old = CutRun.restore(cut, dict(ck, record=np.array(js.dumps(rec))))
     old.step()
     assert old.cpu is None and old.result()["cpu_time_s"] is None
+
+
+def test_the_edge_radius_is_an_option_of_the_contact_outline():
+    """--option edge_radius=R [m]: the contact's outline has the tool's edge rounded by R (the paper's 10 um by
+    default), so the outline's apex moves back along the bisector by R (1/sin(beta/2) - 1)."""
+    import math
+    from refsph.pfem.cutting import pfem_cut
+    from refsph.pfem_run import _options
+    from refsph.scenes.thermal_cutting import CLEARANCE_DEG, RAKE_DEG
+
+    kw = _options(dict(SHORT, edge_radius="3e-5"), quick=True)
+    blunt, sharp = pfem_cut(**kw), pfem_cut(**_options(SHORT, quick=True))
+    assert blunt.shape.radius == 3e-5 and sharp.shape.radius == 1e-5 and blunt.info["edge_radius_m"] == 3e-5
+    half = math.radians(90.0 - RAKE_DEG - CLEARANCE_DEG) / 2
+    apex = np.array(sharp.info["apex0"]) - sharp.shift0                  # the sharp corner, in the outline's frame
+    tip = [min(np.linalg.norm(apex - np.array(c)) for c in cut.shape.core) - cut.shape.radius for cut in (sharp, blunt)]
+    assert tip[1] - tip[0] == pytest.approx(2e-5 * (1 / math.sin(half) - 1), rel=1e-9)

@@ -212,7 +212,7 @@ def pfem_cut(case: int, n_tu: float = 10.0, travel: float = 16.0, length: float 
              courant: float = 0.25, alpha: float = 1.4, penalty: float = 20.0, friction: bool = True,
              conduction: bool = True, chip_fraction: float = 0.5, refine: bool = True, r_min: float = 0.5,
              a_max: float = 2.5, gamma: float = 0.5, edge_nodes: bool = False,
-             remesh_when_needed: bool = False, bossak: float = 0.0) -> PFEMCut:
+             remesh_when_needed: bool = False, bossak: float = 0.0, edge_radius: float = EDGE_RADIUS) -> PFEMCut:
     """The cut of row ``case`` of the paper's Appendix B: dx = t_u / n_tu, ``travel`` t_u of cut on a workpiece
     ``length`` [m] long (default (travel + 12) t_u), dt = courant dx / v_c, contact penalties ``penalty`` G / dx;
     ``conduction``: the heat step (module text; False: adiabatic), ``chip_fraction`` of the frictional heat into
@@ -223,7 +223,8 @@ def pfem_cut(case: int, n_tu: float = 10.0, travel: float = 16.0, length: float 
     instead, Bossak's alpha_B in [-1/3, 0) (:meth:`refsph.pfem.solid.Newmark.bossak`: damped at second order);
     ``edge_nodes``: the mesh kept off the tool (:class:`PFEMCut`; with ``refine``); ``remesh_when_needed``:
     Algorithm 1's "if remeshing is needed" read literally, a remeshing only where a triangle's quality falls below
-    ``remesh_quality`` (False: after every step as well, refsph's default; module text)."""
+    ``remesh_quality`` (False: after every step as well, refsph's default; module text); ``edge_radius`` [m]: the
+    tool's edge radius in the contact's outline (the paper's 10 um; the meshed tool of the heat step keeps it)."""
     row = rla_cutting_case(int(case))
     mat = MATERIALS[row["material"]]
     vc, tu = row["vc_m_per_min"] / 60.0, row["tu_mm"] * 1e-3
@@ -235,6 +236,8 @@ def pfem_cut(case: int, n_tu: float = 10.0, travel: float = 16.0, length: float 
                          f"penalty > 0 and 0 <= chip_fraction <= 1; got n_tu = {n_tu!r}, travel = {travel!r} tu, "
                          f"length = {length!r} m, courant = {courant!r}, penalty = {penalty!r}, "
                          f"chip_fraction = {chip_fraction!r}")
+    if not (0.0 < edge_radius < tu):
+        raise ValueError(f"PFEM cut: the edge radius must be positive and below t_u = {tu!r} m, got {edge_radius!r}")
     if bossak != 0.0 and gamma != 0.5:
         raise ValueError(f"PFEM cut: give gamma (damped Newmark) or bossak (Bossak-Newmark), not both; got gamma = "
                          f"{gamma!r}, bossak = {bossak!r}")
@@ -254,7 +257,7 @@ def pfem_cut(case: int, n_tu: float = 10.0, travel: float = 16.0, length: float 
     apex = np.array([x[:, 0].max() + 0.5 * dx, y0])
     xt, tool_held = tool_particles(dx, tu, apex, 10.0, 6.0)
     centroid = xt.mean(axis=0)
-    shape = tool_shape(tu, apex, centroid, 10.0, 6.0)
+    shape = tool_shape(tu, apex, centroid, 10.0, 6.0, radius=edge_radius)
     mu = CoulombFriction(mu0=mat["mu0"], q=mat["q_friction"], T_room=T0, T_melt=mat["T_melt_K"]) if friction else None
     contact = ToolContact(k_normal=penalty * law.G / dx, k_tangent=penalty * law.G / dx, friction=mu)
     fixed = np.zeros((len(x), 2), bool)
@@ -276,7 +279,7 @@ def pfem_cut(case: int, n_tu: float = 10.0, travel: float = 16.0, length: float 
     info = dict(case=int(case), material=row["material"], vc_m_s=vc, tu_m=tu, dx=dx, length_m=float(x[:, 0].max()),
                 height_m=H, y0=y0, n_work=len(x), n_tool=len(xt), travel_m=travel * tu, mass_scale=1.0,
                 inertia_ratio=mat["rho"] * vc * vc / mat["A_Pa"], rake_deg=RAKE_DEG, clearance_deg=CLEARANCE_DEG,
-                edge_radius_m=EDGE_RADIUS, apex0=apex.tolist(), measured=row, method="pfem", alpha=alpha,
+                edge_radius_m=float(edge_radius), apex0=apex.tolist(), measured=row, method="pfem", alpha=alpha,
                 courant=courant, penalty=penalty, conduction=bool(conduction), chip_fraction=float(chip_fraction),
                 h_int=None if heat is None else heat.h_int, refine=bool(refine), r_min=r_min, a_max=a_max,
                 newmark_gamma=float(newmark.gamma), edge_nodes=bool(edge_nodes),

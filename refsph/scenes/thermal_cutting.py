@@ -134,18 +134,19 @@ def tool_particles(dx: float, tu: float, apex, length: float = 5.0, depth: float
     return np.stack([x, y], axis=1), held
 
 
-def tool_shape(tu: float, apex, centroid, length: float = 5.0, depth: float = 3.0) -> RoundedPolygon:
+def tool_shape(tu: float, apex, centroid, length: float = 5.0, depth: float = 3.0,
+               radius: float = EDGE_RADIUS) -> RoundedPolygon:
     """The tool's exact outline for the penalty contact (``Numerics.contact = 'penalty'``): in the rake-face
     coordinates of :func:`tool_particles` the polygon (0, 0), (L, 0), (L, D), (D / tan(beta), D), L = ``length``
     tu, D = ``depth`` tu (rake face w = 0, flank at the wedge angle beta, the held top and back faces), every
-    corner rounded by the edge radius (the cutting edge's 10 um; the far corners alike), placed with the edge at
-    ``apex``; ``centroid``: that of the tool's particles."""
+    corner rounded by the edge radius ``radius`` (the paper's cutting edge: 10 um; the far corners alike), placed
+    with the edge at ``apex``; ``centroid``: that of the tool's particles."""
     g, beta = math.radians(RAKE_DEG), math.radians(90.0 - RAKE_DEG - CLEARANCE_DEG)
     L, D = length * tu, depth * tu
     uw = np.array([[0.0, 0.0], [L, 0.0], [L, D], [D / math.tan(beta), D]])
     x = apex[0] + uw[:, 0] * math.sin(g) + uw[:, 1] * math.cos(g)
     y = apex[1] + uw[:, 0] * math.cos(g) - uw[:, 1] * math.sin(g)
-    return RoundedPolygon.from_polygon(np.stack([x, y], axis=1), EDGE_RADIUS, centroid)
+    return RoundedPolygon.from_polygon(np.stack([x, y], axis=1), radius, centroid)
 
 
 def _case_values(case, material, vc, tu):

@@ -49,12 +49,12 @@ def run_one(value: float, option: str = "courant", runs: Path = RUNS, cut: str =
 
 # the cuts a scan may run: '' the quick cut (case 1, t_u/5, 4 t_u on 1.2 mm), 'case 1 t_u/5' the whole cut of the
 # sweep's 'case 1 pfem n_tu 5' (its options as the sweep gives them: 16 t_u of cut, 12 t_u left uncut), 'case 1
-# t_u/5 8 t_u' its first half (the same workpiece)
+# t_u/5 8 t_u' its first half (the same workpiece), 'case 1 t_u/10 8 t_u' that at t_u/10 (the sweep's 'case 1 pfem')
 CUTS = {"": ({}, True), "case 1 t_u/5": ({k: v for k, v in tc.converged(1, n_tu=5.0).items() if k in tc.PFEM_OPTIONS},
-                                         False),
-        "case 1 t_u/5 8 t_u": ({k: v for k, v in tc.converged(1, n_tu=5.0, travel=8.0).items()
-                                if k in tc.PFEM_OPTIONS and k != "length"} | {"length": tc.converged(1)["length"]},
-                               False)}
+                                         False)}
+CUTS.update({f"case 1 t_u/{n:g} 8 t_u": ({k: v for k, v in tc.converged(1, n_tu=n, travel=8.0).items()
+                                          if k in tc.PFEM_OPTIONS and k != "length"}
+                                         | {"length": tc.converged(1)["length"]}, False) for n in (5.0, 10.0)})
 
 
 TITLE = "# The PFEM cut's time step (quick cut: case 1, t_u/5, 4 t_u)"
@@ -86,7 +86,8 @@ def report(rows: list, option: str = "courant", title: str = TITLE, made_by: str
 
 
 def scan_main(argv, doc: str, values, option: str, runs: Path, out_json: Path, report_fn, cuts=("",)) -> int:
-    """The command of a scan over one option of the cuts ``cuts`` (keys of CUTS): run what is missing (a committed
+    """The command of a scan over one option of the cuts ``cuts`` (keys of CUTS; ``values`` the option's values, or
+    {cut: values} where they differ from cut to cut): run what is missing (a committed
     row that was 'ok' is kept where its rerun is not), write the JSON and its page, print the page; --report: the
     page only."""
     ap = argparse.ArgumentParser(description=doc.split("\n\n")[0])
@@ -98,7 +99,7 @@ def scan_main(argv, doc: str, values, option: str, runs: Path, out_json: Path, r
             if out_json.exists() else {}
         rows = []
         for cut in cuts:
-            for v in values:
+            for v in (values[cut] if isinstance(values, dict) else values):
                 r = run_one(v, option=option, runs=runs, cut=cut)
                 keep = r["status"] != "ok" and old.get((cut, v), {}).get("status") == "ok"
                 rows.append(old[(cut, v)] if keep else r)

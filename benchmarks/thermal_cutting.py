@@ -375,22 +375,31 @@ def _rising(values) -> bool | None:
     return all(b > a for a, b in zip(values, values[1:]))
 
 
+TREND_NAMES = ("Fc_rises_with_tu", "Fp_rises_with_tu", "TRF_rises_with_vc", "Fc_falls_with_vc")
+
+
+def _exp_name(name: str) -> str:
+    """The measured counterpart of a trend's name: 'Fc_rises_with_tu' -> 'Fc_exp_rises_with_tu'."""
+    q, rest = name.split("_", 1)
+    return f"{q}_exp_{rest}"
+
+
 def trends(rows) -> dict:
-    """Per material: does Fc (Fp) rise with t_u at every v_c, and T_RF with v_c at every t_u (refsph and
-    measured)? The verdict is None where a case is missing; '<key>_lines' counts (lines that rise, lines with every
-    case recorded, lines), so that a partial sweep still shows the lines it has."""
+    """Per material: does Fc (Fp) rise with t_u at every v_c, T_RF rise and Fc fall with v_c at every t_u (refsph
+    and measured; TREND_NAMES)? The verdict is None where a case is missing; '<key>_lines' counts (lines that go
+    that way, lines with every case recorded, lines), so that a partial sweep still shows the lines it has."""
     out = {}
+    columns = dict(Fc=("Fc_N_per_mm", "Fc_exp"), Fp=("Fp_N_per_mm", "Fp_exp"), TRF=("TRF", "TRF_exp"))
     for mat in ("AISI1045", "Ti6Al4V"):
         get = {(r["vc"], r["tu"]): r for r in rows if r["material"] == mat}
         vcs, tus = sorted({k[0] for k in get}), sorted({k[1] for k in get})
         t = out[mat] = {}
-        for name, key, exp, along_tu in (("Fc_rises_with_tu", "Fc_N_per_mm", "Fc_exp", True),
-                                         ("Fp_rises_with_tu", "Fp_N_per_mm", "Fp_exp", True),
-                                         ("TRF_rises_with_vc", "TRF", "TRF_exp", False)):
-            for label, k in ((name, key), (name.replace("_rises", "_exp_rises"), exp)):
+        for name in TREND_NAMES:
+            q, along_tu, sign = name.split("_")[0], name.endswith("_tu"), -1.0 if "_falls_" in name else 1.0
+            for label, k in zip((name, _exp_name(name)), columns[q]):
                 lines = [[get[(v, u)][k] for u in tus] for v in vcs] if along_tu else \
                     [[get[(v, u)][k] for v in vcs] for u in tus]
-                verdicts = [_rising(vals) for vals in lines]
+                verdicts = [_rising([None if x is None else sign * x for x in vals]) for vals in lines]
                 known = [v for v in verdicts if v is not None]
                 t[label] = None if None in verdicts or not verdicts else all(verdicts)
                 t[label + "_lines"] = (sum(known), len(known), len(verdicts))
@@ -398,12 +407,15 @@ def trends(rows) -> dict:
 
 
 def _trend_cell(t: dict, name: str) -> str:
-    """'yes' / 'no (k of n rise)' for refsph, with 'on n of m lines' where cases are missing; then the measured."""
+    """'yes' / 'no (k of n rise)' (or 'fall') for refsph, with 'k of n lines recorded' where cases are missing; then
+    the measured."""
     rising, known, total = t[name + "_lines"]
-    exp = {True: "yes", False: "no", None: "-"}[t[name.replace("_rises", "_exp_rises")]]
+    verb = "fall" if "_falls_" in name else "rise"
+    went, n_exp, _ = t[_exp_name(name) + "_lines"]
+    exp = {True: "yes", False: f"no ({went} of {n_exp} {verb})", None: "-"}[t[_exp_name(name)]]
     if not known:
         return f"- / {exp}"
-    cell = "yes" if rising == known else f"no ({rising} of {known} rise)"
+    cell = "yes" if rising == known else f"no ({rising} of {known} {verb})"
     return f"{cell}{'' if known == total else f', {known} of {total} lines recorded'} / {exp}"
 
 
@@ -448,8 +460,7 @@ def report(res: dict, before: dict | None = None) -> str:
     lines += ["", P("trends")]
     for label, sel in (("SPH, t_u/10", rows), ("SPH, t_u/5", coarse), ("PFEM, t_u/5", pfem), ("PFEM, t_u/10", pfem10)):
         for mat, t in trends(sel).items():
-            lines.append(f"| {mat} | {label} | " + " | ".join(_trend_cell(t, n) for n in (
-                "Fc_rises_with_tu", "Fp_rises_with_tu", "TRF_rises_with_vc")) + " |")
+            lines.append(f"| {mat} | {label} | " + " | ".join(_trend_cell(t, n) for n in TREND_NAMES) + " |")
     lines += _study_lines(res)
     todo = [k for k in dict(jobs(), **retry_jobs(res["runs"])) if k not in res["runs"]]
     recorded = [r for r in res["runs"].values() if r.get("wall_time_s")]

@@ -92,6 +92,23 @@ def test_thermal_cutting_trends_read_every_line():
     rows[4]["Fp_N_per_mm"] = 0.0
     assert mod._trend_cell(mod.trends(rows)["AISI1045"], "Fp_rises_with_tu") == "no (1 of 2 rise) / yes"
     assert mod._trend_cell(mod.trends(rows)["Ti6Al4V"], "Fc_rises_with_tu") == "- / -"
+    t = mod.trends(rows)["AISI1045"]                 # Fc = 100 tu + vc rises with vc: it does not fall, on two lines
+    assert t["Fc_falls_with_vc"] is False and t["Fc_falls_with_vc_lines"] == (0, 3, 3)
+    assert mod._trend_cell(t, "Fc_falls_with_vc") == "no (0 of 3 fall) / no (0 of 3 fall)"
+    for r in rows:
+        r["Fc_N_per_mm"], r["Fc_exp"] = 100 * r["tu"] - r["vc"], -r["vc"]
+    assert mod._trend_cell(mod.trends(rows)["AISI1045"], "Fc_falls_with_vc") == "yes / yes"
+
+
+def test_pfem_edge_radius_report_is_generated_from_the_json():
+    """benchmarks/pfem_edge_radius_report.md is what pfem_edge_radius.report writes from the committed JSON: each cut
+    has the paper's 10 um (the reference of its changes) and a blunter edge."""
+    mod = _script("pfem_edge_radius")
+    rows = json.loads((ROOT / "benchmarks" / "pfem_edge_radius.json").read_text())["rows"]
+    assert mod.report(rows) == (ROOT / "benchmarks" / "pfem_edge_radius_report.md").read_text()
+    for cut in mod.TITLES:
+        radii = {r["edge_radius"] for r in rows if r.get("cut", "") == cut and r["status"] == "ok"}
+        assert mod.PAPER in radii and max(radii) > mod.PAPER, cut
 
 
 def test_pfem_time_step_report_is_generated_from_the_json():

@@ -271,6 +271,14 @@ for label, cases_run in drawn.items():
 # and every method underestimates the force ratio. Titanium conducts heat seven times worse than steel, so its
 # shear zones stay hot and narrow: both of the paper's methods overestimate its rake-face temperature, by several
 # hundred kelvin, and so does refsph in all nine titanium cases at $t_u/5$.
+#
+# *Where a number is read matters as much as how it is computed.* The rake face still warms at the end of the cut
+# (the page's drift table), so a temperature depends on the length of cut it is read at. The paper's PFEM cuts
+# 2 mm for every $t_u$ (2/3 of its 3 mm workpiece: 20, 13.3 and 10 $t_u$); this sweep cuts 16 $t_u$. The page's
+# section "At the paper's length of cut" reads both methods' histories over the last quarter of 2 mm instead: for
+# refsph's PFEM on steel that alone moves the mean rake-face error from about 20 % to about 13 %, and by up to
+# 150 K in one case. Exercise: which of the paper's numbers would you expect to move most with the cut's length,
+# and why do the thin cuts ($t_u$ = 0.1 mm) need their own, longer runs for it?
 
 # %% [markdown]
 # ## 6. What the remedies and choices cost

@@ -212,6 +212,11 @@ def more_jobs() -> list[tuple[str, str, dict, dict]]:
                   for n in TU_01]
 
 
+def bossak_cut(n: int, n_tu: float) -> dict:
+    """The options of case ``n``'s PFEM cut at t_u / ``n_tu`` with the Bossak-Newmark rule (BOSSAK_ALPHA)."""
+    return dict(converged(n, n_tu=n_tu), bossak=BOSSAK_ALPHA)
+
+
 def retry_jobs(records: dict, studies=STUDY_NAMES) -> dict:
     """The retries (RETRIES) of the t_u/10 tables' cases whose record failed and whose retry is not in jobs(): an
     SPH case 'case N' again at RETRY_COURANT, a PFEM case 'case N pfem' with the Bossak-Newmark rule (the first of
@@ -223,8 +228,7 @@ def retry_jobs(records: dict, studies=STUDY_NAMES) -> dict:
         if "cases" in studies and records.get(sph, {}).get("status", "ok") != "ok":
             out[sph + RETRY] = (converged(n), sweep_numerics(courant=RETRY_COURANT))
         if "pfem" in studies and records.get(pfem, {}).get("status", "ok") != "ok":
-            out[pfem + RETRIES[PFEM10][0]] = (dict(converged(n, n_tu=10.0), bossak=BOSSAK_ALPHA),
-                                              dict(method="pfem"))
+            out[pfem + RETRIES[PFEM10][0]] = (bossak_cut(n, 10.0), dict(method="pfem"))
     return out
 
 
@@ -237,8 +241,8 @@ def time_rule_jobs() -> list[tuple[str, dict]]:
     out = [(f"case {n}{PFEM10}{DAMPED}", dict(converged(n, n_tu=10.0), gamma=DAMPED_GAMMA)) for n in (16, 8, 9)]
     out += [(f"case {n}{PFEM}{suffix}", dict(converged(n, n_tu=5.0), **opts)) for n in (1, 8) for suffix, opts in
             ((f" gamma {DAMPED_GAMMA:g}", dict(gamma=DAMPED_GAMMA)), (BOSSAK, dict(bossak=BOSSAK_ALPHA)))]
-    out += [(f"case 16{PFEM}{BOSSAK}", dict(converged(16, n_tu=5.0), bossak=BOSSAK_ALPHA))]   # beside its gamma 0.6
-    return out + [(f"case 8{PFEM10} n_tu 10{BOSSAK}", dict(converged(8, n_tu=10.0), bossak=BOSSAK_ALPHA))]
+    out += [(f"case 16{PFEM}{BOSSAK}", bossak_cut(16, 5.0))]   # beside its gamma 0.6
+    return out + [(f"case 8{PFEM10} n_tu 10{BOSSAK}", bossak_cut(8, 10.0))]
 
 
 def remesh_jobs() -> list[tuple[str, dict]]:

@@ -276,8 +276,8 @@ for label, cases_run in drawn.items():
 # (the page's drift table), so a temperature depends on the length of cut it is read at. The paper's PFEM cuts
 # 2 mm for every $t_u$ (2/3 of its 3 mm workpiece: 20, 13.3 and 10 $t_u$); this sweep cuts 16 $t_u$. The page's
 # section "At the paper's length of cut" reads both methods' histories over the last quarter of 2 mm instead: for
-# refsph's PFEM on steel that alone moves the mean rake-face error from about 20 % to about 13 %, and by up to
-# 150 K in one case. Exercise: which of the paper's numbers would you expect to move most with the cut's length,
+# refsph's PFEM on steel that alone moves the mean rake-face error from about 21 % to about 15 %, and one case's
+# rake face by 150 K. Exercise: which of the paper's numbers would you expect to move most with the cut's length,
 # and why do the thin cuts ($t_u$ = 0.1 mm) need their own, longer runs for it?
 
 # %% [markdown]

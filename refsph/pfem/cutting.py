@@ -236,8 +236,6 @@ def pfem_cut(case: int, n_tu: float = 10.0, travel: float = 16.0, length: float 
                          f"penalty > 0 and 0 <= chip_fraction <= 1; got n_tu = {n_tu!r}, travel = {travel!r} tu, "
                          f"length = {length!r} m, courant = {courant!r}, penalty = {penalty!r}, "
                          f"chip_fraction = {chip_fraction!r}")
-    if not (0.0 < edge_radius < tu):
-        raise ValueError(f"PFEM cut: the edge radius must be positive and below t_u = {tu!r} m, got {edge_radius!r}")
     if bossak != 0.0 and gamma != 0.5:
         raise ValueError(f"PFEM cut: give gamma (damped Newmark) or bossak (Bossak-Newmark), not both; got gamma = "
                          f"{gamma!r}, bossak = {bossak!r}")

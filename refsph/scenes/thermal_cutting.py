@@ -141,6 +141,8 @@ def tool_shape(tu: float, apex, centroid, length: float = 5.0, depth: float = 3.
     tu, D = ``depth`` tu (rake face w = 0, flank at the wedge angle beta, the held top and back faces), every
     corner rounded by the edge radius ``radius`` (the paper's cutting edge: 10 um; the far corners alike), placed
     with the edge at ``apex``; ``centroid``: that of the tool's particles."""
+    if not 0.0 < radius < tu:
+        raise ValueError(f"the tool's edge radius must be positive and below t_u = {tu!r} m, got {radius!r}")
     g, beta = math.radians(RAKE_DEG), math.radians(90.0 - RAKE_DEG - CLEARANCE_DEG)
     L, D = length * tu, depth * tu
     uw = np.array([[0.0, 0.0], [L, 0.0], [L, D], [D / math.tan(beta), D]])

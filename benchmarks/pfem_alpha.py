@@ -40,13 +40,7 @@ MADE_BY = ("Made by `python benchmarks/pfem_alpha.py` (module text). In brackets
 
 def report(rows: list) -> str:
     """A table per cut, each row's change against alpha = DEFAULT."""
-    parts = []
-    for cut, title in TITLES.items():
-        sel = [r for r in rows if r.get("cut", "") == cut]
-        if sel:
-            parts.append(pfem_time_step.report(sel, option="alpha", title=title, made_by=MADE_BY if not parts else
-                                               "The same, on the whole cut.", reference=DEFAULT))
-    return "\n".join(parts)
+    return pfem_time_step.per_cut_report(rows, TITLES, "alpha", MADE_BY, "The same, on the whole cut.", DEFAULT)
 
 
 def main(argv=None) -> int:

@@ -41,13 +41,7 @@ MADE_BY = ("Made by `python benchmarks/pfem_edge_radius.py` (module text). edge_
 
 def report(rows: list) -> str:
     """A table per cut, each row's change against the paper's 10 um."""
-    parts = []
-    for cut, title in TITLES.items():
-        sel = [r for r in rows if r.get("cut", "") == cut]
-        if sel:
-            parts.append(pfem_time_step.report(sel, option="edge_radius", title=title, made_by=MADE_BY if not parts
-                                               else "The same, at t_u/10.", reference=PAPER))
-    return "\n".join(parts)
+    return pfem_time_step.per_cut_report(rows, TITLES, "edge_radius", MADE_BY, "The same, at t_u/10.", PAPER)
 
 
 def main(argv=None) -> int:

@@ -50,11 +50,14 @@ def run_one(value: float, option: str = "courant", runs: Path = RUNS, cut: str =
 # the cuts a scan may run: '' the quick cut (case 1, t_u/5, 4 t_u on 1.2 mm), 'case 1 t_u/5' the whole cut of the
 # sweep's 'case 1 pfem n_tu 5' (its options as the sweep gives them: 16 t_u of cut, 12 t_u left uncut), 'case 1
 # t_u/5 8 t_u' its first half (the same workpiece), 'case 1 t_u/10 8 t_u' that at t_u/10 (the sweep's 'case 1 pfem')
-CUTS = {"": ({}, True), "case 1 t_u/5": ({k: v for k, v in tc.converged(1, n_tu=5.0).items() if k in tc.PFEM_OPTIONS},
-                                         False)}
-CUTS.update({f"case 1 t_u/{n:g} 8 t_u": ({k: v for k, v in tc.converged(1, n_tu=n, travel=8.0).items()
-                                          if k in tc.PFEM_OPTIONS and k != "length"}
-                                         | {"length": tc.converged(1)["length"]}, False) for n in (5.0, 10.0)})
+def _pfem(options: dict) -> dict:
+    """The sweep's scene options that the PFEM cut takes (thermal_cutting.PFEM_OPTIONS)."""
+    return {k: v for k, v in options.items() if k in tc.PFEM_OPTIONS}
+
+
+CUTS = {"": ({}, True), "case 1 t_u/5": (_pfem(tc.converged(1, n_tu=5.0)), False)}
+CUTS.update({f"case 1 t_u/{n:g} 8 t_u": (_pfem(tc.converged(1, n_tu=n, travel=8.0, length=tc.converged(1)["length"])),
+                                         False) for n in (5.0, 10.0)})
 
 
 TITLE = "# The PFEM cut's time step (quick cut: case 1, t_u/5, 4 t_u)"
@@ -83,6 +86,18 @@ def report(rows: list, option: str = "courant", title: str = TITLE, made_by: str
         lines.append(f"| {r[option]:g} | {r['n_steps']} | {r['newton']['halved_steps']} | "
                      f"{r['newton']['iterations']} | " + " | ".join(cells) + " |")
     return "\n".join(lines) + "\n"
+
+
+def per_cut_report(rows: list, titles: dict, option: str, made_by: str, again: str, reference: float) -> str:
+    """A table per cut of ``titles`` ({cut: title}) that has rows, each row's change against ``reference``; the
+    first table says ``made_by``, the others ``again``."""
+    parts = []
+    for cut, title in titles.items():
+        sel = [r for r in rows if r.get("cut", "") == cut]
+        if sel:
+            parts.append(report(sel, option=option, title=title, made_by=again if parts else made_by,
+                                reference=reference))
+    return "\n".join(parts)
 
 
 def scan_main(argv, doc: str, values, option: str, runs: Path, out_json: Path, report_fn, cuts=("",)) -> int:

@@ -123,8 +123,14 @@ class RunStore:
     def merge(self, other: Path) -> dict:
         """Take the records of another store's file (a sweep run in another worktree or on another machine): a key
         not here is added, a good record there replaces a failed one here; a key good here, or failed in both, stays
-        as it is. {'added': keys, 'replaced': keys, 'kept': keys that differ there and stayed}."""
-        theirs = RunStore(other, self.section, self.good).records()
+        as it is. {'added': keys, 'replaced': keys, 'kept': keys that differ there and stayed}. ValueError naming
+        ``other`` where it is missing or not a store's JSON (nothing here is changed then)."""
+        try:
+            theirs = json.loads(Path(other).read_text())[self.section]
+            if not isinstance(theirs, dict):
+                raise TypeError(f"its '{self.section}' is not an object")
+        except (OSError, ValueError, KeyError, TypeError) as e:
+            raise ValueError(f"{other}: not a sweep's records to merge ({type(e).__name__}: {e})") from None
         out = {"added": [], "replaced": [], "kept": []}
 
         def change(doc):

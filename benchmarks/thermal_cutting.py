@@ -952,7 +952,10 @@ def main(argv=None) -> int:
         print("\n".join(status_lines(store(args.json).records(), todo, args.quick)))
         return 0
     if args.merge is not None:
-        merged = store(args.json).merge(args.merge)
+        try:
+            merged = store(args.json).merge(args.merge)
+        except ValueError as e:
+            _parser().error(f"--merge: {e}")
         print("\n".join(f"{what}: {', '.join(keys) or 'none'}" for what, keys in merged.items()))
         args.report = True                                  # then the page, not a sweep
     if args.backfill_cpu:

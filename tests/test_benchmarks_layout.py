@@ -127,6 +127,12 @@ def test_run_store_merges_another_sweeps_records_without_losing_a_good_one(tmp_p
     assert doc["runs"]["new"]["v"] == 4 and doc["runs"]["failed"]["v"] == 5 and doc["runs"]["good"]["v"] == 1
     assert doc["runs"]["good vs failed"]["v"] == 2 and doc["failed"]["failed"]["status"] == "failed: x"
     assert here.merge(tmp_path / "there.json") == {"added": [], "replaced": [], "kept": ["good", "good vs failed"]}
+    before = (tmp_path / "here.json").read_text()
+    (tmp_path / "bad.json").write_text("{bad")
+    for other in (tmp_path / "missing.json", tmp_path / "bad.json"):
+        with pytest.raises(ValueError, match=str(other.name)):
+            here.merge(other)
+    assert (tmp_path / "here.json").read_text() == before
 
 
 def test_execute_runs_each_task_and_records_a_crash():

@@ -423,6 +423,38 @@ def _trend_cell(t: dict, name: str) -> str:
     return f"{cell}{'' if known == total else f', {known} of {total} lines recorded'} / {exp}"
 
 
+def rake_face_ceiling(rows: list) -> list[dict]:
+    """Per material: the largest Fp/Fc that friction on the rake face alone can give, Merchant's tan(atan(mu) -
+    gamma) for a chip slipping everywhere at mu (no force on the edge or the flank), at the law's mu0 and at mu(T)
+    of the measured T_RF (Eq. (11)), with its mean error against the measured Fp/Fc: the smallest mean error a model
+    whose thrust comes from the rake face's Coulomb friction can reach ('ceiling'; cases whose measured ratio lies
+    above it). ``rows``: :func:`comparison`'s (their measured columns only)."""
+    from pfem_rake_friction import rake_friction_bound
+    from refsph.contact import CoulombFriction
+    from refsph.scenes.thermal_cutting import MATERIALS, RAKE_DEG
+    out = []
+    for mat in ("AISI1045", "Ti6Al4V"):
+        sel, d = [r for r in rows if r["material"] == mat], MATERIALS[mat]
+        law = CoulombFriction(mu0=d["mu0"], q=d["q_friction"], T_room=293.0, T_melt=d["T_melt_K"])
+        at_mu0 = rake_friction_bound(d["mu0"], RAKE_DEG)
+        at_T = [rake_friction_bound(float(law.mu(np.array(r["TRF_exp"]))), RAKE_DEG) for r in sel]
+        exp = [r["ratio_exp"] for r in sel]
+        out.append(dict(material=mat, mu0=d["mu0"], ceiling_mu0=at_mu0,
+                        error_mu0=float(np.mean([_err(at_mu0, e) for e in exp])),
+                        ceiling_T=(min(at_T), max(at_T)), error_T=float(np.mean([_err(c, e) for c, e in zip(at_T, exp)])),
+                        cases=len(sel), measured=(min(exp), max(exp)),
+                        above={src: sum(r[f"ratio{src}"] > at_mu0 for r in sel if r[f"ratio{src}"] is not None)
+                               for src in ("_exp", "_sph", "_pfem", "")}))
+    return out
+
+
+def _ceiling_lines(rows: list) -> list[str]:
+    return [f"| {c['material']} | {c['mu0']:.2f} | {c['measured'][0]:.2f}-{c['measured'][1]:.2f} | "
+            f"{c['ceiling_mu0']:.3f} | {c['error_mu0']:.1f} | {c['ceiling_T'][0]:.3f}-{c['ceiling_T'][1]:.3f} | "
+            f"{c['error_T']:.1f} | " + " / ".join(str(c["above"][k]) for k in ("_exp", "_sph", "_pfem", "")) + " |"
+            for c in rake_face_ceiling(rows)]
+
+
 def _f(v, fmt: str) -> str:
     return "-" if v is None or (isinstance(v, float) and not math.isfinite(v)) else format(v, fmt)
 
@@ -465,6 +497,7 @@ def report(res: dict, before: dict | None = None) -> str:
     for label, sel in (("SPH, t_u/10", rows), ("SPH, t_u/5", coarse), ("PFEM, t_u/5", pfem), ("PFEM, t_u/10", pfem10)):
         for mat, t in trends(sel).items():
             lines.append(f"| {mat} | {label} | " + " | ".join(_trend_cell(t, n) for n in TREND_NAMES) + " |")
+    lines += ["", P("rake_ceiling")] + _ceiling_lines(rows)
     lines += _study_lines(res)
     todo = [k for k in dict(jobs(), **retry_jobs(res["runs"])) if k not in res["runs"]]
     recorded = [r for r in res["runs"].values() if r.get("wall_time_s")]

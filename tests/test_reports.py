@@ -100,6 +100,24 @@ def test_thermal_cutting_trends_read_every_line():
     assert mod._trend_cell(mod.trends(rows)["AISI1045"], "Fc_falls_with_vc") == "yes / yes"
 
 
+def test_thermal_cutting_rake_face_ceiling_is_merchants_bound():
+    """rake_face_ceiling: tan(atan(mu) - 10 deg) at mu0 (AISI 1045: mu0 = 0.81 -> 0.554) and at mu(T) of the measured
+    T_RF (lower: mu(T) <= mu0); a case's measured ratio counts as above the ceiling only if it is."""
+    import math
+    mod = _script("thermal_cutting")
+    rows = mod.comparison({"runs": {}})
+    c = {x["material"]: x for x in mod.rake_face_ceiling(rows)}
+    steel = c["AISI1045"]
+    assert steel["ceiling_mu0"] == pytest.approx(math.tan(math.atan(0.81) - math.radians(10.0)), rel=1e-12)
+    assert steel["ceiling_T"][1] < steel["ceiling_mu0"] and steel["error_T"] > steel["error_mu0"] > 0
+    assert steel["above"]["_exp"] == 9 and steel["above"][""] == 0        # no refsph record: nothing counted
+    for r in rows:                                   # a measured ratio on the ceiling: error 0, not counted above it
+        if r["material"] == "AISI1045":
+            r["ratio_exp"] = steel["ceiling_mu0"]
+    steel = mod.rake_face_ceiling(rows)[0]
+    assert steel["error_mu0"] == pytest.approx(0.0, abs=1e-9) and steel["above"]["_exp"] == 0
+
+
 def test_pfem_edge_radius_report_is_generated_from_the_json():
     """benchmarks/pfem_edge_radius_report.md is what pfem_edge_radius.report writes from the committed JSON: the t_u/5
     cut has the paper's 10 um (the reference of its changes) and blunter edges; a cut recorded at all has 10 um."""

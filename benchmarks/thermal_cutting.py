@@ -441,7 +441,8 @@ def rake_face_ceiling(rows: list) -> list[dict]:
         exp = [r["ratio_exp"] for r in sel]
         out.append(dict(material=mat, mu0=d["mu0"], ceiling_mu0=at_mu0,
                         error_mu0=float(np.mean([_err(at_mu0, e) for e in exp])),
-                        ceiling_T=(min(at_T), max(at_T)), error_T=float(np.mean([_err(c, e) for c, e in zip(at_T, exp)])),
+                        ceiling_T=(min(at_T), max(at_T)),
+                        error_T=float(np.mean([_err(c, e) for c, e in zip(at_T, exp)])),
                         cases=len(sel), measured=(min(exp), max(exp)),
                         above={src: sum(r[f"ratio{src}"] > at_mu0 for r in sel if r[f"ratio{src}"] is not None)
                                for src in ("_exp", "_sph", "_pfem", "")}))

@@ -61,6 +61,8 @@ __all__ = ["SimulationError", "RunResult", "RunRecord", "make_solver", "step_phy
 METHODS = ("esph", "tlsph")
 CHECKPOINT = "restart.npz"          # snapshots/restart.npz: how to continue from the last snapshot (see simulate)
 PREVIOUS_CHECKPOINT = "restart_prev.npz"    # the checkpoint before it (a restart falls back on it)
+TIMED_STATES = ("checkpoint_a.npz", "checkpoint_b.npz")   # the states of the timed checkpoints, taken in turn
+CHECKPOINT_EVERY_S = 600.0          # a checkpoint at least this often [s of wall time] between snapshots
 
 
 class SimulationError(RuntimeError):
@@ -230,7 +232,7 @@ class RunRecord:
     own (:class:`RunParts`)."""
 
     def __init__(self, setup: Setup, parts: "RunParts", out, dt, name: str, record: Callable | None, times,
-                 resume: dict | None = None, overwrite: bool = False):
+                 resume: dict | None = None, overwrite: bool = False, checkpoint_every: float | None = None):
         self.setup, self.parts, self.solver, self.record_fn = setup, parts, parts.solver, record
         self.out = Path(out) if out is not None else None
         self.history: dict[str, list] = {}
@@ -239,6 +241,8 @@ class RunRecord:
         self.n_steps, self.dts, self.record_every = 0, [], 1
         self.t0, self.c0 = time.perf_counter(), time.process_time()
         self.lost = False                                   # the run folder vanished during the run
+        self.checkpoint_every, self.checkpointed = checkpoint_every, time.perf_counter()
+        self.last_state: str | None = None                  # the state file of the last checkpoint written
         earlier = earlier_commits(self.out) if resume is not None and self.out is not None else []
         if resume is not None:
             self._resume(resume)
@@ -254,6 +258,7 @@ class RunRecord:
         r = ck["run"]
         self.history = {k: list(v) for k, v in r["history"].items()}
         self.snapshots, self.next_snap = list(r["snapshots"]), int(r["next_snap"])
+        self.last_state = r["snapshot"]
         self.n_steps, self.record_every = int(r["n_steps"]), int(r["record_every"])
         self.dts = list(np.asarray(ck["dts"], dtype=float))
         self.t0 -= float(r["wall_time_s"])
@@ -277,6 +282,19 @@ class RunRecord:
         if path.exists():                                   # the one before stays, for a restart whose last
             os.replace(path, path.with_name(PREVIOUS_CHECKPOINT))   # checkpoint or snapshot a crash has spoilt
         os.replace(tmp, path)
+        self.last_state, self.checkpointed = snapshot, time.perf_counter()
+
+    def checkpoint_if_due(self, state: State) -> None:
+        """A checkpoint between snapshots once ``checkpoint_every`` seconds of wall time have passed since the last
+        (so a killed run loses at most that much): the state in ``snapshots/checkpoint_a.npz`` or ``_b.npz``, the
+        one the last checkpoint does not name, so that ``restart_prev.npz`` still finds its own state. Nothing
+        of the run's numbers changes (the state is only read)."""
+        if (self.out is None or self.checkpoint_every is None or state.t >= self.setup.t_end * (1 - 1e-12)
+                or time.perf_counter() - self.checkpointed < self.checkpoint_every):
+            return
+        name = TIMED_STATES[1] if self.last_state == TIMED_STATES[0] else TIMED_STATES[0]
+        self.save(name, state)
+        self.checkpoint(name)
 
     def _initial_summary(self, setup: Setup, solver: Solver, dt, name: str) -> dict:
         state = setup.state
@@ -485,7 +503,7 @@ def _readable_checkpoint(folder: Path):
 
 
 def _begin(setup: Setup, parts: RunParts, out, dt, name: str, record, record_every, restart: bool,
-           overwrite: bool = False):
+           overwrite: bool = False, checkpoint_every: float | None = None):
     """The initial record: a fresh start (the setup's state, recorded and written at t = 0), or with ``restart``
     the checkpoint of the run folder ``out`` (its snapshot, the history and counters, the parts' own states)."""
     if restart:
@@ -497,13 +515,14 @@ def _begin(setup: Setup, parts: RunParts, out, dt, name: str, record, record_eve
             ck.update({f"physics/heat/{k}": v for k, v in run_ck["heat"].items()})   # a checkpoint before RunParts
         parts.restore(ck, state)
         rec = RunRecord(setup, parts, out, dt, name, record, snapshot_times(setup),
-                        resume=dict(run=run_ck, dts=ck["dts"]))
+                        resume=dict(run=run_ck, dts=ck["dts"]), checkpoint_every=checkpoint_every)
         return state, rec
     state = setup.state.copy()
     state.check()
     parts.solver.check_state(state)
     parts.bind(state)
-    rec = RunRecord(setup, parts, out, dt, name, record, snapshot_times(setup), overwrite=overwrite)
+    rec = RunRecord(setup, parts, out, dt, name, record, snapshot_times(setup), overwrite=overwrite,
+                    checkpoint_every=checkpoint_every)
     rec.record_every = record_every or max(1, int(setup.t_end / _time_step(setup, dt, state, parts.physics) / 400))
     _warn_fixed_dt(setup, dt, state)
     rec.record(state)
@@ -531,7 +550,8 @@ def simulate(setup: Setup, method: str | None = None, *, scene: Scene | None = N
              metrics: Callable[[dict, State, Setup], dict] | None = None, solver: Solver | None = None,
              hook: Callable[[State, Solver], State | None] | None = None, out=None, dt: float | None = None,
              progress: bool = True, label: str = "", record_every: int | None = None, restart: bool = False,
-             meta: dict | None = None, overwrite: bool = False) -> RunResult:
+             meta: dict | None = None, overwrite: bool = False,
+             checkpoint_every: float | None = CHECKPOINT_EVERY_S) -> RunResult:
     """Run a prepared setup with ``method`` ('esph' | 'tlsph'), or with a ``solver`` of one's own (any
     :class:`~refsph.integrate.Solver`, e.g. one that wraps ``make_solver(method, setup)`` to add a force, or a
     :class:`~refsph.integrate.SelfAdvancing` method, e.g. an implicit one).
@@ -545,7 +565,9 @@ def simulate(setup: Setup, method: str | None = None, *, scene: Scene | None = N
     ``dt``. ``out``: the run folder (summary.json, snapshots/, reaction_forces.csv), None: nothing written. The
     step before each snapshot time is shortened to land on it, so snapshots are at their nominal times (to
     round-off). With ``out``, every snapshot also writes ``snapshots/restart.npz``; ``restart=True`` continues the
-    run in ``out`` from there (same setup, solver and callbacks), and gives the same bits as the uninterrupted run.
+    run in ``out`` from there (same setup, solver and callbacks), and gives the same bits as the uninterrupted run;
+    between snapshots a checkpoint is also written once ``checkpoint_every`` seconds of wall time have passed since
+    the last (None: only at snapshots), so that a killed long run loses at most that much.
     ``meta``: extra entries for summary.json. ``out`` must be missing, empty or a run folder of the same scene and
     method (:func:`refsph.io.claim_run_folder`; ``overwrite=True``: any folder, of which only refsph's run files are
     removed). A run whose folder vanishes, or whose output cannot be written, stops with a SimulationError."""
@@ -561,7 +583,9 @@ def simulate(setup: Setup, method: str | None = None, *, scene: Scene | None = N
     name = scene.name if scene is not None else label
     for message in warnings_for(scene.name if scene is not None else None, method, setup.numerics):
         warnings.warn(message, UserWarning, stacklevel=2)
-    state, rec = _begin(setup, parts, out, dt, name, record, record_every, restart, overwrite)
+    if checkpoint_every is not None and not (np.isfinite(checkpoint_every) and checkpoint_every >= 0):
+        raise ValueError(f"checkpoint_every must be >= 0 seconds or None, got {checkpoint_every!r}")
+    state, rec = _begin(setup, parts, out, dt, name, record, record_every, restart, overwrite, checkpoint_every)
     rec.summary.update(meta or {})
     show = _Progress(label or f"{name} {method} {state.dim}D", setup.t_end, progress, rec.out, state.t)
     try:
@@ -609,25 +633,27 @@ def _one_step(setup: Setup, parts: RunParts, rec: RunRecord, state: State, dt: f
         with np.errstate(over="ignore", invalid="ignore"):  # near-blow-up states are caught above
             rec.record(state)
     rec.snapshot_if_due(state)
+    rec.checkpoint_if_due(state)
     return state
 
 
 def run(scene_name: str, method: str, *, dim: int | None = None, dp: float | None = None,
         t_end: float | None = None, out=None, quick: bool = False, dt: float | None = None, progress: bool = True,
         numerics: dict | None = None, options: dict | None = None, restart: bool = False,
-        particles=None, overwrite: bool = False) -> RunResult:
+        particles=None, overwrite: bool = False, checkpoint_every: float | None = CHECKPOINT_EVERY_S) -> RunResult:
     """Build scene ``scene_name`` and run it. ``dim``: None = the scene's default; ``numerics`` overrides
     fields of the scene's Numerics; ``options`` sets the scene's own options (``Scene.options``); ``restart``:
     continue the run in ``out`` from its last checkpoint (:func:`restart_run` takes the arguments from it);
     ``particles``: an ``.npz`` of external particles that replace the scene's own (the scene keeps its material,
     numerics, boundaries and end time; :func:`refsph.io.state_from_particles` says what the file holds). Metrics
     that need the scene's own particle layout are then reported as ``metrics_error``. ``overwrite``: see
-    :func:`simulate` (``out`` of another scene, method or not a run)."""
+    :func:`simulate` (``out`` of another scene, method or not a run); so is ``checkpoint_every`` (not part of the
+    run's arguments: it changes no number)."""
     setup, scene, metrics, args = _prepare(scene_name, method, dim, dp, t_end, quick, dt, numerics, options, particles)
     if restart and out is not None:
         _check_same_run(Path(out), args)
     return simulate(setup, method, scene=scene, out=out, dt=dt, progress=progress, restart=restart,
-                    meta=dict(run_args=args), metrics=metrics, overwrite=overwrite)
+                    meta=dict(run_args=args), metrics=metrics, overwrite=overwrite, checkpoint_every=checkpoint_every)
 
 
 def _check_same_run(out: Path, args: dict) -> None:
@@ -707,7 +733,7 @@ def _tolerant(metrics):
     return measured
 
 
-def restart_run(run_dir, progress: bool = True) -> RunResult:
+def restart_run(run_dir, progress: bool = True, checkpoint_every: float | None = CHECKPOINT_EVERY_S) -> RunResult:
     """Continue the run in ``run_dir`` (made by :func:`run` / ``refsph run``) from its last checkpoint, with the
     arguments it was started with (``summary.json``'s ``run_args``). A PFEM run folder is continued by
     :func:`refsph.pfem_run.restart_pfem` (``refsph run --restart`` takes either)."""
@@ -721,13 +747,13 @@ def restart_run(run_dir, progress: bool = True) -> RunResult:
     args = summary.get("run_args") if isinstance(summary, dict) else None
     if not isinstance(args, dict):
         raise ValueError(f"{path} has no run_args: only runs made by refsph run can be restarted")
-    known = set(inspect.signature(run).parameters) - {"out", "progress", "restart", "overwrite"}
+    known = set(inspect.signature(run).parameters) - {"out", "progress", "restart", "overwrite", "checkpoint_every"}
     unknown = sorted(set(args) - known)
     if unknown or "scene_name" not in args or "method" not in args:
         what = f"unknown entries {', '.join(unknown)}" if unknown else "no scene_name or method"
         raise ValueError(f"{path}: run_args has {what}; it must hold the arguments of refsph.simulate.run "
                          f"({', '.join(sorted(known))})")
     try:
-        return run(**args, out=run_dir, progress=progress, restart=True)
+        return run(**args, out=run_dir, progress=progress, restart=True, checkpoint_every=checkpoint_every)
     except TypeError as e:
         raise ValueError(f"{path}: run_args do not fit refsph.simulate.run ({e})") from None

@@ -69,6 +69,38 @@ def test_restart_is_bit_for_bit(tmp_path, monkeypatch, scene, method, kw):
         assert again["heat_balance"] == whole.summary["heat_balance"]
 
 
+def test_restart_from_a_timed_checkpoint_is_bit_for_bit(tmp_path, monkeypatch):
+    """Between snapshots a checkpoint is written every ``checkpoint_every`` seconds of wall time (here 0: after every
+    step): it changes no bit of the run, a killed run continues from the step it reached (not from its last
+    snapshot), and with that checkpoint spoilt, from the one before, whose state file it has not overwritten."""
+    kw = dict(CASES[6][2])                                          # thermal cutting, penalty friction history
+    whole = run("thermal_cutting", "tlsph", out=tmp_path / "whole", progress=False, checkpoint_every=None, **kw)
+    every = run("thermal_cutting", "tlsph", out=tmp_path / "every", progress=False, checkpoint_every=0.0, **kw)
+    assert np.array_equal(whole.state.x, every.state.x) and np.array_equal(whole.state.T, every.state.T)
+    assert not list((tmp_path / "whole" / "snapshots").glob("checkpoint_*"))
+    for spoil in (False, True):
+        cut = tmp_path / f"cut{spoil}"
+        _killed(monkeypatch, "thermal_cutting", "tlsph", cut, dict(kw, checkpoint_every=0.0))
+        ck = json.loads(str(np.load(cut / "snapshots" / "restart.npz")["run"]))
+        prev = json.loads(str(np.load(cut / "snapshots" / "restart_prev.npz")["run"]))
+        assert {ck["snapshot"], prev["snapshot"]} == {"checkpoint_a.npz", "checkpoint_b.npz"}
+        assert ck["n_steps"] == prev["n_steps"] + 1 and ck["next_snap"] <= len(whole.summary["snapshots"]) - 1
+        if spoil:
+            path = cut / "snapshots" / ck["snapshot"]
+            path.write_bytes(path.read_bytes()[:200])
+            with pytest.warns(UserWarning, match="checkpoint before"):
+                assert main(["run", "--restart", str(cut), "--quiet"]) == 0
+        else:
+            assert main(["run", "--restart", str(cut), "--quiet"]) == 0
+        a, b = (load_snapshot(load_run(d)[1][-1]) for d in (tmp_path / "whole", cut))
+        assert all(np.array_equal(a[k], b[k]) for k in ("x", "v", "S", "eps_p", "T"))
+        again = json.loads((cut / "summary.json").read_text())
+        assert again["n_steps"] == whole.summary["n_steps"] and again["snapshots"] == whole.summary["snapshots"]
+        assert again["heat_balance"] == whole.summary["heat_balance"]
+    with pytest.raises(ValueError, match="checkpoint_every"):
+        run("thermal_cutting", "tlsph", out=tmp_path / "bad", progress=False, checkpoint_every=-1.0, **kw)
+
+
 def test_restart_input_errors(tmp_path, capsys):
     assert main(["run", "--restart", str(tmp_path / "nothing"), "--quiet"]) == 2
     assert main(["run", "bar", "--restart", str(tmp_path), "--quiet"]) == 2

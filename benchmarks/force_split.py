@@ -18,6 +18,7 @@ where it acts and how:
     python benchmarks/force_split.py --keys "case 4"    # the sweep's key(s); writes force_split.json
     python benchmarks/force_split.py --keys "case 1" --set penalty_alpha=0.4    # a what-if: a stiffer penalty
     python benchmarks/force_split.py --keys --folders runs/pfem_cost/case_1_n_tu_10   # a PFEM run folder
+    python benchmarks/force_split.py --merge /tmp/split.json   # rows made elsewhere (--json /tmp/split.json)
 
 The window's means are printed beside the sweep's record (means over the last quarter of the cut), so that a reader
 sees how representative the short window is. The continued run is written to a scratch folder (``--scratch``); the
@@ -366,9 +367,18 @@ def main(argv=None) -> int:
     ap.add_argument("--json", type=Path, default=OUT_JSON, help="where to write the results (default: "
                                                                 "force_split.json)")
     ap.add_argument("--report", action="store_true", help="no runs: the report page from the JSON")
+    ap.add_argument("--merge", type=Path, default=None, metavar="JSON",
+                    help="no runs: take the rows of another force-split JSON (a run with --json elsewhere) into "
+                         "--json, replacing rows of the same key, then the page")
     a = ap.parse_args(argv)
     if a.json.exists() and not isinstance(_read_json(a.json, ap).get("results"), list):
         ap.error(f"--json {a.json}: not a force-split file (no 'results' list); refusing to read or overwrite it")
+    if a.merge is not None:
+        if not a.merge.exists() or not isinstance(_read_json(a.merge, ap).get("results"), list):
+            ap.error(f"--merge {a.merge}: not a force-split file (no 'results' list)")
+        _write(a.json, _read_json(a.json, ap)["results"] if a.json.exists() else [],
+               _read_json(a.merge, ap)["results"])
+        return 0
     if a.report:                                           # the committed page only from the committed JSON
         if not a.json.exists():
             ap.error(f"--report: {a.json} does not exist (run the script first)")
@@ -391,13 +401,17 @@ def main(argv=None) -> int:
         for key, folder in jobs:
             results.append(measure(key, a.travel, scratch, folder, changed, key + suffix))
             print(table(results[-1:]), flush=True)
-    old = _read_json(a.json, ap)["results"] if a.json.exists() else []
-    keep = [r for r in old if r["key"] not in {r["key"] for r in results}]
-    study.write_json(a.json, dict(results=keep + results))
-    if a.json.resolve() == OUT_JSON:
-        study.write_if_changed(REPORT, report(json.loads(a.json.read_text())))
-    print(table(keep + results))
+    _write(a.json, _read_json(a.json, ap)["results"] if a.json.exists() else [], results)
     return 0
+
+
+def _write(path: Path, old: list, results: list) -> None:
+    """``results`` into the JSON at ``path`` (rows of the same key replaced), the page if it is the committed one."""
+    keep = [r for r in old if r["key"] not in {r["key"] for r in results}]
+    study.write_json(path, dict(results=keep + results))
+    if path.resolve() == OUT_JSON:
+        study.write_if_changed(REPORT, report(json.loads(path.read_text())))
+    print(table(keep + results))
 
 
 if __name__ == "__main__":

@@ -122,3 +122,19 @@ def test_the_scratch_copy_never_is_the_recorded_run(tmp_path):
 def test_the_report_is_generated_from_the_json():
     doc = json.loads((ROOT / "benchmarks" / "force_split.json").read_text())
     assert _script().report(doc) == (ROOT / "benchmarks" / "force_split_report.md").read_text()
+
+
+def test_merge_takes_rows_made_elsewhere(tmp_path, capsys):
+    """--merge: the rows of another force-split JSON join --json, a row of the same key replaced; anything else is
+    refused by name."""
+    fs = _script()
+    rows = json.loads((ROOT / "benchmarks" / "force_split.json").read_text())["results"]
+    (tmp_path / "a.json").write_text(json.dumps(dict(results=rows[:2])))
+    (tmp_path / "b.json").write_text(json.dumps(dict(results=[dict(rows[1], Fc=1.0), rows[2]])))
+    assert fs.main(["--merge", str(tmp_path / "b.json"), "--json", str(tmp_path / "a.json")]) == 0
+    merged = json.loads((tmp_path / "a.json").read_text())["results"]
+    assert [r["key"] for r in merged] == [rows[0]["key"], rows[1]["key"], rows[2]["key"]] and merged[1]["Fc"] == 1.0
+    (tmp_path / "c.json").write_text("[1, 2]")
+    with pytest.raises(SystemExit):
+        fs.main(["--merge", str(tmp_path / "c.json"), "--json", str(tmp_path / "a.json")])
+    assert "not a force-split file" in capsys.readouterr().err

@@ -342,13 +342,23 @@ def whatif(page, r: dict, base: dict) -> str:
                 fc_whatif=f"{r['Fc'] / 1e3:.0f}")
 
 
-def _read_json(path: Path, ap) -> dict:
-    """The JSON document at ``path``; a clear error (not a traceback) where it is not JSON."""
+def _read_json(path: Path, ap, flag: str = "--json") -> dict:
+    """The JSON document at ``path`` (given as ``flag``); a clear error (not a traceback) where it is not JSON."""
     try:
         doc = json.loads(path.read_text())
     except (OSError, ValueError) as e:
-        ap.error(f"--json {path}: cannot be read as JSON ({e})")
+        ap.error(f"{flag} {path}: cannot be read as JSON ({e})")
     return doc if isinstance(doc, dict) else {}
+
+
+def _merged_rows(path: Path, ap) -> list:
+    """The rows of the force-split JSON ``path`` given to --merge, each with its key, one per key (the last)."""
+    if not path.exists():
+        ap.error(f"--merge {path}: does not exist")
+    rows = _read_json(path, ap, "--merge").get("results")
+    if not isinstance(rows, list) or not all(isinstance(r, dict) and isinstance(r.get("key"), str) for r in rows):
+        ap.error(f"--merge {path}: not a force-split file (a 'results' list of rows, each with its 'key')")
+    return list({r["key"]: r for r in rows}.values())
 
 
 def main(argv=None) -> int:
@@ -374,10 +384,9 @@ def main(argv=None) -> int:
     if a.json.exists() and not isinstance(_read_json(a.json, ap).get("results"), list):
         ap.error(f"--json {a.json}: not a force-split file (no 'results' list); refusing to read or overwrite it")
     if a.merge is not None:
-        if not a.merge.exists() or not isinstance(_read_json(a.merge, ap).get("results"), list):
-            ap.error(f"--merge {a.merge}: not a force-split file (no 'results' list)")
-        _write(a.json, _read_json(a.json, ap)["results"] if a.json.exists() else [],
-               _read_json(a.merge, ap)["results"])
+        if a.folders or a.set or a.report or a.keys != DEFAULT_KEYS:
+            ap.error("--merge runs nothing: give it without --keys, --folders, --set and --report")
+        _write(a.json, _read_json(a.json, ap)["results"] if a.json.exists() else [], _merged_rows(a.merge, ap))
         return 0
     if a.report:                                           # the committed page only from the committed JSON
         if not a.json.exists():
@@ -408,9 +417,11 @@ def main(argv=None) -> int:
 def _write(path: Path, old: list, results: list) -> None:
     """``results`` into the JSON at ``path`` (rows of the same key replaced), the page if it is the committed one."""
     keep = [r for r in old if r["key"] not in {r["key"] for r in results}]
-    study.write_json(path, dict(results=keep + results))
-    if path.resolve() == OUT_JSON:
-        study.write_if_changed(REPORT, report(json.loads(path.read_text())))
+    doc = dict(results=keep + results)
+    page = report(doc) if path.resolve() == OUT_JSON else None   # made before anything is written: a row the
+    study.write_json(path, doc)                                   # page cannot take leaves both files as they were
+    if page is not None:
+        study.write_if_changed(REPORT, page)
     print(table(keep + results))
 
 

@@ -24,10 +24,10 @@ dx, three seeds; first at t_u/5), ``resolution`` (t_u/5 and t_u/15 for cases 1 a
 scene's step, which fails, case 1 at Ti6Al4V's, and case 10 at t_u/5 at both), ``tool`` (the first sweep's tool 5
 t_u x 3 t_u and 4 t_u left uncut, one change at a time, at t_u/5 and t_u/10), ``contact`` (the pinball; all the
 frictional heat to the chip). Resumable twice over: a finished run is a record in
-``benchmarks/thermal_cutting.json`` and is skipped; a run that was killed continues from its last snapshot (``refsph
-run --restart``). A run that fails (non-finite state, lost chip) is a record with its status and error; it stays in
-the table until ``--redo`` runs it again, and a failed rerun never replaces a good record. A rerun with nothing to
-do writes nothing.
+``benchmarks/thermal_cutting.json`` and is skipped; a run that was killed continues from its last checkpoint
+(``refsph run --restart``; one at every snapshot and every 10 minutes of wall time between them). A run that fails
+(non-finite state, lost chip) is a record with its status and error; it stays in the table until ``--redo`` runs it
+again, and a failed rerun never replaces a good record. A rerun with nothing to do writes nothing.
 
 The experimental values are not printed in the paper: ``refsph.paper_data.RLA_CUTTING_CASES`` recovers them from
 each printed prediction and its printed percent error. The paper does not state the width of cut, so forces are
@@ -431,11 +431,12 @@ def rake_face_ceiling(rows: list) -> list[dict]:
     above it). ``rows``: :func:`comparison`'s (their measured columns only)."""
     from pfem_rake_friction import rake_friction_bound
     from refsph.contact import CoulombFriction
+    from refsph.paper_data import CONTACT_RLA
     from refsph.scenes.thermal_cutting import MATERIALS, RAKE_DEG
     out = []
     for mat in ("AISI1045", "Ti6Al4V"):
         sel, d = [r for r in rows if r["material"] == mat], MATERIALS[mat]
-        law = CoulombFriction(mu0=d["mu0"], q=d["q_friction"], T_room=293.0, T_melt=d["T_melt_K"])
+        law = CoulombFriction(mu0=d["mu0"], q=d["q_friction"], T_room=CONTACT_RLA["T_ref_K"], T_melt=d["T_melt_K"])
         at_mu0 = rake_friction_bound(d["mu0"], RAKE_DEG)
         at_T = [rake_friction_bound(float(law.mu(np.array(r["TRF_exp"]))), RAKE_DEG) for r in sel]
         exp = [r["ratio_exp"] for r in sel]
@@ -445,14 +446,16 @@ def rake_face_ceiling(rows: list) -> list[dict]:
                         error_T=float(np.mean([_err(c, e) for c, e in zip(at_T, exp)])),
                         cases=len(sel), measured=(min(exp), max(exp)),
                         above={src: sum(r[f"ratio{src}"] > at_mu0 for r in sel if r[f"ratio{src}"] is not None)
-                               for src in ("_exp", "_sph", "_pfem", "")}))
+                               for src in ("_exp", "_sph", "_pfem", "")},
+                        recorded=sum(r["ratio"] is not None for r in sel)))
     return out
 
 
 def _ceiling_lines(rows: list) -> list[str]:
     return [f"| {c['material']} | {c['mu0']:.2f} | {c['measured'][0]:.2f}-{c['measured'][1]:.2f} | "
             f"{c['ceiling_mu0']:.3f} | {c['error_mu0']:.1f} | {c['ceiling_T'][0]:.3f}-{c['ceiling_T'][1]:.3f} | "
-            f"{c['error_T']:.1f} | " + " / ".join(str(c["above"][k]) for k in ("_exp", "_sph", "_pfem", "")) + " |"
+            f"{c['error_T']:.1f} | " + " / ".join(str(c["above"][k]) for k in ("_exp", "_sph", "_pfem"))
+            + f" / {c['above']['']} of {c['recorded']} |"
             for c in rake_face_ceiling(rows)]
 
 
@@ -944,12 +947,24 @@ def _heartbeat(folder: Path, summary_written: float) -> str | None:
     t, t_end, t0, wall = b["t"], b["t_end"], b.get("t_begin", 0.0), b["wall_s"]
     age = (time.time() - b["written"]) / 60
     if gone:
+        ck = _checkpoint_time(folder)
         return (f"stopped: its process ({b['pid']}) is gone, last heard of {age:.0f} min ago at t = {t * 1e3:.3f} of "
                 f"{t_end * 1e3:.3f} ms ({100 * t / t_end:.0f} %); a rerun of the key continues from its last "
-                "checkpoint")
+                "checkpoint" + ("" if ck is None else f", at t = {ck * 1e3:.3f} ms"))
     left = wall * (t_end - t) / (t - t0) if t > t0 else float("nan")
     return (f"running: t = {t * 1e3:.3f} of {t_end * 1e3:.3f} ms ({100 * t / t_end:.0f} %), {b['steps']} steps, "
             f"this process {wall / 60:.0f} min, about {left / 60:.0f} min to go; heartbeat {age:.0f} min ago")
+
+
+def _checkpoint_time(folder: Path) -> float | None:
+    """The simulated time of a run folder's last checkpoint (an SPH run's ``snapshots/restart.npz`` names it);
+    None where there is none or it does not say (a PFEM run's, an older one's)."""
+    try:
+        with np.load(folder / "snapshots" / "restart.npz") as z:
+            t = json.loads(str(z["run"])).get("t")
+    except (OSError, ValueError, KeyError):
+        return None
+    return float(t) if isinstance(t, (int, float)) else None
 
 
 def backfill_cpu(st) -> list[str]:

@@ -304,8 +304,8 @@ for title in ("## Mass scaling", "## The mass scale", "## Run-to-run scatter at 
 #   $\mu \approx 1.1$, above the law's 0.81: part of the measured thrust comes from the edge and the flank, and a
 #   sticking rake face cannot give more than the chip's shear flow stress times the contact length. Every
 #   measured ratio lies above Merchant's ceiling $\tan(\arctan\mu_0 - \gamma)$ (the first table below, from
-#   the paper's data alone): no model whose thrust comes from Coulomb friction on the rake face can bring the
-#   mean error below 26 % for steel or 43 % for titanium. The second splits the tool's force in recorded cuts
+#   the paper's data alone): no model whose thrust comes from the rake face's friction, with the paper's law
+#   $\mu(T) \le \mu_0$, can bring the mean error below 26 % for steel or 43 % for titanium. The second splits the tool's force in recorded cuts
 #   (`benchmarks/force_split.py`): how much of the rake face sticks, and what a rake face slipping everywhere
 #   at $\mu(T)$ would give.
 

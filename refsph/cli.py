@@ -65,7 +65,8 @@ def _parser() -> argparse.ArgumentParser:
                    help="start the scene's physics from external particles (x, v, m; optional body, rho, S, S_zz, "
                         "X, V0, T, clamp_<name>; see refsph.io.state_from_particles)")
     r.add_argument("--restart", default=None, metavar="RUN_DIR",
-                   help="continue the run in RUN_DIR from its last snapshot, with the arguments it was started with "
+                   help="continue the run in RUN_DIR from its last checkpoint (written at every snapshot and every 10 "
+                        "minutes of wall time), with the arguments it was started with "
                         "(bit for bit the same as the uninterrupted run)")
     r.add_argument("--method", choices=METHODS + ("both", "pfem"), default=None,
                    help="formulation (default: the scene's; 'pfem': the Particle Finite Element Method, for "

@@ -8,8 +8,8 @@ A run directory holds
     snapshots/last_good.npz   only after a failure: the last state that was finite
     snapshots/restart.npz     the last checkpoint (solver state, history) for refsph run --restart: written at
                               every snapshot and, between them, every 10 minutes of wall time (its state then in
-                              snapshots/checkpoint_a.npz or checkpoint_b.npz, in turn; restart_prev.npz: the one
-                              before)
+                              snapshots/checkpoint_a.npz, _b or _c, in turn; removed when the run ends well);
+                              restart_prev.npz: the one before
     reaction_forces.csv       scenes with rigid bodies or clamps: the force on each, every step (below)
 
 Snapshot arrays (N particles, d dimensions):
@@ -251,7 +251,7 @@ HEARTBEAT_S = 30.0                  # ... written this often [s of wall time] by
 RUN_FILE_PATTERNS = ("summary.json", "summary.json.tmp", PROGRESS, PROGRESS + ".tmp", "reaction_forces.csv",
                      "reaction_forces.csv.tmp",
                      "snapshots/snap_[0-9][0-9][0-9][0-9][0-9].npz", "snapshots/*.tmp.npz", "snapshots/restart.npz",
-                     "snapshots/restart_prev.npz", "snapshots/checkpoint_[ab].npz", "snapshots/last_good.npz",
+                     "snapshots/restart_prev.npz", "snapshots/checkpoint_[abc].npz", "snapshots/last_good.npz",
                      f"snapshots/{UNITS_FILE}", f"snapshots/{UNITS_FILE}.tmp",
                      "vtk/snap_[0-9][0-9][0-9][0-9][0-9].vtu", "vtk/run.pvd", "vtk/units.json")
 

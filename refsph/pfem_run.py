@@ -15,7 +15,8 @@ The folder (:mod:`refsph.io` documents the common files):
                               of the node arrays (int64); ``tool_x`` (P, 2) and ``tool_T`` (P,): the tool's nodes
                               where the heat step meshes it
     snapshots/units.json      the unit of each array
-    snapshots/restart.npz     the checkpoint of the last snapshot (``refsph run --restart`` continues from it)
+    snapshots/restart.npz     the last checkpoint, the whole run (``refsph run --restart`` continues from it):
+                              written at every snapshot and, between them, every 10 minutes of wall time
     reaction_forces.csv       the force on the tool, every step
 
 ``rho`` of a node is rho0 / J with J its area-weighted volume ratio; ``p`` is the nodal pressure of the mixed
@@ -42,7 +43,7 @@ from .material import von_mises
 from .pfem.cutting import CutRun, pfem_cut
 from .pfem.solid import TRAPEZOIDAL, NewtonFailed
 from .scenes.base import parse_bool
-from .simulate import SimulationError, earlier_commits, provenance
+from .simulate import CHECKPOINT_EVERY_S, SimulationError, earlier_commits, provenance
 
 RINGING_HINT = (" [with the paper's trapezoidal rule the chip's ringing is undamped late in a cut, and Newton can "
                 "stall there (README, PFEM: cases 8 and 16); Newmark's damped rule, --option gamma=0.6 (a departure "
@@ -140,13 +141,17 @@ def _restore(folder: Path, cut):
 
 def run_pfem(scene_name: str = "thermal_cutting", *, out=None, options: dict | None = None, quick: bool = False,
              progress: bool = True, restart: bool = False, overwrite: bool = False,
-             max_steps: int | None = None) -> PFEMRunResult:
+             max_steps: int | None = None, checkpoint_every: float | None = CHECKPOINT_EVERY_S) -> PFEMRunResult:
     """Run the PFEM version of a scene into the run folder ``out`` (default runs/SCENE-pfem-2d; module text);
     ``restart``: continue the run there from its last checkpoint. ``max_steps``: stop after that many steps of
-    this call (the folder can be continued with ``restart``). BLAS runs at one thread meanwhile
-    (:func:`one_blas_thread`). Returns a :class:`PFEMRunResult`."""
+    this call (the folder can be continued with ``restart``). Between snapshots a checkpoint is also written once
+    ``checkpoint_every`` seconds of wall time have passed since the last (None: only at snapshots), so that a
+    killed long run loses at most that much (the checkpoint holds the whole run: the same bits on a restart).
+    BLAS runs at one thread meanwhile (:func:`one_blas_thread`). Returns a :class:`PFEMRunResult`."""
+    if checkpoint_every is not None and not (np.isfinite(checkpoint_every) and checkpoint_every >= 0):
+        raise ValueError(f"checkpoint_every must be >= 0 seconds or None, got {checkpoint_every!r}")
     with one_blas_thread():
-        return _run_pfem(scene_name, out, options, quick, progress, restart, overwrite, max_steps)
+        return _run_pfem(scene_name, out, options, quick, progress, restart, overwrite, max_steps, checkpoint_every)
 
 
 def one_blas_thread():
@@ -162,7 +167,8 @@ def one_blas_thread():
     return threadpool_limits(1, user_api="blas")
 
 
-def _run_pfem(scene_name, out, options, quick, progress, restart, overwrite, max_steps) -> PFEMRunResult:
+def _run_pfem(scene_name, out, options, quick, progress, restart, overwrite, max_steps,
+              checkpoint_every=None) -> PFEMRunResult:
     """:func:`run_pfem`'s run."""
     if scene_name not in PFEM_SCENES:
         raise ValueError(f"scene {scene_name!r} has no PFEM version; PFEM scenes: {', '.join(PFEM_SCENES)}")
@@ -190,7 +196,7 @@ def _run_pfem(scene_name, out, options, quick, progress, restart, overwrite, max
     if not restart:
         running_summary()
     status, error, t_start, steps0 = "ok", None, time.perf_counter(), run.steps
-    beat, last_print = Heartbeat(out, cut.t_end, run.nodes.t), 0.0
+    beat, last_print, checkpointed = Heartbeat(out, cut.t_end, run.nodes.t), 0.0, time.perf_counter()
     try:
         while not run.done and (max_steps is None or run.steps - steps0 < max_steps):
             run.step()
@@ -204,6 +210,11 @@ def _run_pfem(scene_name, out, options, quick, progress, restart, overwrite, max
                     next_snap += 1
                 _checkpoint(snaps_dir, run, snapshots, next_snap)
                 running_summary()
+                checkpointed = time.perf_counter()
+            elif checkpoint_every is not None and time.perf_counter() - checkpointed >= checkpoint_every:
+                _checkpoint(snaps_dir, run, snapshots, next_snap)       # a timed one, between snapshots
+                running_summary()
+                checkpointed = time.perf_counter()
             beat(run.nodes.t, run.steps)                    # the heartbeat between checkpoints
             now = time.perf_counter()
             if progress and now - last_print > 2.0:
@@ -258,14 +269,14 @@ def _summary(scene_name: str, run: CutRun, res: dict, kwargs: dict, args: dict, 
     return summary
 
 
-def restart_pfem(run_dir, progress: bool = True) -> PFEMRunResult:
+def restart_pfem(run_dir, progress: bool = True, checkpoint_every: float | None = CHECKPOINT_EVERY_S) -> PFEMRunResult:
     """Continue the PFEM run in ``run_dir`` from its last checkpoint, with the arguments it was started with
     (``summary.json``'s ``run_args``)."""
     path = Path(run_dir) / "summary.json"
     try:
         args = json.loads(path.read_text())["run_args"]
         return run_pfem(args["scene_name"], out=run_dir, options=args.get("options"), quick=bool(args.get("quick")),
-                        progress=progress, restart=True)
+                        progress=progress, restart=True, checkpoint_every=checkpoint_every)
     except FileNotFoundError:
         raise ValueError(f"{path} does not exist: {run_dir} is not a refsph run folder") from None
     except (KeyError, TypeError, ValueError) as e:

@@ -59,9 +59,9 @@ __all__ = ["SimulationError", "RunResult", "RunRecord", "make_solver", "step_phy
            "snapshot_times", "step_or_fail", "provenance", "run_commits", "earlier_commits", "restart_run", "METHODS"]
 
 METHODS = ("esph", "tlsph")
-CHECKPOINT = "restart.npz"          # snapshots/restart.npz: how to continue from the last snapshot (see simulate)
+CHECKPOINT = "restart.npz"          # snapshots/restart.npz: how to continue from the last checkpoint (see simulate)
 PREVIOUS_CHECKPOINT = "restart_prev.npz"    # the checkpoint before it (a restart falls back on it)
-TIMED_STATES = ("checkpoint_a.npz", "checkpoint_b.npz")   # the states of the timed checkpoints, taken in turn
+TIMED_STATES = ("checkpoint_a.npz", "checkpoint_b.npz", "checkpoint_c.npz")   # the timed checkpoints' states
 CHECKPOINT_EVERY_S = 600.0          # a checkpoint at least this often [s of wall time] between snapshots
 
 
@@ -242,13 +242,13 @@ class RunRecord:
         self.t0, self.c0 = time.perf_counter(), time.process_time()
         self.lost = False                                   # the run folder vanished during the run
         self.checkpoint_every, self.checkpointed = checkpoint_every, time.perf_counter()
-        self.last_state: str | None = None                  # the state file of the last checkpoint written
+        self.states: list = [None, None]                    # the state files of the checkpoint before and the last
         earlier = earlier_commits(self.out) if resume is not None and self.out is not None else []
         if resume is not None:
             self._resume(resume)
         if self.out is not None:
             _open_run_folder(self.out, name, parts.solver.method, overwrite, self.snapshots if resume else None)
-        self.summary = self._initial_summary(setup, parts.solver, dt, name)
+        self.summary = _initial_summary(setup, parts, dt, name, times)
         if resume is not None:
             self.summary["restarts"] = int(resume["run"]["restarts"]) + 1
             self.summary["provenance"]["earlier_commits"] = earlier
@@ -258,20 +258,21 @@ class RunRecord:
         r = ck["run"]
         self.history = {k: list(v) for k, v in r["history"].items()}
         self.snapshots, self.next_snap = list(r["snapshots"]), int(r["next_snap"])
-        self.last_state = r["snapshot"]
+        self.states = [None, r["snapshot"]]
         self.n_steps, self.record_every = int(r["n_steps"]), int(r["record_every"])
         self.dts = list(np.asarray(ck["dts"], dtype=float))
         self.t0 -= float(r["wall_time_s"])
         self.c0 -= float(r["cpu_time_s"])
 
-    def checkpoint(self, snapshot: str) -> None:
+    def checkpoint(self, snapshot: str, t: float) -> None:
         """``snapshots/restart.npz``: what :func:`simulate` needs to continue from snapshot ``snapshot`` exactly as
-        the uninterrupted run (the parts' own states, the history, the counters), written atomically."""
+        the uninterrupted run (the parts' own states, the history, the counters), written atomically; ``t``: the
+        snapshot's time, which a restart checks against the snapshot file's (a file overwritten since is refused)."""
         if self.out is None:
             return
         if not self.present():
             raise SimulationError(self.summary["error"])
-        run = dict(snapshot=snapshot, history={k: v for k, v in self.history.items() if k != "reaction"},
+        run = dict(snapshot=snapshot, t=float(t), history={k: v for k, v in self.history.items() if k != "reaction"},
                    snapshots=self.snapshots, next_snap=self.next_snap, n_steps=self.n_steps,
                    record_every=self.record_every, wall_time_s=time.perf_counter() - self.t0,
                    cpu_time_s=time.process_time() - self.c0, restarts=self.summary.get("restarts", 0))
@@ -282,36 +283,7 @@ class RunRecord:
         if path.exists():                                   # the one before stays, for a restart whose last
             os.replace(path, path.with_name(PREVIOUS_CHECKPOINT))   # checkpoint or snapshot a crash has spoilt
         os.replace(tmp, path)
-        self.last_state, self.checkpointed = snapshot, time.perf_counter()
-
-    def checkpoint_if_due(self, state: State) -> None:
-        """A checkpoint between snapshots once ``checkpoint_every`` seconds of wall time have passed since the last
-        (so a killed run loses at most that much): the state in ``snapshots/checkpoint_a.npz`` or ``_b.npz``, the
-        one the last checkpoint does not name, so that ``restart_prev.npz`` still finds its own state. Nothing
-        of the run's numbers changes (the state is only read)."""
-        if (self.out is None or self.checkpoint_every is None or state.t >= self.setup.t_end * (1 - 1e-12)
-                or time.perf_counter() - self.checkpointed < self.checkpoint_every):
-            return
-        name = TIMED_STATES[1] if self.last_state == TIMED_STATES[0] else TIMED_STATES[0]
-        self.save(name, state)
-        self.checkpoint(name)
-
-    def _initial_summary(self, setup: Setup, solver: Solver, dt, name: str) -> dict:
-        state = setup.state
-        return dict(
-            scene=name, method=solver.method, dim=state.dim, dp=setup.dp, h=setup.h, n_particles=state.n,
-            t_end=setup.t_end, n_steps=0, dt_mode="fixed" if dt is not None else "cfl",
-            courant=setup.numerics.courant, numerics=dataclasses.asdict(setup.numerics), threads=solver.threads,
-            material=dataclasses.asdict(setup.material), strength=_as_dict(setup.strength),
-            heating=heats(setup.strength),
-            boundaries=dict(symmetry_axes=list(setup.mirror.axes) if setup.mirror is not None else [],
-                            walls=[dataclasses.asdict(w) for w in setup.walls],
-                            rigid_bodies=[dataclasses.asdict(b) for b in setup.rigid],
-                            clamps=[c.to_dict() for c in setup.clamps],
-                            friction=(dataclasses.asdict(setup.friction) if setup.friction is not None else None)),
-            scene_info=setup.info, snapshot_times=[float(t) for t in self.times], refsph_version=__version__,
-            provenance=provenance(solver.threads), status="running", metrics={},
-            **{p.name: json_ready(p.describe()) for p in self.parts.physics})
+        self.states, self.checkpointed = [self.states[1], snapshot], time.perf_counter()
 
     def record(self, state: State) -> None:
         values = self.record_fn(state, self.setup) if self.record_fn is not None else {}
@@ -353,7 +325,7 @@ class RunRecord:
                         write_json(self.out / "summary.json", self.summary)
             self.next_snap += 1
             if self.out is not None:
-                self.checkpoint(name)                       # (a vanished folder: SimulationError)
+                self.checkpoint(name, state.t)              # (a vanished folder: SimulationError)
             if state.t < self.setup.t_end * (1 - 1e-12):
                 break
 
@@ -390,8 +362,43 @@ class RunRecord:
             self.summary["metrics"] = metrics(self.history, state, self.setup)
         if self.present():
             write_json(self.out / "summary.json", self.summary)
+            if self.summary["status"] == "ok":              # the timed checkpoints' states are not needed now
+                for name in set(TIMED_STATES) - {self.states[1]}:
+                    (self.out / "snapshots" / name).unlink(missing_ok=True)
         elif self.lost:
             raise SimulationError(self.summary["error"])
+
+
+def _initial_summary(setup: Setup, parts: "RunParts", dt, name: str, times) -> dict:
+    """summary.json as a run starts (status 'running')."""
+    state, solver = setup.state, parts.solver
+    return dict(
+        scene=name, method=solver.method, dim=state.dim, dp=setup.dp, h=setup.h, n_particles=state.n,
+        t_end=setup.t_end, n_steps=0, dt_mode="fixed" if dt is not None else "cfl",
+        courant=setup.numerics.courant, numerics=dataclasses.asdict(setup.numerics), threads=solver.threads,
+        material=dataclasses.asdict(setup.material), strength=_as_dict(setup.strength),
+        heating=heats(setup.strength),
+        boundaries=dict(symmetry_axes=list(setup.mirror.axes) if setup.mirror is not None else [],
+                        walls=[dataclasses.asdict(w) for w in setup.walls],
+                        rigid_bodies=[dataclasses.asdict(b) for b in setup.rigid],
+                        clamps=[c.to_dict() for c in setup.clamps],
+                        friction=(dataclasses.asdict(setup.friction) if setup.friction is not None else None)),
+        scene_info=setup.info, snapshot_times=[float(t) for t in times], refsph_version=__version__,
+        provenance=provenance(solver.threads), status="running", metrics={},
+        **{p.name: json_ready(p.describe()) for p in parts.physics})
+
+
+def _checkpoint_if_due(rec: RunRecord, state: State) -> None:
+    """A checkpoint between snapshots once ``rec.checkpoint_every`` seconds of wall time have passed since the last
+    (so a killed run loses at most that much): the state in ``snapshots/checkpoint_a.npz``, ``_b`` or ``_c``, one
+    that neither the last checkpoint nor the one before names (both stay whole, whenever the run is killed).
+    Nothing of the run's numbers changes (the state is only read)."""
+    if (rec.out is None or rec.checkpoint_every is None or state.t >= rec.setup.t_end * (1 - 1e-12)
+            or time.perf_counter() - rec.checkpointed < rec.checkpoint_every):
+        return
+    name = next(n for n in TIMED_STATES if n not in rec.states)
+    rec.save(name, state)
+    rec.checkpoint(name, state.t)
 
 
 @dataclass
@@ -492,13 +499,17 @@ def _readable_checkpoint(folder: Path):
                 ck = {k: z[k] for k in z.files}
             run_ck = json.loads(str(ck["run"]))
             state = state_from_snapshot(folder / run_ck["snapshot"])
+            if "t" in run_ck and state.t != run_ck["t"]:         # (a checkpoint before 2026-11-29 has no t)
+                raise ValueError(f"its state {run_ck['snapshot']} is at t = {state.t!r} s, the checkpoint's at "
+                                 f"{run_ck['t']!r} s (overwritten since)")
         except (OSError, ValueError, KeyError, EOFError, zipfile.BadZipFile) as e:
             failures.append(f"{path} (or its snapshot) cannot be read: {type(e).__name__}: {e}")
             continue
         if failures:
             warnings.warn(f"{failures[0]}; continuing from the checkpoint before it, at {run_ck['snapshot']}",
                           UserWarning, stacklevel=3)
-        return ck, run_ck, state
+            os.replace(path, folder / CHECKPOINT)           # the spoilt one retired: the next checkpoints rotate
+        return ck, run_ck, state                            # from this one
     raise ValueError("nothing to restart from (a run writes a checkpoint at every snapshot): " + "; ".join(failures))
 
 
@@ -633,7 +644,7 @@ def _one_step(setup: Setup, parts: RunParts, rec: RunRecord, state: State, dt: f
         with np.errstate(over="ignore", invalid="ignore"):  # near-blow-up states are caught above
             rec.record(state)
     rec.snapshot_if_due(state)
-    rec.checkpoint_if_due(state)
+    _checkpoint_if_due(rec, state)
     return state
 
 

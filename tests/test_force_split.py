@@ -134,7 +134,16 @@ def test_merge_takes_rows_made_elsewhere(tmp_path, capsys):
     assert fs.main(["--merge", str(tmp_path / "b.json"), "--json", str(tmp_path / "a.json")]) == 0
     merged = json.loads((tmp_path / "a.json").read_text())["results"]
     assert [r["key"] for r in merged] == [rows[0]["key"], rows[1]["key"], rows[2]["key"]] and merged[1]["Fc"] == 1.0
-    (tmp_path / "c.json").write_text("[1, 2]")
+    for text, says in (("[1, 2]", "not a force-split file"), ('{"results": [{"Fc": 1}]}', "each with its 'key'"),
+                       ("{", "--merge")):
+        (tmp_path / "c.json").write_text(text)
+        with pytest.raises(SystemExit):
+            fs.main(["--merge", str(tmp_path / "c.json"), "--json", str(tmp_path / "a.json")])
+        assert says in capsys.readouterr().err
     with pytest.raises(SystemExit):
-        fs.main(["--merge", str(tmp_path / "c.json"), "--json", str(tmp_path / "a.json")])
-    assert "not a force-split file" in capsys.readouterr().err
+        fs.main(["--merge", str(tmp_path / "none.json"), "--json", str(tmp_path / "a.json")])
+    assert "does not exist" in capsys.readouterr().err
+    with pytest.raises(SystemExit):
+        fs.main(["--merge", str(tmp_path / "b.json"), "--report"])
+    assert "runs nothing" in capsys.readouterr().err
+    assert json.loads((tmp_path / "a.json").read_text())["results"] == merged      # untouched by the refusals

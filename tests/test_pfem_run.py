@@ -72,6 +72,28 @@ def test_restart_gives_the_uninterrupted_numbers(short_run, tmp_path):
         np.testing.assert_array_equal(za[k], zb[k])
 
 
+def test_a_timed_checkpoint_changes_nothing_and_is_continued(short_run, tmp_path, monkeypatch):
+    """checkpoint_every=0: a checkpoint after every step (between snapshots too: here only at the start and the end,
+    which moves no number of the PFEM, whose step does not land on them); the run stopped after 5 steps continues
+    from its fifth step, not from its last snapshot, to the uninterrupted run's numbers."""
+    import refsph.pfem_run as pr
+    monkeypatch.setattr(pr, "N_SNAPSHOTS", 1)
+    out, res = short_run
+    part = tmp_path / "timed"
+    first = run_pfem("thermal_cutting", out=part, options=SHORT, quick=True, progress=False, max_steps=5,
+                     checkpoint_every=0.0)
+    kept, snaps, _ = pr._restore(part / "snapshots", pr.pfem_cut(**pr._options(SHORT, True)))
+    assert first.summary["n_steps"] == 5 and kept.steps == 5 and snaps == ["snap_00000.npz"]
+    second = restart_pfem(part, progress=False, checkpoint_every=0.0)
+    assert second.summary["n_steps"] == res.summary["n_steps"]
+    np.testing.assert_array_equal(load_reactions(out / "reaction_forces.csv")["tool"],
+                                  load_reactions(part / "reaction_forces.csv")["tool"])
+    for key in ("cutting_force_N_per_m", "rake_face_temperature_K", "max_temperature_K"):
+        assert second.summary["metrics"][key] == res.summary["metrics"][key]
+    with pytest.raises(ValueError, match="checkpoint_every"):
+        run_pfem("thermal_cutting", out=tmp_path / "bad", options=SHORT, quick=True, checkpoint_every=float("nan"))
+
+
 def test_provenance_is_the_code_that_ran(tmp_path, monkeypatch):
     """summary.json's provenance is taken when a run starts, not when the summary is written (a long run outlives
     its commit); a run continued at another commit names the earlier one."""

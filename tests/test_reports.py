@@ -110,7 +110,7 @@ def test_thermal_cutting_rake_face_ceiling_is_merchants_bound():
     steel = c["AISI1045"]
     assert steel["ceiling_mu0"] == pytest.approx(math.tan(math.atan(0.81) - math.radians(10.0)), rel=1e-12)
     assert steel["ceiling_T"][1] < steel["ceiling_mu0"] and steel["error_T"] > steel["error_mu0"] > 0
-    assert steel["above"]["_exp"] == 9 and steel["above"][""] == 0        # no refsph record: nothing counted
+    assert steel["above"]["_exp"] == 9 and steel["above"][""] == steel["recorded"] == 0   # no refsph record
     for r in rows:                                   # a measured ratio on the ceiling: error 0, not counted above it
         if r["material"] == "AISI1045":
             r["ratio_exp"] = steel["ceiling_mu0"]
@@ -184,6 +184,25 @@ def test_thermal_cutting_status_reads_records_and_run_folders(tmp_path, monkeypa
     assert lines[0].split() == ["case", "1", "recorded:", "ok", "(32", "min)"]
     assert "t = 0.600 of 2.400 ms (25 %)" in lines[1] and "about 30 min to go" in lines[1]
     assert lines[2].endswith("to run") and mod.run_folder("case 1 s/2").name == "case_1_s2"
+
+
+def test_thermal_cutting_status_of_a_killed_run_names_its_last_checkpoint(tmp_path, monkeypatch):
+    """A run whose process is gone: 'stopped', where it was last heard of, and the time of the checkpoint a rerun
+    continues from (restart.npz's; none said where the checkpoint does not tell it)."""
+    import socket
+    import time
+    mod = _script("thermal_cutting")
+    monkeypatch.setattr(mod, "RUNS", tmp_path)
+    folder = mod.run_folder("case 2")
+    (folder / "snapshots").mkdir(parents=True)
+    (folder / "progress.json").write_text(json.dumps(dict(t=1e-3, t_end=2e-3, t_begin=0.0, wall_s=60.0, steps=5,
+                                                          written=time.time(), pid=2**22 + 12345,
+                                                          host=socket.gethostname())))
+    line = mod.status_lines({}, {"case 2": None})[0]
+    assert "stopped" in line and "t = 1.000 of 2.000 ms" in line and line.endswith("from its last checkpoint")
+    np.savez(folder / "snapshots" / "restart.npz", run=json.dumps(dict(t=4e-4, snapshot="checkpoint_a.npz")))
+    line = mod.status_lines({}, {"case 2": None})[0]
+    assert line.endswith("from its last checkpoint, at t = 0.400 ms")
 
 
 def test_thermal_cutting_backfills_cpu_seconds_only_from_the_same_run(tmp_path, monkeypatch):

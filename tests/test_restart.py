@@ -69,22 +69,37 @@ def test_restart_is_bit_for_bit(tmp_path, monkeypatch, scene, method, kw):
         assert again["heat_balance"] == whole.summary["heat_balance"]
 
 
-def test_restart_from_a_timed_checkpoint_is_bit_for_bit(tmp_path, monkeypatch):
+def _same_run(whole, cut):
+    """The restarted run ``cut`` ends as ``whole``: its last snapshot, step count, metrics, reactions, heat ledger."""
+    a, b = (load_snapshot(load_run(d)[1][-1]) for d in (whole, cut))
+    assert all(np.array_equal(a[k], b[k]) for k in ("x", "v", "rho", "S", "S_zz", "eps_p", "T"))
+    s, again = (json.loads((d / "summary.json").read_text()) for d in (whole, cut))
+    assert again["status"] == "ok" and again["n_steps"] == s["n_steps"] and again["snapshots"] == s["snapshots"]
+    numbers = {k: v for k, v in s["metrics"].items() if isinstance(v, (int, float)) and v == v}
+    assert numbers and all(again["metrics"][k] == v for k, v in numbers.items())
+    assert again["heat_balance"] == s["heat_balance"]
+    assert (whole / "reaction_forces.csv").read_text() == (cut / "reaction_forces.csv").read_text()
+
+
+@pytest.mark.parametrize("case", [6, 7], ids=["penalty", "heat_every"])
+def test_restart_from_a_timed_checkpoint_is_bit_for_bit(tmp_path, monkeypatch, case):
     """Between snapshots a checkpoint is written every ``checkpoint_every`` seconds of wall time (here 0: after every
-    step): it changes no bit of the run, a killed run continues from the step it reached (not from its last
-    snapshot), and with that checkpoint spoilt, from the one before, whose state file it has not overwritten."""
-    kw = dict(CASES[6][2])                                          # thermal cutting, penalty friction history
+    step): it changes no bit of the run; a killed run continues from the step it reached (not from its last
+    snapshot); with that checkpoint's state spoilt, from the one before, whose state file is another; a finished
+    run keeps none of the timed states."""
+    from refsph.io import run_files
+    kw = dict(CASES[case][2])                                       # thermal cutting: friction history, heat kept
     whole = run("thermal_cutting", "tlsph", out=tmp_path / "whole", progress=False, checkpoint_every=None, **kw)
     every = run("thermal_cutting", "tlsph", out=tmp_path / "every", progress=False, checkpoint_every=0.0, **kw)
     assert np.array_equal(whole.state.x, every.state.x) and np.array_equal(whole.state.T, every.state.T)
-    assert not list((tmp_path / "whole" / "snapshots").glob("checkpoint_*"))
+    assert not list((tmp_path / "every" / "snapshots").glob("checkpoint_*"))
     for spoil in (False, True):
         cut = tmp_path / f"cut{spoil}"
         _killed(monkeypatch, "thermal_cutting", "tlsph", cut, dict(kw, checkpoint_every=0.0))
-        ck = json.loads(str(np.load(cut / "snapshots" / "restart.npz")["run"]))
-        prev = json.loads(str(np.load(cut / "snapshots" / "restart_prev.npz")["run"]))
-        assert {ck["snapshot"], prev["snapshot"]} == {"checkpoint_a.npz", "checkpoint_b.npz"}
-        assert ck["n_steps"] == prev["n_steps"] + 1 and ck["next_snap"] <= len(whole.summary["snapshots"]) - 1
+        ck, prev = (json.loads(str(np.load(cut / "snapshots" / n)["run"])) for n in ("restart.npz", "restart_prev.npz"))
+        assert ck["snapshot"] != prev["snapshot"] and {ck["snapshot"], prev["snapshot"]} <= set(sim.TIMED_STATES)
+        assert ck["n_steps"] == prev["n_steps"] + 1 and ck["next_snap"] < len(whole.summary["snapshots"])
+        assert {cut / "snapshots" / n for n in sim.TIMED_STATES} <= set(run_files(cut))
         if spoil:
             path = cut / "snapshots" / ck["snapshot"]
             path.write_bytes(path.read_bytes()[:200])
@@ -92,13 +107,34 @@ def test_restart_from_a_timed_checkpoint_is_bit_for_bit(tmp_path, monkeypatch):
                 assert main(["run", "--restart", str(cut), "--quiet"]) == 0
         else:
             assert main(["run", "--restart", str(cut), "--quiet"]) == 0
-        a, b = (load_snapshot(load_run(d)[1][-1]) for d in (tmp_path / "whole", cut))
-        assert all(np.array_equal(a[k], b[k]) for k in ("x", "v", "S", "eps_p", "T"))
-        again = json.loads((cut / "summary.json").read_text())
-        assert again["n_steps"] == whole.summary["n_steps"] and again["snapshots"] == whole.summary["snapshots"]
-        assert again["heat_balance"] == whole.summary["heat_balance"]
+        _same_run(tmp_path / "whole", cut)
+        assert not list((cut / "snapshots").glob("checkpoint_*"))
     with pytest.raises(ValueError, match="checkpoint_every"):
         run("thermal_cutting", "tlsph", out=tmp_path / "bad", progress=False, checkpoint_every=-1.0, **kw)
+
+
+def test_a_checkpoint_whose_state_was_overwritten_is_refused(tmp_path, monkeypatch):
+    """A checkpoint names its state file and its time: a state file overwritten since (another step's state under
+    its name) is not continued from silently; the restart takes the checkpoint before, or says there is none."""
+    kw = dict(CASES[6][2])
+    whole = run("thermal_cutting", "tlsph", out=tmp_path / "whole", progress=False, checkpoint_every=None, **kw)
+    cut = tmp_path / "cut"
+    _killed(monkeypatch, "thermal_cutting", "tlsph", cut, dict(kw, checkpoint_every=0.0))
+    snaps = cut / "snapshots"
+    ck, prev = (json.loads(str(np.load(snaps / n)["run"]))["snapshot"] for n in ("restart.npz", "restart_prev.npz"))
+    (snaps / ck).write_bytes((snaps / prev).read_bytes())        # the last checkpoint's state: an older step's
+    with pytest.warns(UserWarning, match="overwritten since"):
+        assert main(["run", "--restart", str(cut), "--quiet"]) == 0
+    _same_run(tmp_path / "whole", cut)
+    assert whole.summary["status"] == "ok"
+    cut2 = tmp_path / "cut2"
+    _killed(monkeypatch, "thermal_cutting", "tlsph", cut2, dict(kw, checkpoint_every=0.0))
+    snaps = cut2 / "snapshots"
+    for n in ("restart.npz", "restart_prev.npz"):                 # both states swapped: neither can be continued
+        name = json.loads(str(np.load(snaps / n)["run"]))["snapshot"]
+        (snaps / name).write_bytes((snaps / "snap_00000.npz").read_bytes())
+    with pytest.raises(ValueError, match="nothing to restart from"):
+        run("thermal_cutting", "tlsph", out=cut2, progress=False, restart=True, **kw)
 
 
 def test_restart_input_errors(tmp_path, capsys):

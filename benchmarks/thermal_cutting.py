@@ -483,6 +483,7 @@ def report(res: dict, before: dict | None = None) -> str:
     lines += ["", P("pfem10", done=sum(r["status"] == "ok" for r in pfem10))] + [_case_line(r) for r in pfem10]
     lines += ["", P("pfem10_errors")] + _mean_error_lines(pfem10, old)
     lines += ["", P("pfem10_same")] + _same_cases_lines(pfem10)
+    lines += ["", P("method_gap")] + _gap_lines(method_gaps(res))
     at2 = {m: paper_length_rows(res, sfx) for m, sfx in (("PFEM", PFEM10), ("SPH", ""))}
     lines += ["", P("paper_length")] + [x for m, rows_ in at2.items() for x in _paper_length_lines(rows_, m)]
     lines += ["", P("paper_length_errors")] + [x for m, rows_ in at2.items() for x in _paper_length_errors(rows_, m)]
@@ -569,6 +570,48 @@ def _same_cases_lines(rows: list) -> list[str]:
             diff = f"{np.mean(d):+.1f} ({min(d):+.0f} to {max(d):+.0f})" if d else "-"
             lines.append(f"| {mat} | {name} | {len(ran)} | {_f(_mean(ran, f'{q}_err'), '.1f')} | "
                          f"{_f(_mean(ran, f'{q}_pfem_err'), '.1f')} | {diff} |")
+    return lines
+
+
+GAP_QUANTITIES = (("TRF", "T_RF [K]", "K"), ("TFCS", "T_FCS [K]", "K"), ("Fc", "Fc [%]", "%"),
+                  ("ratio", "Fp/Fc [%]", "%"))   # the PFEM-SPH gap: in kelvin for temperatures, relative for forces
+
+
+def method_gaps(res: dict) -> list[dict]:
+    """Per case with both of refsph's methods recorded at t_u/10: the PFEM's value minus the SPH's (temperatures in
+    K; Fc and Fp/Fc as PFEM/SPH - 1 in percent), refsph's and the paper's (its Appendix B predictions): whether
+    refsph's two methods differ as the paper's do."""
+    from refsph.paper_data import rla_cutting_case
+    sph, pfem = comparison(res), comparison(res, PFEM10)
+    out = []
+    for a, b in zip(sph, pfem):
+        if a["status"] != "ok" or b["status"] != "ok":
+            continue
+        c = rla_cutting_case(a["case"])
+        ours = dict(TRF=b["TRF"] - a["TRF"], TFCS=b["TFCS"] - a["TFCS"],
+                    Fc=100.0 * (b["Fc_N_per_mm"] / a["Fc_N_per_mm"] - 1.0),
+                    ratio=100.0 * (b["ratio"] / a["ratio"] - 1.0))
+        paper = dict(TRF=c["TRF_pfem_K"] - c["TRF_sph_K"], TFCS=c["TFCS_pfem_K"] - c["TFCS_sph_K"],
+                     Fc=100.0 * (c["Fc_pfem_N"] / c["Fc_sph_N"] - 1.0),
+                     ratio=100.0 * (a["ratio_pfem"] / a["ratio_sph"] - 1.0))
+        out.append(dict(case=a["case"], material=a["material"], ours=ours, paper=paper))
+    return out
+
+
+def _gap_lines(gaps: list) -> list[str]:
+    """The gap table's rows, then per material the means and on how many cases refsph's gap has the paper's sign."""
+    lines = [f"| {g['case']} | {g['material']} | " + " | ".join(f"{g['ours'][q]:+.0f} | {g['paper'][q]:+.0f}"
+                                                             for q, _, _ in GAP_QUANTITIES) + " |" for g in gaps]
+    for mat in ("AISI1045", "Ti6Al4V"):
+        sel = [g for g in gaps if g["material"] == mat]
+        if not sel:
+            continue
+        cells = []
+        for q, _, _ in GAP_QUANTITIES:
+            same = sum(np.sign(g["ours"][q]) == np.sign(g["paper"][q]) for g in sel)
+            cells.append(f"{np.mean([g['ours'][q] for g in sel]):+.0f} | {np.mean([g['paper'][q] for g in sel]):+.0f}"
+                         f" (same sign: {same} of {len(sel)})")
+        lines.append(f"| mean | {mat} | " + " | ".join(cells) + " |")
     return lines
 
 

@@ -118,6 +118,26 @@ def test_thermal_cutting_rake_face_ceiling_is_merchants_bound():
     assert steel["error_mu0"] == pytest.approx(0.0, abs=1e-9) and steel["above"]["_exp"] == 0
 
 
+def test_thermal_cutting_method_gap_is_pfem_minus_sph():
+    """method_gaps: per case with both methods recorded, PFEM - SPH in K for temperatures and PFEM / SPH - 1 in %
+    for Fc and Fp/Fc, refsph's beside the paper's (case 1: T_RF 850 - 671.5 K); the mean rows count the cases
+    whose sign is the paper's."""
+    mod = _script("thermal_cutting")
+    rec = lambda trf, fc, fp: dict(status="ok", metrics=dict(                       # noqa: E731
+        rake_face_temperature_K=trf, free_chip_surface_temperature_K=500.0, cutting_force_N_per_m=fc * 1e3,
+        passive_force_N_per_m=fp * 1e3, force_ratio=fp / fc))
+    res = dict(runs={"case 1": rec(600.0, 400.0, 200.0), "case 1" + mod.PFEM10: rec(800.0, 300.0, 120.0),
+                     "case 2": rec(600.0, 400.0, 200.0)})           # case 2: no PFEM record, no row
+    (g,) = mod.method_gaps(res)
+    assert g["case"] == 1 and g["ours"]["TRF"] == 200.0 and g["ours"]["TFCS"] == 0.0
+    assert g["ours"]["Fc"] == pytest.approx(-25.0) and g["ours"]["ratio"] == pytest.approx(-20.0)
+    assert g["paper"]["TRF"] == pytest.approx(850.0 - 671.5)
+    assert g["paper"]["Fc"] == pytest.approx(100.0 * (499.73 / 703.54 - 1.0))
+    lines = mod._gap_lines([g])
+    assert len(lines) == 2 and "(same sign: 1 of 1)" in lines[1].split("|")[4]          # T_RF: both hotter
+    assert "(same sign: 0 of 1)" in lines[1].split("|")[10]                             # Fp/Fc: the paper's rises
+
+
 def test_pfem_edge_radius_report_is_generated_from_the_json():
     """benchmarks/pfem_edge_radius_report.md is what pfem_edge_radius.report writes from the committed JSON: the t_u/5
     cut has the paper's 10 um (the reference of its changes) and blunter edges; a cut recorded at all has 10 um."""

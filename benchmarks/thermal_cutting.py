@@ -488,7 +488,7 @@ def report(res: dict, before: dict | None = None) -> str:
     lines += ["", P("paper_length")] + [x for m, rows_ in at2.items() for x in _paper_length_lines(rows_, m)]
     lines += ["", P("paper_length_errors")] + [x for m, rows_ in at2.items() for x in _paper_length_errors(rows_, m)]
     lines += ["", P("pfem_forces")] + [_pfem_force_line(r, res) for r in pfem]
-    lines += ["", P("dof")] + _dof_lines(pfem, coarse, res)
+    lines += ["", P("dof")] + _dof_lines(pfem, coarse, res, pfem10, rows)
     lines += ["", P("forces")]
     for r in rows:
         lines.append(f"| {r['case']} | {_f(r['Fc_N_per_mm'], '.1f')} | {_f(r['Fp_N_per_mm'], '.1f')} | "
@@ -523,22 +523,23 @@ def _pfem_force_line(r: dict, res: dict) -> str:
             f"{_f(pf.get('wall_time_s'), '.0f')} | {_f(sph.get('wall_time_s'), '.0f')} |")
 
 
-def _dof_lines(pfem: list, coarse: list, res: dict) -> list[str]:
-    """Degrees of freedom against accuracy, per material, over the cases both methods ran at t_u / 5: the mean
-    node and particle counts, DOF (PFEM: u_x, u_y, p per node; SPH: x, y per particle), the mean errors and the
-    mean wall time of each."""
+def _dof_lines(pfem: list, coarse: list, res: dict, pfem10: list = (), fine: list = ()) -> list[str]:
+    """Degrees of freedom against accuracy, per resolution and material, over the cases both methods ran (t_u / 5:
+    ``pfem`` and ``coarse``; t_u / 10: ``pfem10`` and ``fine``, the sweep's table): the mean node and particle
+    counts, DOF (PFEM: u_x, u_y, p per node; SPH: x, y per particle), the mean errors and the mean wall time."""
     lines = []
-    for mat in ("AISI1045", "Ti6Al4V"):
-        both = [(a, b) for a, b in zip(pfem, coarse) if a["material"] == mat and a["status"] == b["status"] == "ok"]
-        if not both:
-            continue
-        n = {m: float(np.mean([res["runs"][f"case {a['case']}{k}"]["n_particles"] for a, _ in both]))
-             for m, k in (("pfem", PFEM), ("sph", COARSE))}
-        cells = [mat, str(len(both)), f"{n['pfem']:.0f} / {3 * n['pfem']:.0f}", f"{n['sph']:.0f} / {2 * n['sph']:.0f}"]
-        pf, sph = [a for a, _ in both], [b for _, b in both]
-        cells += [f"{_mean(pf, f'{q}_err'):.1f} / {_mean(sph, f'{q}_err'):.1f}" for q in ("TRF", "TFCS", "ratio")]
-        cells.append(f"{_mean(pf, 'wall_s') / 60:.1f} / {_mean(sph, 'wall_s') / 60:.1f}")
-        lines.append("| " + " | ".join(cells) + " |")
+    for label, pf_rows, sph_rows in (("t_u/5", pfem, coarse), ("t_u/10", pfem10, fine)):
+        for mat in ("AISI1045", "Ti6Al4V"):
+            both = [(a, b) for a, b in zip(pf_rows, sph_rows)
+                    if a["material"] == mat and a["status"] == b["status"] == "ok"]
+            if not both:
+                continue
+            n = [float(np.mean([res["runs"][r["key"]]["n_particles"] for r in rows])) for rows in zip(*both)]
+            cells = [label, mat, str(len(both)), f"{n[0]:.0f} / {3 * n[0]:.0f}", f"{n[1]:.0f} / {2 * n[1]:.0f}"]
+            pf, sph = [a for a, _ in both], [b for _, b in both]
+            cells += [f"{_mean(pf, f'{q}_err'):.1f} / {_mean(sph, f'{q}_err'):.1f}" for q in ("TRF", "TFCS", "ratio")]
+            cells.append(f"{_mean(pf, 'wall_s') / 60:.1f} / {_mean(sph, 'wall_s') / 60:.1f}")
+            lines.append("| " + " | ".join(cells) + " |")
     return lines
 
 

@@ -451,6 +451,34 @@ def rake_face_ceiling(rows: list) -> list[dict]:
     return out
 
 
+def own_ceilings(sets: dict) -> dict:
+    """Per material and prediction: how many of its cases' Fp/Fc lie above the rake-face ceiling at mu(T) of its
+    own T_RF (:func:`rake_face_ceiling`'s ceiling at the temperature that prediction puts on the rake face), and
+    its mean of Fp/Fc over that ceiling. ``sets``: {label: (rows, ratio key, T_RF key)} of :func:`comparison`'s
+    rows. Above it, a prediction's thrust does not come from the friction law on the rake face alone."""
+    from pfem_rake_friction import rake_friction_bound
+    from refsph.contact import CoulombFriction
+    from refsph.paper_data import CONTACT_RLA
+    from refsph.scenes.thermal_cutting import MATERIALS, RAKE_DEG
+    out = {}
+    for mat in ("AISI1045", "Ti6Al4V"):
+        d = MATERIALS[mat]
+        law = CoulombFriction(mu0=d["mu0"], q=d["q_friction"], T_room=CONTACT_RLA["T_ref_K"], T_melt=d["T_melt_K"])
+        for label, (rows, rk, tk) in sets.items():
+            x = [r[rk] / rake_friction_bound(float(law.mu(np.array(r[tk]))), RAKE_DEG) for r in rows
+                 if r["material"] == mat and r[rk] is not None and r[tk] is not None]
+            out[(mat, label)] = (sum(v > 1.0 for v in x), len(x), float(np.mean(x)) if x else float("nan"))
+    return out
+
+
+def _own_ceiling_lines(rows: list, pfem10: list) -> list[str]:
+    sets = {"paper SPH": (rows, "ratio_sph", "TRF_sph"), "paper PFEM": (rows, "ratio_pfem", "TRF_pfem"),
+            "refsph SPH": (rows, "ratio", "TRF"), "refsph PFEM": (pfem10, "ratio", "TRF")}
+    got = own_ceilings(sets)
+    return [f"| {mat} | " + " | ".join(f"{got[(mat, k)][0]} of {got[(mat, k)][1]} ({got[(mat, k)][2]:.2f})"
+                                       for k in sets) + " |" for mat in ("AISI1045", "Ti6Al4V")]
+
+
 def _ceiling_lines(rows: list) -> list[str]:
     return [f"| {c['material']} | {c['mu0']:.2f} | {c['measured'][0]:.2f}-{c['measured'][1]:.2f} | "
             f"{c['ceiling_mu0']:.3f} | {c['error_mu0']:.1f} | {c['ceiling_T'][0]:.3f}-{c['ceiling_T'][1]:.3f} | "
@@ -503,6 +531,7 @@ def report(res: dict, before: dict | None = None) -> str:
         for mat, t in trends(sel).items():
             lines.append(f"| {mat} | {label} | " + " | ".join(_trend_cell(t, n) for n in TREND_NAMES) + " |")
     lines += ["", P("rake_ceiling")] + _ceiling_lines(rows)
+    lines += ["", P("own_ceiling")] + _own_ceiling_lines(rows, pfem10)
     lines += _study_lines(res)
     todo = [k for k in dict(jobs(), **retry_jobs(res["runs"])) if k not in res["runs"]]
     recorded = [r for r in res["runs"].values() if r.get("wall_time_s")]

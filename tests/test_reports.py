@@ -118,6 +118,23 @@ def test_thermal_cutting_rake_face_ceiling_is_merchants_bound():
     assert steel["error_mu0"] == pytest.approx(0.0, abs=1e-9) and steel["above"]["_exp"] == 0
 
 
+def test_thermal_cutting_own_ceiling_uses_each_predictions_temperature():
+    """own_ceilings: a prediction on the ceiling at mu(its own T_RF) is not above it (mean 1), one at twice it is
+    (mean 2), and a hotter rake face lowers the ceiling (the same Fp/Fc is then above it)."""
+    import math
+    mod = _script("thermal_cutting")
+    mu = lambda T: 0.81 * (1.0 - ((T - 293.0) / (1773.0 - 293.0)) ** 2.09)           # noqa: E731  (AISI 1045)
+    from refsph.scenes.thermal_cutting import MATERIALS
+    assert MATERIALS["AISI1045"]["T_melt_K"] == 1773.0
+    on = math.tan(math.atan(mu(700.0)) - math.radians(10.0))
+    rows = [dict(material="AISI1045", ratio=on, TRF=700.0), dict(material="AISI1045", ratio=2 * on, TRF=700.0)]
+    got = mod.own_ceilings({"x": (rows[:1], "ratio", "TRF"), "y": (rows[1:], "ratio", "TRF"),
+                            "hot": ([dict(rows[0], TRF=1100.0)], "ratio", "TRF")})
+    assert got[("AISI1045", "x")][:2] == (0, 1) and got[("AISI1045", "x")][2] == pytest.approx(1.0)
+    assert got[("AISI1045", "y")][:2] == (1, 1) and got[("AISI1045", "y")][2] == pytest.approx(2.0)
+    assert got[("AISI1045", "hot")][0] == 1 and got[("Ti6Al4V", "x")][1] == 0
+
+
 def test_thermal_cutting_method_gap_is_pfem_minus_sph():
     """method_gaps: per case with both methods recorded, PFEM - SPH in K for temperatures and PFEM / SPH - 1 in %
     for Fc and Fp/Fc, refsph's beside the paper's (case 1: T_RF 850 - 671.5 K); the mean rows count the cases

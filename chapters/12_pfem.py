@@ -616,11 +616,8 @@ for case in (1, 10):
               f"T_FCS {c[f'TFCS_{t}_K']:.0f} K")
 
 # %% [markdown]
-# **Where it stands.** 17 of 18 cuts at t_u/5; case 1 at t_u/10: 27 min. **Fails:** Fp/Fc 0.14-0.40 (measured 0.71-0.83;
-# a 10° rake allows 0.55; α 1.25-2 moves it ≤ 9 %); the trapezoidal rule rings (8, 9, 16 stall): `gamma=0.6` damps it.
-# The paper's PFEM gives 0.43-0.62, above $\tan(\arctan\mu(T) - 10°)$ at its own rake-face temperature in all 18
-# cases (the sweep's report, "What friction on the rake face alone can give"): its thrust is not the stated friction
-# law's on the rake face alone. refsph's PFEM obeys that law, and its edge and flank carry no force.
+# **Fails:** Fp/Fc 0.14-0.40 (measured 0.71-0.83; a 10° rake allows 0.55; the paper's PFEM, above $\tan(\arctan\mu(T)
+# -10°)$ at its own T_RF in all 18 cases, is not the law's rake friction); the trapezoidal rule rings: `gamma=0.6`.
 
 # %% [markdown]
 # ## Your turn

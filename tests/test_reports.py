@@ -327,6 +327,12 @@ def test_thermal_cutting_queues_the_retry_of_a_failed_case():
     assert numerics == dict(method="pfem")
     assert out["case 3" + mod.RETRY][1]["courant"] == mod.RETRY_COURANT
     assert set(mod.retry_jobs(recs, studies=("pfem",))) == {bossak}
+    two = "case 4" + mod.PFEM10 + mod.TO_2MM                         # a PFEM cut to 2 mm: its Bossak retry
+    out = mod.retry_jobs(dict(recs, **{two: dict(status="failed")}), studies=("pfem",))
+    assert set(out) == {bossak, two + mod.BOSSAK}
+    options = out[two + mod.BOSSAK][0]
+    assert (options["case"], options["travel"], options["length"], options["bossak"]) == (4, 20.0, 3e-3, -0.1)
+    assert not mod.retry_jobs({"case 1" + mod.TO_2MM: dict(status="failed")})   # the SPH cut's: none (yet)
 
 
 def test_thermal_cutting_takes_a_failed_pfem_case_with_the_damped_rule():
@@ -370,3 +376,9 @@ def test_thermal_cutting_means_at_the_paper_length_of_cut():
         w = mod.window_means(runs[key], vc, 0.75 * end, end)
         assert w["TRF"] == pytest.approx(m["rake_face_temperature_K"], rel=0.01)
         assert w["ratio"] == pytest.approx(m["force_ratio"], rel=0.03)
+    done = dict(runs["case 1 pfem 2 mm"])                             # case 1's PFEM cut to 2 mm, as recorded
+    res = dict(runs={"case 1 pfem": runs["case 1 pfem"], "case 1 pfem 2 mm": dict(status="failed"),
+                     "case 1 pfem 2 mm" + mod.BOSSAK: done})        # failed, and its Bossak retry ran
+    row = mod.paper_length_rows(res, mod.PFEM10)[0]
+    assert row["key2"] == "case 1 pfem 2 mm" + mod.BOSSAK
+    assert row["2mm"]["TRF"][0] == pytest.approx(mod.window_means(done, 1.0, *mod.PAPER_CUT)["TRF"])

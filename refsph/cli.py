@@ -82,6 +82,9 @@ def _parser() -> argparse.ArgumentParser:
                    "refsph writes in a run folder are removed, every other file is kept")
     r.add_argument("--quick", action="store_true", help="coarse, fast version of the scene")
     r.add_argument("--quiet", action="store_true", help="no progress lines")
+    r.add_argument("--checkpoint-every", type=float, default=600.0, metavar="SECONDS",
+                   help="a restart checkpoint between snapshots every SECONDS of wall time (default 600; 0: after "
+                        "every step; inf: only at snapshots); also with --restart")
     r.add_argument("--option", action="append", default=[], metavar="NAME=VALUE",
                    help="a scene option (see 'refsph list'), e.g. --option T_melt=1793 (or --T_melt 1793); "
                         "repeatable")
@@ -91,7 +94,7 @@ def _parser() -> argparse.ArgumentParser:
     return ap
 
 
-NUMBER_FLAGS = ("--dp", "--t-end", "--dt")
+NUMBER_FLAGS = ("--dp", "--t-end", "--dt", "--checkpoint-every")
 
 
 def _join_negative_numbers(argv: list) -> list:
@@ -215,11 +218,11 @@ def _restart(args, extra=()) -> int:
                                       ("--set", args.set or None)) if value is not None]
     if given or extra:
         print(f"refsph: --restart continues the run in RUN_DIR with the scene and settings of its summary.json; it "
-              f"takes no {', '.join(given + list(extra))} (only --quiet)", file=sys.stderr)
+              f"takes no {', '.join(given + list(extra))} (only --quiet and --checkpoint-every)", file=sys.stderr)
         return 2
     from .pfem_run import is_pfem_run, restart_pfem
     again = restart_pfem if is_pfem_run(args.restart) else restart_run
-    res, code = _attempt(lambda: again(args.restart, progress=not args.quiet))
+    res, code = _attempt(lambda: again(args.restart, progress=not args.quiet, checkpoint_every=args.checkpoint_every))
     if code:
         return code
     s = res.summary
@@ -295,12 +298,13 @@ def _run(args, extra) -> int:
             if args.out and len(methods) > 1:
                 out = f"{args.out}/pfem"
             res, code = _attempt(lambda: run_pfem(args.scene, out=out, options=options, quick=args.quick,
-                                                  progress=not args.quiet, overwrite=args.overwrite))
+                                                  progress=not args.quiet, overwrite=args.overwrite,
+                                                  checkpoint_every=args.checkpoint_every))
         else:
             res, code = _attempt(lambda: run(args.scene, method, dim=dim, dp=args.dp, t_end=args.t_end, out=out,
                                              quick=args.quick, dt=args.dt, progress=not args.quiet,
                                              options=options, numerics=numerics, particles=args.particles,
-                                             overwrite=args.overwrite))
+                                             overwrite=args.overwrite, checkpoint_every=args.checkpoint_every))
         if code:
             return code
         s = res.summary

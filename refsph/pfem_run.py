@@ -148,7 +148,7 @@ def run_pfem(scene_name: str = "thermal_cutting", *, out=None, options: dict | N
     ``checkpoint_every`` seconds of wall time have passed since the last (None: only at snapshots), so that a
     killed long run loses at most that much (the checkpoint holds the whole run: the same bits on a restart).
     BLAS runs at one thread meanwhile (:func:`one_blas_thread`). Returns a :class:`PFEMRunResult`."""
-    if checkpoint_every is not None and not (np.isfinite(checkpoint_every) and checkpoint_every >= 0):
+    if checkpoint_every is not None and not checkpoint_every >= 0:     # (inf: only at snapshots, as None)
         raise ValueError(f"checkpoint_every must be >= 0 seconds or None, got {checkpoint_every!r}")
     with one_blas_thread():
         return _run_pfem(scene_name, out, options, quick, progress, restart, overwrite, max_steps, checkpoint_every)

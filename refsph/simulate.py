@@ -594,7 +594,7 @@ def simulate(setup: Setup, method: str | None = None, *, scene: Scene | None = N
     name = scene.name if scene is not None else label
     for message in warnings_for(scene.name if scene is not None else None, method, setup.numerics):
         warnings.warn(message, UserWarning, stacklevel=2)
-    if checkpoint_every is not None and not (np.isfinite(checkpoint_every) and checkpoint_every >= 0):
+    if checkpoint_every is not None and not checkpoint_every >= 0:     # (inf: only at snapshots, as None)
         raise ValueError(f"checkpoint_every must be >= 0 seconds or None, got {checkpoint_every!r}")
     state, rec = _begin(setup, parts, out, dt, name, record, record_every, restart, overwrite, checkpoint_every)
     rec.summary.update(meta or {})

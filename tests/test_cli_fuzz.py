@@ -107,6 +107,10 @@ CASES = [
     *[["run", sc, "--quick"] + flags for sc in ("spinning_disc", "pressing", "cutting", "thermal_cutting")
       for flags in (["--dp", "0"], ["--dt", "-1e-9"], ["--t-end", "inf"], ["--set", "courant=nan"])],
     ["run", "taylor", "--dim", "3", "--dp", "1e-9"], ["run", "rings", "--dp", "1e-9"],
+    ["run", "bar", "--quick", "--checkpoint-every", "-1"], ["run", "bar", "--quick", "--checkpoint-every", "nan"],
+    ["run", "bar", "--quick", "--checkpoint-every", "often"],
+    ["run", "thermal_cutting", "--method", "pfem", "--quick", "--checkpoint-every", "-5"],
+    ["run", "--restart", "{d}/run", "--checkpoint-every", "-1"],
 ]
 
 

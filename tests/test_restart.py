@@ -252,3 +252,19 @@ def test_earlier_commits_reads_what_it_can(tmp_path):
     for bad in ('{"provenance": "x"}', '{"provenance": {"earlier_commits": 3}}', "[1]", "{"):
         (tmp_path / "summary.json").write_text(bad)
         assert sim.earlier_commits(tmp_path) == []
+
+
+def test_the_command_line_sets_the_checkpoint_interval(tmp_path, monkeypatch):
+    """refsph run --checkpoint-every S reaches the run loop (a run and a restart), 600 s without it."""
+    seen, original = [], sim.simulate
+
+    def spy(*args, **k):
+        seen.append(k["checkpoint_every"])
+        return original(*args, **k)
+    monkeypatch.setattr(sim, "simulate", spy)
+    out = str(tmp_path / "r")
+    assert main(["run", "pressing", "--method", "tlsph", "--quick", "--t-end", "0.1e-6", "--out", out, "--quiet",
+                 "--checkpoint-every", "0"]) == 0
+    assert main(["run", "--restart", out, "--quiet", "--checkpoint-every", "inf"]) == 0
+    assert main(["run", "pressing", "--method", "tlsph", "--quick", "--t-end", "0.1e-6", "--out", out, "--quiet"]) == 0
+    assert seen == [0.0, float("inf"), 600.0] and sim.CHECKPOINT_EVERY_S == 600.0

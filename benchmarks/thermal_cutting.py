@@ -219,9 +219,9 @@ def bossak_cut(n: int, n_tu: float) -> dict:
 
 def retry_jobs(records: dict, studies=STUDY_NAMES) -> dict:
     """The retries (RETRIES) of the t_u/10 tables' cases whose record failed and whose retry is not in jobs(): an
-    SPH case 'case N' again at RETRY_COURANT, a PFEM case 'case N pfem' (or its cut to 2 mm, 'case N pfem 2 mm')
-    with the Bossak-Newmark rule (the first of RETRIES[PFEM10]); the sweep adds them, so that a failed case is
-    taken again without a new line in jobs()."""
+    SPH case 'case N' again at RETRY_COURANT, a PFEM case 'case N pfem' with the Bossak-Newmark rule (key + the
+    first of RETRIES[PFEM10]), a PFEM cut to 2 mm 'case N pfem 2 mm' with it too (key + BOSSAK); the sweep adds
+    them, so that a failed case is taken again without a new line in jobs()."""
     out = {}
     for n in TU_01:
         key = f"case {n}{PFEM10}{TO_2MM}"
@@ -470,8 +470,9 @@ def own_ceilings(sets: dict) -> dict:
         d = MATERIALS[mat]
         law = CoulombFriction(mu0=d["mu0"], q=d["q_friction"], T_room=CONTACT_RLA["T_ref_K"], T_melt=d["T_melt_K"])
         for label, (rows, rk, tk) in sets.items():
-            x = [r[rk] / rake_friction_bound(float(law.mu(np.array(r[tk]))), RAKE_DEG) for r in rows
+            c = [(r[rk], rake_friction_bound(float(law.mu(np.array(r[tk]))), RAKE_DEG)) for r in rows
                  if r["material"] == mat and r[rk] is not None and r[tk] is not None]
+            x = [v / b if b > 0 else float("inf") for v, b in c]      # (mu(T) <= tan(gamma): no thrust from it)
             out[(mat, label)] = (sum(v > 1.0 for v in x), len(x), float(np.mean(x)) if x else float("nan"))
     return out
 
@@ -569,10 +570,12 @@ def _dof_lines(pfem: list, coarse: list, res: dict, pfem10: list = (), fine: lis
             if not both:
                 continue
             n = [float(np.mean([res["runs"][r["key"]]["n_particles"] for r in rows])) for rows in zip(*both)]
-            cells = [label, mat, str(len(both)), f"{n[0]:.0f} / {3 * n[0]:.0f}", f"{n[1]:.0f} / {2 * n[1]:.0f}"]
+            n = [round(v) for v in n]
+            cells = [label, mat, str(len(both)), f"{n[0]} / {3 * n[0]}", f"{n[1]} / {2 * n[1]}"]
             pf, sph = [a for a, _ in both], [b for _, b in both]
             cells += [f"{_mean(pf, f'{q}_err'):.1f} / {_mean(sph, f'{q}_err'):.1f}" for q in ("TRF", "TFCS", "ratio")]
-            cells.append(f"{_mean(pf, 'wall_s') / 60:.1f} / {_mean(sph, 'wall_s') / 60:.1f}")
+            cells.append(f"{_mean(pf, 'wall_s') / 60:.1f} / {_mean(sph, 'wall_s') / 60:.1f}" if label == "t_u/5" else
+                         "-")                   # t_u/10: runs three and four at a time over sessions (page text)
             lines.append("| " + " | ".join(cells) + " |")
     return lines
 
@@ -619,8 +622,9 @@ def method_gaps(res: dict) -> list[dict]:
     from refsph.paper_data import rla_cutting_case
     sph, pfem = comparison(res), comparison(res, PFEM10)
     out = []
+    need = ("TRF", "TFCS", "Fc_N_per_mm", "ratio")
     for a, b in zip(sph, pfem):
-        if a["status"] != "ok" or b["status"] != "ok":
+        if a["status"] != "ok" or b["status"] != "ok" or any(r[k] is None for r in (a, b) for k in need):
             continue
         c = rla_cutting_case(a["case"])
         ours = dict(TRF=b["TRF"] - a["TRF"], TFCS=b["TFCS"] - a["TFCS"],
@@ -629,14 +633,16 @@ def method_gaps(res: dict) -> list[dict]:
         paper = dict(TRF=c["TRF_pfem_K"] - c["TRF_sph_K"], TFCS=c["TFCS_pfem_K"] - c["TFCS_sph_K"],
                      Fc=100.0 * (c["Fc_pfem_N"] / c["Fc_sph_N"] - 1.0),
                      ratio=100.0 * (a["ratio_pfem"] / a["ratio_sph"] - 1.0))
-        out.append(dict(case=a["case"], material=a["material"], ours=ours, paper=paper))
+        out.append(dict(case=a["case"], material=a["material"], ours=ours, paper=paper,
+                        retried=a["key"] != f"case {a['case']}" or b["key"] != f"case {a['case']}{PFEM10}"))
     return out
 
 
 def _gap_lines(gaps: list) -> list[str]:
     """The gap table's rows, then per material the means and on how many cases refsph's gap has the paper's sign."""
-    lines = [f"| {g['case']} | {g['material']} | " + " | ".join(f"{g['ours'][q]:+.0f} | {g['paper'][q]:+.0f}"
-                                                             for q, _, _ in GAP_QUANTITIES) + " |" for g in gaps]
+    lines = [f"| {g['case']}{' †' if g['retried'] else ''} | {g['material']} | "
+             + " | ".join(f"{g['ours'][q]:+.0f} | {g['paper'][q]:+.0f}" for q, _, _ in GAP_QUANTITIES) + " |"
+             for g in gaps]
     for mat in ("AISI1045", "Ti6Al4V"):
         sel = [g for g in gaps if g["material"] == mat]
         if not sel:

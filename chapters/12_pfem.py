@@ -616,8 +616,8 @@ for case in (1, 10):
               f"T_FCS {c[f'TFCS_{t}_K']:.0f} K")
 
 # %% [markdown]
-# **Fails:** Fp/Fc 0.14-0.40 (measured 0.71-0.83; a 10° rake allows 0.55; the paper's PFEM, above $\tan(\arctan\mu(T)
-# -10°)$ at its own T_RF in all 18 cases, is not the law's rake friction); the trapezoidal rule rings: `gamma=0.6`.
+# **Fails:** Fp/Fc 0.13-0.40 (measured 0.65-0.83; a 10° rake allows 0.55 at μ0, which the paper's PFEM exceeds in 13 of
+# 18 cases: not the law's rake friction alone); the trapezoidal rule rings (cases 8, 9, 12, 14, 16): `bossak=-0.1`.
 
 # %% [markdown]
 # ## Your turn

@@ -16,7 +16,7 @@ import numpy as np
 
 from .scenes import SCENES, Numerics, parse_bool
 from .scenes.base import numerics_field_optional
-from .simulate import METHODS, SimulationError, check_run, run
+from .simulate import CHECKPOINT_EVERY_S, METHODS, SimulationError, check_run, run
 
 
 def _fmt(v):
@@ -65,8 +65,8 @@ def _parser() -> argparse.ArgumentParser:
                    help="start the scene's physics from external particles (x, v, m; optional body, rho, S, S_zz, "
                         "X, V0, T, clamp_<name>; see refsph.io.state_from_particles)")
     r.add_argument("--restart", default=None, metavar="RUN_DIR",
-                   help="continue the run in RUN_DIR from its last checkpoint (written at every snapshot and every 10 "
-                        "minutes of wall time), with the arguments it was started with "
+                   help="continue the run in RUN_DIR from its last checkpoint (written at every snapshot and every "
+                        "--checkpoint-every seconds of wall time), with the arguments it was started with "
                         "(bit for bit the same as the uninterrupted run)")
     r.add_argument("--method", choices=METHODS + ("both", "pfem"), default=None,
                    help="formulation (default: the scene's; 'pfem': the Particle Finite Element Method, for "
@@ -82,9 +82,10 @@ def _parser() -> argparse.ArgumentParser:
                    "refsph writes in a run folder are removed, every other file is kept")
     r.add_argument("--quick", action="store_true", help="coarse, fast version of the scene")
     r.add_argument("--quiet", action="store_true", help="no progress lines")
-    r.add_argument("--checkpoint-every", type=float, default=600.0, metavar="SECONDS",
-                   help="a restart checkpoint between snapshots every SECONDS of wall time (default 600; 0: after "
-                        "every step; inf: only at snapshots); also with --restart")
+    r.add_argument("--checkpoint-every", type=_seconds, default=CHECKPOINT_EVERY_S, metavar="SECONDS",
+                   help=f"a restart checkpoint between snapshots every SECONDS of wall time (default "
+                        f"{CHECKPOINT_EVERY_S:g}; 0: after every step; inf: only at snapshots); a --restart takes "
+                        "its own (not the first part's)")
     r.add_argument("--option", action="append", default=[], metavar="NAME=VALUE",
                    help="a scene option (see 'refsph list'), e.g. --option T_melt=1793 (or --T_melt 1793); "
                         "repeatable")
@@ -95,6 +96,17 @@ def _parser() -> argparse.ArgumentParser:
 
 
 NUMBER_FLAGS = ("--dp", "--t-end", "--dt", "--checkpoint-every")
+
+
+def _seconds(text: str) -> float:
+    """--checkpoint-every: a number of seconds >= 0 (inf allowed); argparse's message otherwise."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a number of seconds, got {text!r}") from None
+    if not value >= 0:
+        raise argparse.ArgumentTypeError(f"must be >= 0 seconds (inf: only at snapshots), got {text!r}")
+    return value
 
 
 def _join_negative_numbers(argv: list) -> list:

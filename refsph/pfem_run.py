@@ -272,6 +272,8 @@ def _summary(scene_name: str, run: CutRun, res: dict, kwargs: dict, args: dict, 
 def restart_pfem(run_dir, progress: bool = True, checkpoint_every: float | None = CHECKPOINT_EVERY_S) -> PFEMRunResult:
     """Continue the PFEM run in ``run_dir`` from its last checkpoint, with the arguments it was started with
     (``summary.json``'s ``run_args``)."""
+    if checkpoint_every is not None and not checkpoint_every >= 0:     # said as itself, not as a folder's fault
+        raise ValueError(f"checkpoint_every must be >= 0 seconds or None, got {checkpoint_every!r}")
     path = Path(run_dir) / "summary.json"
     try:
         args = json.loads(path.read_text())["run_args"]

@@ -92,6 +92,8 @@ def test_a_timed_checkpoint_changes_nothing_and_is_continued(short_run, tmp_path
         assert second.summary["metrics"][key] == res.summary["metrics"][key]
     with pytest.raises(ValueError, match="checkpoint_every"):
         run_pfem("thermal_cutting", out=tmp_path / "bad", options=SHORT, quick=True, checkpoint_every=float("nan"))
+    with pytest.raises(ValueError, match="checkpoint_every must be"):            # not "not a PFEM run folder"
+        restart_pfem(part, checkpoint_every=-1.0)
 
 
 def test_provenance_is_the_code_that_ran(tmp_path, monkeypatch):

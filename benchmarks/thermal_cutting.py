@@ -206,10 +206,13 @@ def more_jobs() -> list[tuple[str, str, dict, dict]]:
     PFEM's first."""
     pfem = dict(method="pfem")
     out = [("pfem", key, options, pfem) for key, options in time_rule_jobs() + remesh_jobs() + pfem_resolution_jobs()]
-    out += [("pfem", f"case {n}{PFEM10}{TO_2MM}", converged(n, n_tu=10.0, travel=20.0, length=3e-3), pfem)
-            for n in TU_01]
-    return out + [("cases", f"case {n}{TO_2MM}", converged(n, travel=20.0, length=3e-3), sweep_numerics())
-                  for n in TU_01]
+    out += [("pfem", f"case {n}{PFEM10}{TO_2MM}", to_2mm(n, n_tu=10.0), pfem) for n in TU_01]
+    return out + [("cases", f"case {n}{TO_2MM}", to_2mm(n), sweep_numerics()) for n in TU_01]
+
+
+def to_2mm(n: int, **more) -> dict:
+    """The options of case ``n`` cut to the paper's 2 mm (20 t_u for t_u = 0.1 mm) on its 3 mm workpiece."""
+    return converged(n, travel=20.0, length=3e-3, **more)
 
 
 def bossak_cut(n: int, n_tu: float) -> dict:
@@ -226,8 +229,7 @@ def retry_jobs(records: dict, studies=STUDY_NAMES) -> dict:
     for n in TU_01:
         key = f"case {n}{PFEM10}{TO_2MM}"
         if "pfem" in studies and records.get(key, {}).get("status", "ok") != "ok":
-            out[key + BOSSAK] = (dict(converged(n, n_tu=10.0, travel=20.0, length=3e-3), bossak=BOSSAK_ALPHA),
-                                 dict(method="pfem"))
+            out[key + BOSSAK] = (dict(to_2mm(n, n_tu=10.0), bossak=BOSSAK_ALPHA), dict(method="pfem"))
     for n in range(1, 19):
         sph, pfem = f"case {n}", f"case {n}{PFEM10}"
         if "cases" in studies and records.get(sph, {}).get("status", "ok") != "ok":
@@ -428,24 +430,31 @@ def _trend_cell(t: dict, name: str) -> str:
     return f"{cell}{'' if known == total else f', {known} of {total} lines recorded'} / {exp}"
 
 
+def _ceiling_law(mat: str):
+    """(mu0, Merchant's tan(atan(mu0) - gamma), T -> tan(atan(mu(T)) - gamma)) of ``mat`` under the paper's friction
+    law (Eq. (11))."""
+    from pfem_rake_friction import rake_friction_bound
+    from refsph.contact import CoulombFriction
+    from refsph.paper_data import CONTACT_RLA
+    from refsph.scenes.thermal_cutting import MATERIALS, RAKE_DEG
+    d = MATERIALS[mat]
+    law = CoulombFriction(mu0=d["mu0"], q=d["q_friction"], T_room=CONTACT_RLA["T_ref_K"], T_melt=d["T_melt_K"])
+    return (d["mu0"], rake_friction_bound(d["mu0"], RAKE_DEG),
+            lambda T: rake_friction_bound(float(law.mu(np.array(T))), RAKE_DEG))
+
+
 def rake_face_ceiling(rows: list) -> list[dict]:
     """Per material: the largest Fp/Fc that friction on the rake face alone can give, Merchant's tan(atan(mu) -
     gamma) for a chip slipping everywhere at mu (no force on the edge or the flank), at the law's mu0 and at mu(T)
     of the measured T_RF (Eq. (11)), with its mean error against the measured Fp/Fc: the smallest mean error a model
     whose thrust comes from the rake face's Coulomb friction can reach ('ceiling'; cases whose measured ratio lies
     above it). ``rows``: :func:`comparison`'s (their measured columns only)."""
-    from pfem_rake_friction import rake_friction_bound
-    from refsph.contact import CoulombFriction
-    from refsph.paper_data import CONTACT_RLA
-    from refsph.scenes.thermal_cutting import MATERIALS, RAKE_DEG
     out = []
     for mat in ("AISI1045", "Ti6Al4V"):
-        sel, d = [r for r in rows if r["material"] == mat], MATERIALS[mat]
-        law = CoulombFriction(mu0=d["mu0"], q=d["q_friction"], T_room=CONTACT_RLA["T_ref_K"], T_melt=d["T_melt_K"])
-        at_mu0 = rake_friction_bound(d["mu0"], RAKE_DEG)
-        at_T = [rake_friction_bound(float(law.mu(np.array(r["TRF_exp"]))), RAKE_DEG) for r in sel]
+        sel, (mu0, at_mu0, ceiling) = [r for r in rows if r["material"] == mat], _ceiling_law(mat)
+        at_T = [ceiling(r["TRF_exp"]) for r in sel]
         exp = [r["ratio_exp"] for r in sel]
-        out.append(dict(material=mat, mu0=d["mu0"], ceiling_mu0=at_mu0,
+        out.append(dict(material=mat, mu0=mu0, ceiling_mu0=at_mu0,
                         error_mu0=float(np.mean([_err(at_mu0, e) for e in exp])),
                         ceiling_T=(min(at_T), max(at_T)),
                         error_T=float(np.mean([_err(c, e) for c, e in zip(at_T, exp)])),
@@ -461,16 +470,11 @@ def own_ceilings(sets: dict) -> dict:
     own T_RF (:func:`rake_face_ceiling`'s ceiling at the temperature that prediction puts on the rake face), and
     its mean of Fp/Fc over that ceiling. ``sets``: {label: (rows, ratio key, T_RF key)} of :func:`comparison`'s
     rows. Above it, a prediction's thrust does not come from the friction law on the rake face alone."""
-    from pfem_rake_friction import rake_friction_bound
-    from refsph.contact import CoulombFriction
-    from refsph.paper_data import CONTACT_RLA
-    from refsph.scenes.thermal_cutting import MATERIALS, RAKE_DEG
     out = {}
     for mat in ("AISI1045", "Ti6Al4V"):
-        d = MATERIALS[mat]
-        law = CoulombFriction(mu0=d["mu0"], q=d["q_friction"], T_room=CONTACT_RLA["T_ref_K"], T_melt=d["T_melt_K"])
+        _, _, ceiling = _ceiling_law(mat)
         for label, (rows, rk, tk) in sets.items():
-            c = [(r[rk], rake_friction_bound(float(law.mu(np.array(r[tk]))), RAKE_DEG)) for r in rows
+            c = [(r[rk], ceiling(r[tk])) for r in rows
                  if r["material"] == mat and r[rk] is not None and r[tk] is not None]
             x = [v / b if b > 0 else float("inf") for v, b in c]      # (mu(T) <= tan(gamma): no thrust from it)
             out[(mat, label)] = (sum(v > 1.0 for v in x), len(x), float(np.mean(x)) if x else float("nan"))

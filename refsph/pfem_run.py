@@ -43,7 +43,7 @@ from .material import von_mises
 from .pfem.cutting import CutRun, pfem_cut
 from .pfem.solid import TRAPEZOIDAL, NewtonFailed
 from .scenes.base import parse_bool
-from .simulate import CHECKPOINT_EVERY_S, SimulationError, earlier_commits, provenance
+from .simulate import CHECKPOINT_EVERY_S, SimulationError, check_checkpoint_every, earlier_commits, provenance
 
 RINGING_HINT = (" [with the paper's trapezoidal rule the chip's ringing is undamped late in a cut, and Newton can "
                 "stall there (README, PFEM: cases 8 and 16); Newmark's damped rule, --option gamma=0.6 (a departure "
@@ -148,8 +148,7 @@ def run_pfem(scene_name: str = "thermal_cutting", *, out=None, options: dict | N
     ``checkpoint_every`` seconds of wall time have passed since the last (None: only at snapshots), so that a
     killed long run loses at most that much (the checkpoint holds the whole run: the same bits on a restart).
     BLAS runs at one thread meanwhile (:func:`one_blas_thread`). Returns a :class:`PFEMRunResult`."""
-    if checkpoint_every is not None and not checkpoint_every >= 0:     # (inf: only at snapshots, as None)
-        raise ValueError(f"checkpoint_every must be >= 0 seconds or None, got {checkpoint_every!r}")
+    check_checkpoint_every(checkpoint_every)
     with one_blas_thread():
         return _run_pfem(scene_name, out, options, quick, progress, restart, overwrite, max_steps, checkpoint_every)
 
@@ -202,17 +201,15 @@ def _run_pfem(scene_name, out, options, quick, progress, restart, overwrite, max
             run.step()
             if not np.all(np.isfinite(run.nodes.x)) or not np.all(np.isfinite(run.nodes.T)):
                 raise FloatingPointError(f"non-finite nodes after step {run.steps} (t = {run.nodes.t:.6e} s)")
-            if next_snap <= N_SNAPSHOTS and run.nodes.t >= times[next_snap] * (1 - 1e-9):
+            due = next_snap <= N_SNAPSHOTS and run.nodes.t >= times[next_snap] * (1 - 1e-9)
+            if due:
                 name = f"snap_{len(snapshots):05d}.npz"             # one snapshot however many times a step passed
                 _snapshot(snaps_dir / name, run)
                 snapshots.append(name)
                 while next_snap <= N_SNAPSHOTS and run.nodes.t >= times[next_snap] * (1 - 1e-9):
                     next_snap += 1
-                _checkpoint(snaps_dir, run, snapshots, next_snap)
-                running_summary()
-                checkpointed = time.perf_counter()
-            elif checkpoint_every is not None and time.perf_counter() - checkpointed >= checkpoint_every:
-                _checkpoint(snaps_dir, run, snapshots, next_snap)       # a timed one, between snapshots
+            if due or (checkpoint_every is not None and time.perf_counter() - checkpointed >= checkpoint_every):
+                _checkpoint(snaps_dir, run, snapshots, next_snap)       # at a snapshot, or timed between them
                 running_summary()
                 checkpointed = time.perf_counter()
             beat(run.nodes.t, run.steps)                    # the heartbeat between checkpoints
@@ -272,8 +269,7 @@ def _summary(scene_name: str, run: CutRun, res: dict, kwargs: dict, args: dict, 
 def restart_pfem(run_dir, progress: bool = True, checkpoint_every: float | None = CHECKPOINT_EVERY_S) -> PFEMRunResult:
     """Continue the PFEM run in ``run_dir`` from its last checkpoint, with the arguments it was started with
     (``summary.json``'s ``run_args``)."""
-    if checkpoint_every is not None and not checkpoint_every >= 0:     # said as itself, not as a folder's fault
-        raise ValueError(f"checkpoint_every must be >= 0 seconds or None, got {checkpoint_every!r}")
+    check_checkpoint_every(checkpoint_every)                  # said as itself, not as a folder's fault
     path = Path(run_dir) / "summary.json"
     try:
         args = json.loads(path.read_text())["run_args"]

@@ -388,6 +388,12 @@ def _initial_summary(setup: Setup, parts: "RunParts", dt, name: str, times) -> d
         **{p.name: json_ready(p.describe()) for p in parts.physics})
 
 
+def check_checkpoint_every(checkpoint_every: float | None) -> None:
+    """A checkpoint interval is None or >= 0 seconds (inf: only at snapshots, as None); ValueError naming it."""
+    if checkpoint_every is not None and not checkpoint_every >= 0:
+        raise ValueError(f"checkpoint_every must be >= 0 seconds or None, got {checkpoint_every!r}")
+
+
 def _checkpoint_if_due(rec: RunRecord, state: State) -> None:
     """A checkpoint between snapshots once ``rec.checkpoint_every`` seconds of wall time have passed since the last
     (so a killed run loses at most that much): the state in ``snapshots/checkpoint_a.npz``, ``_b`` or ``_c``, one
@@ -594,8 +600,7 @@ def simulate(setup: Setup, method: str | None = None, *, scene: Scene | None = N
     name = scene.name if scene is not None else label
     for message in warnings_for(scene.name if scene is not None else None, method, setup.numerics):
         warnings.warn(message, UserWarning, stacklevel=2)
-    if checkpoint_every is not None and not checkpoint_every >= 0:     # (inf: only at snapshots, as None)
-        raise ValueError(f"checkpoint_every must be >= 0 seconds or None, got {checkpoint_every!r}")
+    check_checkpoint_every(checkpoint_every)
     state, rec = _begin(setup, parts, out, dt, name, record, record_every, restart, overwrite, checkpoint_every)
     rec.summary.update(meta or {})
     show = _Progress(label or f"{name} {method} {state.dim}D", setup.t_end, progress, rec.out, state.t)

@@ -412,26 +412,6 @@ def _plot_contact(records):
     study.save_figure(fig, FIG / "07_pressing_contact_force.png", dpi=120)
 
 
-def observed_order(h, f):
-    """The order p of f(h) = f0 + C h^p through three values at h1 > h2 > h3 (any ratios): the root of
-    (h1^p - h2^p) / (h2^p - h3^p) = (f1 - f2) / (f2 - f3); None where the differences change sign or grow (no
-    convergence to be seen), inf beyond p = 20."""
-    (h1, h2, h3), (f1, f2, f3) = h, f
-    if (f1 - f2) * (f2 - f3) <= 0:
-        return None
-    ratio = (f1 - f2) / (f2 - f3)
-    g = lambda p: (h1**p - h2**p) / (h2**p - h3**p)  # noqa: E731   (grows with p from its limit at p -> 0)
-    lo, hi = 1e-9, 20.0
-    if ratio <= g(lo):
-        return None
-    if ratio >= g(hi):
-        return float("inf")
-    for _ in range(100):
-        mid = 0.5 * (lo + hi)
-        lo, hi = (mid, hi) if g(mid) < ratio else (lo, mid)
-    return 0.5 * (lo + hi)
-
-
 def _pct(x, signed=True) -> str:
     """A relative difference (not percent) as a percentage with one decimal."""
     return f"{100 * x:+.1f} %" if signed else f"{100 * x:.1f} %"
@@ -572,7 +552,7 @@ def _orders(pairs, k) -> str:
     rs = [p[k] for p in pairs]
     out = []
     for a, b, c in zip(rs, rs[1:], rs[2:]):
-        p = observed_order([r["dp_mm"] for r in (a, b, c)], [r["tool_force_mean_MN_per_m"] for r in (a, b, c)])
+        p = study.observed_order([r["dp_mm"] for r in (a, b, c)], [r["tool_force_mean_MN_per_m"] for r in (a, b, c)])
         word = "none (the differences change sign or grow)" if p is None else study.fmt(p, ".1f")
         out.append(f"{_um(a)}, {_um(b)}, {_um(c)} um: {word}")
     return "; ".join(out)

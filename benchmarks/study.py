@@ -22,6 +22,8 @@ tables and pages, and parse the common flags.
   writes. A partial rerun (``--only``, a fresh clone without the git-ignored run folders) merges its records into
   the committed ones, a failed run never replaces a good record, and a file (JSON, page, figure) whose content did
   not change is not written: a rerun that reproduced the committed results leaves ``git status`` clean.
+* ``observed_order()``, ``richardson()``: the order p of f = f0 + C h^p seen through three resolutions (any
+  ratios), and f0 extrapolated from the two finest.
 * ``md_table()``, ``fmt()``: markdown tables and cells.
 * ``Page``: the prose of a report page, in ``benchmarks/templates/<name>.md``, sections marked ``@@ name``,
   filled with ``string.Template`` (``$name``; a literal dollar is ``$$``).
@@ -323,6 +325,34 @@ def timed_in_subprocess(fn, *args):
     """``fn(*args)`` in a fresh process of its own (for one timing that no earlier work in this process may
     pollute); its result."""
     return run_all(fn, {"run": args}, jobs=1)[0]
+
+
+# ----------------------------------------------------------------------------- convergence
+def observed_order(h, f):
+    """The order p of f(h) = f0 + C h^p through three values at h1 > h2 > h3 (any ratios): the root of
+    (h1^p - h2^p) / (h2^p - h3^p) = (f1 - f2) / (f2 - f3); None where the differences change sign or grow (no
+    convergence to be seen), inf beyond p = 20."""
+    (h1, h2, h3), (f1, f2, f3) = h, f
+    if (f1 - f2) * (f2 - f3) <= 0:
+        return None
+    ratio = (f1 - f2) / (f2 - f3)
+    g = lambda p: (h1**p - h2**p) / (h2**p - h3**p)  # noqa: E731   (grows with p from its limit at p -> 0)
+    lo, hi = 1e-9, 20.0
+    if ratio <= g(lo):
+        return None
+    if ratio >= g(hi):
+        return float("inf")
+    for _ in range(100):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if g(mid) < ratio else (lo, mid)
+    return 0.5 * (lo + hi)
+
+
+def richardson(h, f, p: float) -> float:
+    """The value at h -> 0 of f(h) = f0 + C h^p through the two finest of ``h`` (largest first), ``f``:
+    f0 = f3 + (f3 - f2) / ((h2 / h3)^p - 1)."""
+    (h2, h3), (f2, f3) = h[-2:], f[-2:]
+    return f3 + (f3 - f2) / ((h2 / h3) ** p - 1.0)
 
 
 # ----------------------------------------------------------------------------- markdown

@@ -780,6 +780,14 @@ SCATTER_KEYS = ("case 1", "case 1 jitter 1", "case 1 jitter 2", "case 1 jitter 3
 SCATTER_T5 = tuple(k.replace("case 1", "case 1 n_tu 5") for k in SCATTER_KEYS)         # at t_u/5
 SCATTER_S2 = tuple(k.replace("n_tu 5", "n_tu 5 s/2") for k in SCATTER_T5)               # at t_u/5 and s/2
 SCATTER_TI10 = ("case 10", "case 10 jitter 1", "case 10 jitter 2")                     # Ti6Al4V at t_u/10
+# the resolution study: case -> its runs at 5, 10 and 15 particles across t_u (at courant 0.15), and the scatter
+# groups that measure its run-to-run spread at t_u/5 and t_u/10 (the t_u/5 group of case 1 at the scene's courant 0.3)
+RESOLUTION_N = (5.0, 10.0, 15.0)
+RESOLUTION_KEYS = {1: ("case 1 n_tu 5 courant 0.15", "case 1", "case 1 n_tu 15"),
+                   10: ("case 10 n_tu 5 courant 0.15", "case 10", "case 10 n_tu 15")}
+RESOLUTION_NOISE = {1: (SCATTER_T5, SCATTER_KEYS),
+                    10: (("case 10 n_tu 5", "case 10 n_tu 5 jitter 1", "case 10 n_tu 5 jitter 2",
+                          "case 10 n_tu 5 jitter 3"), SCATTER_TI10)}
 STUDIES = (
     ("Mass scaling: s halved (the rule's factor 0.01 A in s rho vc^2 = 0.01 A halved to 0.005 A)",
      ("case 1", "case 1 s/2", "case 10", "case 10 s/2", "case 1 n_tu 5", "case 1 n_tu 5 s/2", "case 10 n_tu 5",
@@ -805,9 +813,7 @@ STUDIES = (
      "at s/2 (one run) moves by more than the scatter", SCATTER_TI10, BASIC),
     ("Run-to-run scatter of Ti6Al4V at t_u/5 (case 10, the same perturbation)",
      ("case 10 n_tu 5", "case 10 n_tu 5 jitter 1", "case 10 n_tu 5 jitter 2", "case 10 n_tu 5 jitter 3"), BASIC),
-    ("Resolution (particles across t_u; at courant 0.15)",
-     ("case 1 n_tu 5 courant 0.15", "case 1", "case 1 n_tu 15", "case 10 n_tu 5 courant 0.15", "case 10",
-      "case 10 n_tu 15"),
+    ("Resolution (particles across t_u; at courant 0.15)", RESOLUTION_KEYS[1] + RESOLUTION_KEYS[10],
      (("across t_u", "across", ".0f"), ("dx [um]", "dx_um", ".1f"), ("particles", "n_particles", "d")) + BASIC
      + (("steps", "n_steps", "d"), ("wall [s]", "wall", ".0f"))),
     ("Tool and workpiece size (the sweep: the tool 10 t_u x 6 t_u, 12 t_u left uncut at the end of the cut; the "
@@ -901,7 +907,81 @@ def _study_lines(res: dict) -> list[str]:
             if other is not None:
                 lines += ["", _difference_line(res, keys, other)]
             lines += [_single_run_line(res, k, keys) for k in SINGLES.get(keys, ())]
+        if keys == RESOLUTION_KEYS[1] + RESOLUTION_KEYS[10]:
+            lines += _resolution_lines(res)
     return lines
+
+
+def resolution_convergence(res: dict) -> list[dict]:
+    """Per case of the resolution study and basic quantity: its values f at 5, 10 and 15 particles across t_u, the
+    changes between successive resolutions with their z (the change over its standard deviation from the scatter
+    groups: sqrt(s5^2 + s10^2) for t_u/5 -> t_u/10, sqrt(2) s10 for t_u/10 -> t_u/15, t_u/15's spread taken as
+    t_u/10's), and where both changes exceed twice their standard deviation with the same sign, the observed order
+    p of f = f0 + C dx^p and the extrapolated f0 (``study.observed_order``, ``study.richardson``)."""
+    h, out = [1.0 / n for n in RESOLUTION_N], []
+    for case, keys in RESOLUTION_KEYS.items():
+        runs = [res["runs"].get(k) for k in keys]
+        vals = [_values(r) if r is not None and r.get("status") == "ok" else {} for r in runs]
+        g5, g10 = (_groups(res, grp) for grp in RESOLUTION_NOISE[case])
+        for name, q, spec in BASIC:
+            f = [float(v.get(q, math.nan)) for v in vals]
+            sd5, sd10 = (float(g[q].std(ddof=1)) if len(g[q]) >= 2 else math.nan for g in (g5, g10))
+            z1, z2 = _z(f[1] - f[0], math.hypot(sd5, sd10)), _z(f[2] - f[1], math.sqrt(2.0) * sd10)
+            p = f0 = None
+            seen = all(math.isfinite(x) for x in f + [z1, z2]) and min(abs(z1), abs(z2)) > 2.0
+            if seen:
+                p = study.observed_order(h, f)
+                f0 = study.richardson(h, f, p) if p is not None and math.isfinite(p) else None
+            out.append(dict(case=case, name=name, spec=spec, f=f, z1=z1, z2=z2, p=p, f0=f0,
+                            d1=_rel(f[1], f[0]), d2=_rel(f[2], f[1]), seen=seen))
+    return out
+
+
+def _z(d: float, sd: float) -> float:
+    """A change over its standard deviation: +-inf for a change where the runs have no spread, NaN for none."""
+    if math.isnan(d) or math.isnan(sd):
+        return math.nan
+    if sd > 0:
+        return d / sd
+    return math.copysign(math.inf, d) if d != 0 else math.nan
+
+
+def _rel(a: float, b: float) -> float:
+    """100 (a - b) / |b|: a change in percent (NaN where either is missing)."""
+    return 100.0 * (a - b) / abs(b) if math.isfinite(a) and math.isfinite(b) and b != 0 else math.nan
+
+
+def _order_cell(r: dict) -> str:
+    """What the three resolutions say of a quantity's convergence."""
+    if not math.isfinite(r["f"][2]):
+        return "t_u/15 to run"
+    if not r["seen"]:
+        return "a change inside the scatter"
+    if r["p"] is None:
+        return "not monotone"
+    return "above 20" if not math.isfinite(r["p"]) else f"{r['p']:.1f}"
+
+
+def _resolution_lines(res: dict) -> list[str]:
+    """The resolution study's convergence table (``resolution_convergence``) with its prose."""
+    lines = ["", study.Page("thermal_cutting_report")("resolution_orders"), "",
+             "| case | quantity | t_u/5 | t_u/10 | t_u/15 | t_u/5 -> 10 (z) | t_u/10 -> 15 (z) | observed order "
+             "| extrapolated | t_u/10 from it |", "|---" * 10 + "|"]
+    for r in resolution_convergence(res):
+        f, spec = r["f"], r["spec"]
+        off = _rel(f[1], r["f0"]) if r["f0"] is not None else math.nan
+        cells = [r["case"], r["name"]] + [_f(x, spec) for x in f] + [_change_cell(r["d1"], r["z1"]),
+                                                                      _change_cell(r["d2"], r["z2"]), _order_cell(r),
+                                                                      _f(r["f0"], spec), _change_cell(off)]
+        lines.append("| " + " | ".join(str(c) for c in cells) + " |")
+    return lines
+
+
+def _change_cell(d: float, z: float = math.nan) -> str:
+    """'+5.1 % (+2.3)': a change in percent and its z; '-' where the change is missing."""
+    if not math.isfinite(d):
+        return "-"
+    return f"{d:+.1f} %" + (f" ({z:+.1f})" if math.isfinite(z) else "")
 
 
 COMPARED = {SCATTER_S2: SCATTER_T5}         # a scatter group -> the group it is compared with (_difference_line)

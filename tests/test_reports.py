@@ -386,3 +386,45 @@ def test_thermal_cutting_means_at_the_paper_length_of_cut():
     row = mod.paper_length_rows(res, mod.PFEM10)[0]
     assert row["key2"] == "case 1 pfem 2 mm" + mod.BOSSAK
     assert row["2mm"]["TRF"][0] == pytest.approx(mod.window_means(done, 1.0, *mod.PAPER_CUT)["TRF"])
+
+
+def test_thermal_cutting_resolution_order_is_read_only_where_the_changes_beat_the_scatter():
+    """resolution_convergence: Fc = 300 + C dx^2 through t_u/5, /10, /15 with a scatter of 1 N/mm gives the order 2
+    and the limit 300; the same runs with a scatter of 100 N/mm give no order (a change inside the scatter); a
+    missing t_u/15 run says so. study.observed_order and study.richardson on an exact power law."""
+    import math
+    mod = _script("thermal_cutting")
+    st = mod.study
+    h = [1 / 5, 1 / 10, 1 / 15]
+    assert abs(st.observed_order(h, [1 + 2 * x**1.5 for x in h]) - 1.5) < 1e-9
+    assert abs(st.richardson(h, [1 + 2 * x**1.5 for x in h], 1.5) - 1.0) < 1e-12
+    assert st.observed_order(h, [1.0, 2.0, 1.5]) is None
+
+    def rec(fc, n):
+        return dict(status="ok", dp=1e-4 / n, scene_info=dict(tu_m=1e-4),
+                    metrics=dict(cutting_force_N_per_m=1e3 * fc, passive_force_N_per_m=5e4, force_ratio=50 / fc,
+                                 rake_face_temperature_K=600.0, rake_face_temperature_max_K=650.0,
+                                 free_chip_surface_temperature_K=500.0, chip_thickness_mm=0.3,
+                                 contact_length_mm=0.3))
+
+    def records(spread, with_fine=True):
+        runs = {}
+        for case, keys in mod.RESOLUTION_KEYS.items():
+            for key, n in zip(keys, mod.RESOLUTION_N):
+                if n != 15.0 or with_fine:
+                    runs[key] = rec(300.0 + 1e4 * (1 / n) ** 2, n)
+            for group, n in zip(mod.RESOLUTION_NOISE[case], (5.0, 10.0)):
+                for k, sign in zip(group, (1, -1, 1, -1)):
+                    runs.setdefault(k, rec(300.0 + 1e4 * (1 / n) ** 2 + sign * spread, n))
+        return dict(runs=runs)
+
+    for case in (1, 10):
+        rows = {r["name"]: r for r in mod.resolution_convergence(records(1.0)) if r["case"] == case}
+        fc = rows["Fc [N/mm]"]
+        assert fc["seen"] and abs(fc["p"] - 2.0) < 1e-6 and abs(fc["f0"] - 300.0) < 1e-6
+        assert not rows["T_RF [K]"]["seen"] and mod._order_cell(rows["T_RF [K]"]) == "a change inside the scatter"
+    noisy = {r["name"]: r for r in mod.resolution_convergence(records(100.0)) if r["case"] == 1}["Fc [N/mm]"]
+    assert not noisy["seen"] and noisy["p"] is None and math.isfinite(noisy["z2"])
+    missing = [r for r in mod.resolution_convergence(records(1.0, with_fine=False)) if r["name"] == "Fc [N/mm]"]
+    assert all(mod._order_cell(r) == "t_u/15 to run" for r in missing)
+    assert "| 1 | Fc [N/mm] | 700.0 | 400.0 | 344.4 |" in "\n".join(mod._resolution_lines(records(1.0)))

@@ -932,7 +932,7 @@ def resolution_convergence(res: dict) -> list[dict]:
             if seen:
                 p = study.observed_order(h, f)
                 f0 = study.richardson(h, f, p) if p is not None and math.isfinite(p) else None
-            out.append(dict(case=case, name=name, spec=spec, f=f, z1=z1, z2=z2, p=p, f0=f0,
+            out.append(dict(case=case, name=name, spec=spec, f=f, z1=z1, z2=z2, p=p, f0=f0, sd=[sd5, sd10],
                             d1=_rel(f[1], f[0]), d2=_rel(f[2], f[1]), seen=seen))
     return out
 
@@ -1061,6 +1061,35 @@ def figures(res: dict) -> None:
         ax.legend(fontsize=7)
     fig.savefig(FIG / "11_thermal_cutting_trends.png", dpi=100)
     plt.close(fig)
+    resolution_figure(res, plt)
+
+
+RESOLUTION_SHOWN = ("Fc [N/mm]", "Fp/Fc", "T_RF [K]", "T_FCS [K]")
+
+
+def resolution_figure(res: dict, plt) -> None:
+    """figures/11_thermal_cutting_resolution.png: the resolution study's quantities against dx / t_u, each run with
+    its scatter group's standard deviation as an error bar (t_u/15's taken as t_u/10's), the Richardson limit at 0
+    where the three runs show an order (``resolution_convergence``)."""
+    rows = resolution_convergence(res)
+    fig, axes = plt.subplots(1, len(RESOLUTION_SHOWN), figsize=(13, 3.4), constrained_layout=True)
+    x = [1.0 / n for n in RESOLUTION_N]
+    for ax, name in zip(axes, RESOLUTION_SHOWN):
+        for k, case in enumerate(RESOLUTION_KEYS):
+            r = next(r for r in rows if r["case"] == case and r["name"] == name)
+            sd = r["sd"] + [r["sd"][1]]
+            ax.errorbar(x, r["f"], yerr=sd, fmt="o-", color=f"C{k}", capsize=3, label=f"case {case}")
+            if r["f0"] is not None:
+                ax.plot([0.0, x[2]], [r["f0"], r["f"][2]], ":", color=f"C{k}")
+                ax.plot([0.0], [r["f0"]], "*", color=f"C{k}", ms=9)
+        ax.set_xlim(left=0.0)
+        ax.set_xlabel("dx / t_u")
+        ax.set_title(name, fontsize=10)
+        ax.grid(alpha=0.3)
+    axes[0].legend(fontsize=8)
+    fig.suptitle("Resolution: t_u/5, t_u/10, t_u/15 (courant 0.15), bars: run-to-run standard deviation; "
+                 "star: Richardson limit where an order is seen", fontsize=9)
+    study.save_figure(fig, FIG / "11_thermal_cutting_resolution.png", dpi=100)
 
 
 def run_folder(key: str, quick: bool = False) -> Path:

@@ -102,8 +102,8 @@ for name, rows in conv.items():
 # Even so the heat step's limit is many mechanical steps (30–60 for steel at $t_u/10$), so `--set heat_every=8` runs
 # the heat step once every 8 mechanical steps, over their summed step with the frictional and dissipated heat they
 # made (an operator split, `refsph.thermal.KeptHeat`; the plastic heat still raises $T$ every step): case 1 at
-# $t_u/10$ in 36.5 instead of 51.7 min of CPU, its results within the run-to-run scatter measured at $t_u/5$
-# (`benchmarks/thermal_cutting_report.md`).
+# $t_u/10$ in 36.5 instead of 51.7 min of CPU, its results within the run-to-run scatter measured at $t_u/10$
+# except $T_{FCS}$ (−4.3 %, two standard deviations; `benchmarks/thermal_cutting_report.md`).
 
 # %% [markdown]
 # ## 2. Friction whose coefficient falls with temperature
@@ -132,8 +132,8 @@ ch.show(fig, "11_friction_law.png", caption="The friction coefficient μ(T) of t
                                             "temperature at the contact: it falls from μ0 to zero at melting.")
 
 # %% [markdown]
-# At 900 K steel keeps 0.67 of its room-temperature coefficient, titanium 0.99: titanium's friction only collapses
-# near melting ($q$ = 5.76).
+# At 900 K steel keeps 0.84 of its room-temperature coefficient (μ = 0.68), titanium 0.99: titanium's friction
+# only collapses near melting ($q$ = 5.76).
 #
 # ## 3. Finding the free surface
 #
@@ -248,7 +248,7 @@ assert abs(hb["residual_rel"]) < 1e-9
 #
 # `python benchmarks/thermal_cutting.py` runs the 18 cases at $\Delta x = t_u/10$ and 16 $t_u$ of cut (means over
 # the last quarter, with the drift over that quarter reported), resumably, on local processes or a
-# `dask.distributed` cluster; one case takes about half an hour on one core, so the sweep spans sessions and its
+# `dask.distributed` cluster; one case takes 20–52 min of CPU (13.2 h for the 18), so the sweep spans sessions and its
 # page says which cases are still to run. The measured values are not printed in the paper: they are recovered
 # from each printed prediction and its printed error. Every case against the measurement and the paper's own SPH
 # and PFEM (the mean errors, and issue 19's first sweep, are on the page,
@@ -276,7 +276,7 @@ for label, cases_run in drawn.items():
 # (the page's drift table), so a temperature depends on the length of cut it is read at. The paper's PFEM cuts
 # 2 mm for every $t_u$ (2/3 of its 3 mm workpiece: 20, 13.3 and 10 $t_u$); this sweep cuts 16 $t_u$. The page's
 # section "At the paper's length of cut" reads both methods' histories over the last quarter of 2 mm instead: for
-# refsph's PFEM on steel that alone moves the mean rake-face error from about 21 % to about 15 %, and one case's
+# refsph's PFEM on steel that alone moves the mean rake-face error from about 21 % to about 17 %, and one case's
 # rake face by 150 K. Exercise: which of the paper's numbers would you expect to move most with the cut's length,
 # and why do the thin cuts ($t_u$ = 0.1 mm) need their own, longer runs for it?
 
@@ -325,7 +325,7 @@ display(Markdown(split_page.split("\n\n", 1)[1]))             # the page without
 # %% [markdown]
 # * **What "rake-face temperature" means.** The paper does not say how its source measured $T_{RF}$ (a radiation
 #   measurement of the rake face "without manipulating the chip flow"): refsph fixed the contact mean as its
-#   definition before the sweep and prints the hottest contact particle beside it. The two differ by 27 K (case 1
+#   definition before the sweep and prints the hottest contact particle beside it. The two differ by 18 K (case 1
 #   at $t_u/10$) to 340 K (at $t_u/5$), more than most of the errors compared.
 # * **Resolution and steadiness.** Ten particles across $t_u$ still put two to three particles across the
 #   secondary shear zone; the resolution table and the drift columns say which digits hold.
@@ -333,8 +333,8 @@ display(Markdown(split_page.split("\n\n", 1)[1]))             # the page without
 # %% [markdown]
 # * **Mass scaling** changes inertia by the factor $s$, and with it the artificial viscosity's stress ($\propto
 #   \sqrt{s}$). At $t_u/5$, four runs a side, halving $s$ moves neither force (case 1: $F_c$ −0.5 %) but cools
-#   the rake face by 10 % (Welch's $t = -3.8$): the frictional heat halves. The page's run at $s/4$ says whether
-#   that goes on; until then the temperatures carry a mass-scaling bias of that order.
+#   the rake face by 10 % (Welch's $t = -3.8$). At $s/4$ (one run, Courant 0.15 as its $s$ run) it is 15 % cooler
+#   still, the frictional heat unchanged (1.9 against 1.7 % of the work): a mass-scaling bias of the temperatures.
 # * **The time step.** At $t_u/10$ the scene's step (Courant 0.3) broke two of three runs: a particle of case 10
 #   inverts at 1.1 ms, and in case 2 two particles of the chip's free surface oscillate against each other until
 #   their artificial viscosity heats the chip past 1500 K. The step $C h/(c_L + |v|_{max})$ leaves out the

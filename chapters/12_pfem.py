@@ -616,8 +616,8 @@ for case in (1, 10):
               f"T_FCS {c[f'TFCS_{t}_K']:.0f} K")
 
 # %% [markdown]
-# **Fails:** Fp/Fc 0.13-0.40 (measured 0.65-0.83; a 10° rake allows 0.55 at μ0, which the paper's PFEM exceeds in 13 of
-# 18 cases: not the law's rake friction alone); the trapezoidal rule rings (cases 8, 9, 12, 14, 16): `bossak=-0.1`.
+# **Fails:** Fp/Fc 0.08-0.40 at t_u/10 (measured 0.45-0.83; a 10° rake allows 0.55 / 0.31 at μ0 for steel / Ti, the
+# paper's PFEM above in 13 of 18: not rake friction alone); trapezoidal rule rings (8, 9, 12, 14, 16): `bossak=-0.1`.
 
 # %% [markdown]
 # ## Your turn

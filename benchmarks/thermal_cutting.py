@@ -27,7 +27,9 @@ frictional heat to the chip). Resumable twice over: a finished run is a record i
 ``benchmarks/thermal_cutting.json`` and is skipped; a run that was killed continues from its last checkpoint
 (``refsph run --restart``; one at every snapshot and every 10 minutes of wall time between them). A run that fails
 (non-finite state, lost chip) is a record with its status and error; it stays in the table until ``--redo`` runs it
-again, and a failed rerun never replaces a good record. A rerun with nothing to do writes nothing.
+again, and a failed rerun never replaces a good record. A failed case of the t_u/10 tables is taken again by its
+retry (``retry_jobs``: SPH at half the step, PFEM with the Bossak rule) in the same call and in every later one. A
+rerun with nothing to do writes nothing.
 
 The experimental values are not printed in the paper: ``refsph.paper_data.RLA_CUTTING_CASES`` recovers them from
 each printed prediction and its printed percent error. The paper does not state the width of cut, so forces are
@@ -1256,7 +1258,21 @@ def _same_options(recorded: dict, asked: dict) -> bool:
 
 def sweep(runs: study.RunStore, todo: dict, args) -> list:
     """Run the keys of ``todo`` not yet recorded (or in ``--redo``), each record stored as it comes (a failed run
-    never replaces a good record: study.RunStore); the keys that ran."""
+    never replaces a good record: study.RunStore), then the retries (``retry_jobs``) that this sweep's failures
+    called for, in the same call, so that an unattended sweep takes a failed case again; the keys that ran."""
+    studies = args.study or STUDY_NAMES
+    before = set(retry_jobs(runs.records(), studies))
+    ran = _sweep_round(runs, todo, args)
+    retries = {k: v for k, v in retry_jobs(runs.records(), studies).items()
+               if k not in before and any(k.startswith(key + " ") for key in ran)}
+    if retries:
+        print(f"retrying what failed: {', '.join(retries)}", flush=True)
+        ran += _sweep_round(runs, retries, args)
+    return ran
+
+
+def _sweep_round(runs: study.RunStore, todo: dict, args) -> list:
+    """One pass of ``sweep`` over ``todo``: the keys that ran."""
     stale = [k for k, r in runs.records().items() if k in todo and k not in args.redo
              and not _same_options(r.get("options", {}), todo[k][0])]
     if stale:

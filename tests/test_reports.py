@@ -428,3 +428,27 @@ def test_thermal_cutting_resolution_order_is_read_only_where_the_changes_beat_th
     missing = [r for r in mod.resolution_convergence(records(1.0, with_fine=False)) if r["name"] == "Fc [N/mm]"]
     assert all(mod._order_cell(r) == "t_u/15 to run" for r in missing)
     assert "| 1 | Fc [N/mm] | 700.0 | 400.0 | 344.4 |" in "\n".join(mod._resolution_lines(records(1.0)))
+
+
+def test_thermal_cutting_sweep_takes_a_failed_case_again_in_the_same_call(tmp_path, monkeypatch, capsys):
+    """thermal_cutting.sweep: a case that fails in this call is retried in it (retry_jobs: 'case 16 pfem' with the
+    Bossak rule), where a failure that was recorded before the call is not; the retry's record is stored."""
+    import argparse
+    mod = _script("thermal_cutting")
+    calls = []
+
+    def fake_run(key, options, numerics, quick):
+        calls.append(key)
+        status = "failed: Newton stalled" if key in ("case 16 pfem", "case 17 pfem") else "ok"
+        return key, dict(key=key, status=status, options=options, metrics={}, wall_time_s=1.0)
+
+    monkeypatch.setattr(mod.study, "execute", lambda fn, tasks, jobs, scheduler: (fake_run(*a) for a in tasks.values()))
+    runs = mod.store(tmp_path / "sweep.json")
+    runs.commit("case 17 pfem", dict(key="case 17 pfem", status="failed: before", options={}, metrics={}))
+    args = argparse.Namespace(study=None, redo=(), jobs=1, scheduler=None, quick=False)
+    todo = mod.jobs(("pfem",))
+    ran = mod.sweep(runs, {k: todo[k] for k in ("case 16 pfem", "case 15 pfem")}, args)
+    retry = "case 16 pfem n_tu 10" + mod.BOSSAK
+    assert calls == ["case 16 pfem", "case 15 pfem", retry] and ran == calls
+    assert runs.records()[retry]["status"] == "ok" and runs.records()[retry]["options"]["bossak"] == mod.BOSSAK_ALPHA
+    assert "retrying what failed: " + retry in capsys.readouterr().out

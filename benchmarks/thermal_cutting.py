@@ -783,7 +783,7 @@ SCATTER_T5 = tuple(k.replace("case 1", "case 1 n_tu 5") for k in SCATTER_KEYS)  
 SCATTER_S2 = tuple(k.replace("n_tu 5", "n_tu 5 s/2") for k in SCATTER_T5)               # at t_u/5 and s/2
 SCATTER_TI10 = ("case 10", "case 10 jitter 1", "case 10 jitter 2")                     # Ti6Al4V at t_u/10
 # the resolution study: case -> its runs at 5, 10 and 15 particles across t_u (at courant 0.15), and the scatter
-# groups that measure its run-to-run spread at t_u/5 and t_u/10 (the t_u/5 group of case 1 at the scene's courant 0.3)
+# groups that measure its run-to-run spread at t_u/5 and t_u/10 (the t_u/5 groups at the scene's courant 0.3)
 RESOLUTION_N = (5.0, 10.0, 15.0)
 RESOLUTION_KEYS = {1: ("case 1 n_tu 5 courant 0.15", "case 1", "case 1 n_tu 15"),
                    10: ("case 10 n_tu 5 courant 0.15", "case 10", "case 10 n_tu 15")}

@@ -918,8 +918,9 @@ def resolution_convergence(res: dict) -> list[dict]:
     """Per case of the resolution study and basic quantity: its values f at 5, 10 and 15 particles across t_u, the
     changes between successive resolutions with their z (the change over its standard deviation from the scatter
     groups: sqrt(s5^2 + s10^2) for t_u/5 -> t_u/10, sqrt(2) s10 for t_u/10 -> t_u/15, t_u/15's spread taken as
-    t_u/10's), and where both changes exceed twice their standard deviation with the same sign, the observed order
-    p of f = f0 + C dx^p and the extrapolated f0 (``study.observed_order``, ``study.richardson``)."""
+    t_u/10's), the verdict (``_verdict``), and where both changes exceed twice their standard deviation with the
+    same sign, the observed order p of f = f0 + C dx^p with its range (``_order_range``) and the extrapolated f0
+    (``study.observed_order``, ``study.richardson``)."""
     h, out = [1.0 / n for n in RESOLUTION_N], []
     for case, keys in RESOLUTION_KEYS.items():
         runs = [res["runs"].get(k) for k in keys]
@@ -928,15 +929,41 @@ def resolution_convergence(res: dict) -> list[dict]:
         for name, q, spec in BASIC:
             f = [float(v.get(q, math.nan)) for v in vals]
             sd5, sd10 = (float(g[q].std(ddof=1)) if len(g[q]) >= 2 else math.nan for g in (g5, g10))
-            z1, z2 = _z(f[1] - f[0], math.hypot(sd5, sd10)), _z(f[2] - f[1], math.sqrt(2.0) * sd10)
-            p = f0 = None
-            seen = all(math.isfinite(x) for x in f + [z1, z2]) and min(abs(z1), abs(z2)) > 2.0
-            if seen:
+            s1, s2 = math.hypot(sd5, sd10), math.sqrt(2.0) * sd10
+            z1, z2 = _z(f[1] - f[0], s1), _z(f[2] - f[1], s2)
+            verdict, p, f0, p_range = _verdict(f, sd5, sd10, z1, z2), None, None, None
+            if verdict == "order":
                 p = study.observed_order(h, f)
-                f0 = study.richardson(h, f, p) if p is not None and math.isfinite(p) else None
+                if p is None:
+                    verdict = "no convergence seen"
+                else:
+                    f0 = study.richardson(h, f, p) if math.isfinite(p) else None
+                    p_range = _order_range(h, f, s1, s2)
             out.append(dict(case=case, name=name, spec=spec, f=f, z1=z1, z2=z2, p=p, f0=f0, sd=[sd5, sd10],
-                            d1=_rel(f[1], f[0]), d2=_rel(f[2], f[1]), seen=seen))
+                            d1=_rel(f[1], f[0]), d2=_rel(f[2], f[1]), verdict=verdict, p_range=p_range))
     return out
+
+
+def _verdict(f: list, sd5: float, sd10: float, z1: float, z2: float) -> str:
+    """What three resolutions can say: 'order' only where all three runs and both scatters are there and both
+    changes exceed twice their standard deviation with the same sign."""
+    if math.isnan(f[0]) or math.isnan(f[1]):
+        return "t_u/5 or t_u/10 not recorded"
+    if math.isnan(f[2]):
+        return "t_u/15 to run"
+    if math.isnan(sd5) or math.isnan(sd10):
+        return "scatter not measured"
+    if math.isnan(z1) or math.isnan(z2) or min(abs(z1), abs(z2)) <= 2.0:
+        return "a change inside the scatter"
+    return "order" if z1 * z2 > 0 else "not monotone"
+
+
+def _order_range(h: list, f: list, s1: float, s2: float) -> tuple:
+    """The observed order with each change moved by one standard deviation either way (f at t_u/5 by s1, at t_u/15
+    by s2): (lowest, highest); 0 where a moved pair shows no convergence, inf above 20."""
+    ps = [study.observed_order(h, [f[0] + a, f[1], f[2] + b]) for a in (-s1, s1) for b in (-s2, s2)]
+    ps = [0.0 if x is None else x for x in ps]
+    return min(ps), max(ps)
 
 
 def _z(d: float, sd: float) -> float:
@@ -954,14 +981,11 @@ def _rel(a: float, b: float) -> float:
 
 
 def _order_cell(r: dict) -> str:
-    """What the three resolutions say of a quantity's convergence."""
-    if not math.isfinite(r["f"][2]):
-        return "t_u/15 to run"
-    if not r["seen"]:
-        return "a change inside the scatter"
+    """The observed order with its range ('1.8 (0.9-3.5)'), or the verdict where there is none."""
     if r["p"] is None:
-        return "not monotone"
-    return "above 20" if not math.isfinite(r["p"]) else f"{r['p']:.1f}"
+        return r["verdict"]
+    fmt = lambda x: "above 20" if not math.isfinite(x) else f"{x:.1f}"  # noqa: E731
+    return f"{fmt(r['p'])} ({fmt(r['p_range'][0])}-{fmt(r['p_range'][1])})"
 
 
 def _resolution_lines(res: dict) -> list[str]:
@@ -1258,13 +1282,13 @@ def _same_options(recorded: dict, asked: dict) -> bool:
 
 def sweep(runs: study.RunStore, todo: dict, args) -> list:
     """Run the keys of ``todo`` not yet recorded (or in ``--redo``), each record stored as it comes (a failed run
-    never replaces a good record: study.RunStore), then the retries (``retry_jobs``) that this sweep's failures
-    called for, in the same call, so that an unattended sweep takes a failed case again; the keys that ran."""
-    studies = args.study or STUDY_NAMES
-    before = set(retry_jobs(runs.records(), studies))
+    never replaces a good record: study.RunStore), then the retries (``retry_jobs``) that this sweep's own failures
+    call for (not those another sweep on the same file records meanwhile), in the same call, so that an unattended
+    sweep takes a failed case again; the keys that ran."""
     ran = _sweep_round(runs, todo, args)
-    retries = {k: v for k, v in retry_jobs(runs.records(), studies).items()
-               if k not in before and any(k.startswith(key + " ") for key in ran)}
+    recs = runs.records()
+    retries = {k: v for k, v in retry_jobs({k: recs[k] for k in ran if k in recs}, args.study or STUDY_NAMES).items()
+               if k not in ran}
     if retries:
         print(f"retrying what failed: {', '.join(retries)}", flush=True)
         ran += _sweep_round(runs, retries, args)

@@ -421,34 +421,55 @@ def test_thermal_cutting_resolution_order_is_read_only_where_the_changes_beat_th
     for case in (1, 10):
         rows = {r["name"]: r for r in mod.resolution_convergence(records(1.0)) if r["case"] == case}
         fc = rows["Fc [N/mm]"]
-        assert fc["seen"] and abs(fc["p"] - 2.0) < 1e-6 and abs(fc["f0"] - 300.0) < 1e-6
-        assert not rows["T_RF [K]"]["seen"] and mod._order_cell(rows["T_RF [K]"]) == "a change inside the scatter"
+        assert fc["verdict"] == "order" and abs(fc["p"] - 2.0) < 1e-6 and abs(fc["f0"] - 300.0) < 1e-6
+        lo, hi = fc["p_range"]
+        assert 1.5 < lo < 2.0 < hi < 2.5 and mod._order_cell(fc) == f"2.0 ({lo:.1f}-{hi:.1f})"
+        assert rows["T_RF [K]"]["p"] is None and mod._order_cell(rows["T_RF [K]"]) == "a change inside the scatter"
     noisy = {r["name"]: r for r in mod.resolution_convergence(records(100.0)) if r["case"] == 1}["Fc [N/mm]"]
-    assert not noisy["seen"] and noisy["p"] is None and math.isfinite(noisy["z2"])
+    assert noisy["verdict"] == "a change inside the scatter" and noisy["p"] is None and math.isfinite(noisy["z2"])
     missing = [r for r in mod.resolution_convergence(records(1.0, with_fine=False)) if r["name"] == "Fc [N/mm]"]
     assert all(mod._order_cell(r) == "t_u/15 to run" for r in missing)
     assert "| 1 | Fc [N/mm] | 700.0 | 400.0 | 344.4 |" in "\n".join(mod._resolution_lines(records(1.0)))
 
+    def verdict(fine, drop=()):                          # case 1's Fc with t_u/15's run at ``fine``
+        res = records(1.0)
+        res["runs"]["case 1 n_tu 15"] = rec(fine, 15.0)
+        for k in drop:
+            del res["runs"][k]
+        r = next(r for r in mod.resolution_convergence(res) if r["case"] == 1 and r["name"] == "Fc [N/mm]")
+        return mod._order_cell(r)
+    assert verdict(500.0) == "not monotone"                # down by 300, then up by 100: beyond the scatter
+    assert verdict(200.0) == "no convergence seen"         # 700 -> 400 -> 200: shrinks too slowly for any p > 0
+    assert verdict(344.4, drop=("case 1",)) == "t_u/5 or t_u/10 not recorded"
+    assert verdict(344.4, drop=mod.SCATTER_T5) == "scatter not measured"
+
 
 def test_thermal_cutting_sweep_takes_a_failed_case_again_in_the_same_call(tmp_path, monkeypatch, capsys):
     """thermal_cutting.sweep: a case that fails in this call is retried in it (retry_jobs: 'case 16 pfem' with the
-    Bossak rule), where a failure that was recorded before the call is not; the retry's record is stored."""
+    Bossak rule), also one run again by --redo that fails again; a failure recorded before the call and not run in
+    it is not, nor one that another sweep on the same file records meanwhile ('case 1 pfem', while 'case 1' runs
+    here); the retry's record is stored."""
     import argparse
     mod = _script("thermal_cutting")
     calls = []
+    runs = mod.store(tmp_path / "sweep.json")
 
     def fake_run(key, options, numerics, quick):
         calls.append(key)
+        if key == "case 1":                                   # another sweep on the file records a failure
+            runs.commit("case 1 pfem", dict(key="case 1 pfem", status="failed: elsewhere", options={}, metrics={}))
         status = "failed: Newton stalled" if key in ("case 16 pfem", "case 17 pfem") else "ok"
         return key, dict(key=key, status=status, options=options, metrics={}, wall_time_s=1.0)
 
     monkeypatch.setattr(mod.study, "execute", lambda fn, tasks, jobs, scheduler: (fake_run(*a) for a in tasks.values()))
-    runs = mod.store(tmp_path / "sweep.json")
-    runs.commit("case 17 pfem", dict(key="case 17 pfem", status="failed: before", options={}, metrics={}))
-    args = argparse.Namespace(study=None, redo=(), jobs=1, scheduler=None, quick=False)
-    todo = mod.jobs(("pfem",))
-    ran = mod.sweep(runs, {k: todo[k] for k in ("case 16 pfem", "case 15 pfem")}, args)
-    retry = "case 16 pfem n_tu 10" + mod.BOSSAK
-    assert calls == ["case 16 pfem", "case 15 pfem", retry] and ran == calls
-    assert runs.records()[retry]["status"] == "ok" and runs.records()[retry]["options"]["bossak"] == mod.BOSSAK_ALPHA
-    assert "retrying what failed: " + retry in capsys.readouterr().out
+    for k in ("case 17 pfem", "case 12 pfem"):
+        runs.commit(k, dict(key=k, status="failed: before", options={}, metrics={}))
+    todo = mod.jobs()
+    asked = ("case 16 pfem", "case 15 pfem", "case 1", "case 17 pfem")
+    args = argparse.Namespace(study=None, redo=("case 17 pfem",), jobs=1, scheduler=None, quick=False)
+    ran = mod.sweep(runs, {k: todo[k] for k in asked}, args)
+    retries = ["case 16 pfem n_tu 10" + mod.BOSSAK, "case 17 pfem n_tu 10" + mod.BOSSAK]
+    assert calls == list(asked) + retries and ran == calls
+    rec = runs.records()[retries[0]]
+    assert rec["status"] == "ok" and rec["options"]["bossak"] == mod.BOSSAK_ALPHA
+    assert "retrying what failed: " + ", ".join(retries) in capsys.readouterr().out

@@ -1,0 +1,132 @@
+"""How much plastic strain the chip carries against what its thickness implies (issues 22 and 24): for each run folder
+of benchmarks/thermal_cutting.py's t_u/10 cuts (SPH and PFEM), from its last snapshot, the mean effective plastic
+strain of the chip's body against the strain of Merchant's thin shear plane for the chip thickness the run itself
+measured (``chip_thickness_mm`` of its summary):
+
+    r = t_u / t_c,   tan(phi) = r cos(gamma) / (1 - r sin(gamma)),   shear = cos(gamma) / (sin(phi) cos(phi - gamma)),
+    eps_Merchant = shear / sqrt(3)                                        (von Mises equivalent of simple shear)
+
+(Merchant 1945; e.g. Shaw, Metal Cutting Principles, 2nd ed., Ch. 3). gamma is the rake angle (10 deg). Continuity
+alone fixes it: material that enters the chip at v_c and leaves at v_c t_u / t_c has been sheared by about that much,
+in a thin primary zone or a wide one; the secondary zone at the rake face adds to it. The chip's body: the
+workpiece rows between 1.5 and 3 t_u along the rake face and between 25 and 75 % of t_c from the face (away from the
+secondary zone and the free surface): past the primary shear plane (which meets n = 0.75 t_c within 0.3 t_u of the
+edge for shear angles of 10-45 deg), and made after the cut's start (material 3 t_u along left the shear plane
+3 t_c / v_c ago, 1.1 ms in case 1 of its 1.6; farther along, the chip holds the start's transient), in the rake-face
+frame of :func:`refsph.scenes.thermal_cutting.rake_frame`; also the rows within 10 % of t_c of the face (the
+secondary zone). Their mean temperature too. Read from the run folders (made by the sweep; not in git), kept in
+chip_strain.json (a key whose folder is gone keeps its earlier row) and tabulated in chip_strain_report.md.
+
+    python benchmarks/chip_strain.py [--runs DIR ...]   # read the folders, write the JSON and the page
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import sys
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))      # benchmarks/study.py, however this file is loaded
+import study  # noqa: E402
+
+study.pin_threads()
+
+import numpy as np  # noqa: E402
+
+import thermal_cutting as tc  # noqa: E402
+
+OUT_JSON = Path(__file__).resolve().parent / "chip_strain.json"
+OUT_MD = Path(__file__).resolve().parent / "chip_strain_report.md"
+ALONG = (1.5, 3.0)          # the chip's body: from 1.5 to 3 t_u along the rake face ...
+ACROSS = (0.25, 0.75)       # ... and from 25 to 75 % of the chip thickness from the face
+SECONDARY = 0.1             # the secondary zone: within 10 % of the chip thickness from the face
+
+
+def merchant_strain(tu: float, tc_: float, rake_deg: float) -> float:
+    """The equivalent plastic strain of Merchant's thin shear plane for uncut chip thickness ``tu`` and chip
+    thickness ``tc_`` (any one unit) on a tool of rake angle ``rake_deg`` (module text)."""
+    g, r = math.radians(rake_deg), tu / tc_
+    phi = math.atan(r * math.cos(g) / (1.0 - r * math.sin(g)))
+    return math.cos(g) / (math.sin(phi) * math.cos(phi - g)) / math.sqrt(3.0)
+
+
+def body_means(u, n, eps_p, T, tu: float, tc_: float) -> dict:
+    """Mean eps_p and T of the rows of the chip's body and of its secondary zone (module text); u, n [m] in the
+    rake-face frame, tu, tc_ [m]."""
+    along = (u >= ALONG[0] * tu) & (u < ALONG[1] * tu)
+    body = along & (n >= ACROSS[0] * tc_) & (n < ACROSS[1] * tc_)
+    face = along & (n >= 0.0) & (n < SECONDARY * tc_)
+    out = dict(n_body=int(body.sum()), n_face=int(face.sum()))
+    for name, sel in (("body", body), ("face", face)):
+        out[f"eps_{name}"] = float(eps_p[sel].mean()) if sel.any() else math.nan
+        out[f"T_{name}_K"] = float(T[sel].mean()) if sel.any() else math.nan
+    return out
+
+
+def row(folder: Path) -> dict | None:
+    """The chip's strain of one finished run folder (None without a summary, a good status or a snapshot)."""
+    from refsph.io import load_snapshot
+    from refsph.scenes.thermal_cutting import RAKE_DEG, rake_frame
+    path = folder / "summary.json"
+    if not path.exists():
+        return None
+    s = json.loads(path.read_text())
+    if s.get("status") != "ok" or not s.get("snapshots"):
+        return None
+    info, m = s["scene_info"], s["metrics"]
+    z = load_snapshot(folder / "snapshots" / s["snapshots"][-1])
+    n_work = len(z["x"]) if s["method"] == "pfem" else info["n_work"]
+    u, n = rake_frame(z["x"][:n_work], float(z["t"]), info)
+    tu, tc_ = info["tu_m"], 1e-3 * m["chip_thickness_mm"]
+    eps_m = merchant_strain(tu, tc_, RAKE_DEG)
+    out = dict(method=s["method"], tu_mm=1e3 * tu, chip_mm=m["chip_thickness_mm"], eps_merchant=eps_m,
+               **body_means(u, n, z["eps_p"][:n_work], z["T"][:n_work], tu, tc_))
+    out["body_over_merchant"] = out["eps_body"] / eps_m
+    return out
+
+
+def report(rows: dict) -> str:
+    f = study.fmt
+    lines = ["# The chip's plastic strain against its thickness", "",
+             "Made by `python benchmarks/chip_strain.py` from the sweep's run folders (module text): the mean "
+             f"effective plastic strain of the chip's body ({ALONG[0]:g}-{ALONG[1]:g} t_u along the rake face, "
+             f"{100 * ACROSS[0]:g}-{100 * ACROSS[1]:g} % of the chip thickness t_c from it) in the run's last "
+             "snapshot, against Merchant's thin-shear-plane strain for the t_c the run measured; the secondary "
+             f"zone: within {100 * SECONDARY:g} % of t_c of the face.", "",
+             "| run | method | t_u [mm] | t_c [mm] | Merchant eps | body eps | body / Merchant | body T [K] | "
+             "secondary-zone eps | its T [K] | rows (body, zone) |", "|---" * 11 + "|"]
+    for key, r in rows.items():
+        lines.append(f"| {key} | {r['method']} | {r['tu_mm']:.2f} | {r['chip_mm']:.3f} | {f(r['eps_merchant'], '.2f')} "
+                     f"| {f(r['eps_body'], '.2f')} | {f(r['body_over_merchant'], '.2f')} | {f(r['T_body_K'], '.0f')} "
+                     f"| {f(r['eps_face'], '.2f')} | {f(r['T_face_K'], '.0f')} | {r['n_body']}, {r['n_face']} |")
+    for method in sorted({r["method"] for r in rows.values()}):
+        x = [r["body_over_merchant"] for r in rows.values() if r["method"] == method
+             and math.isfinite(r["body_over_merchant"])]
+        if x:
+            lines.append(f"\n{method}: body / Merchant {np.mean(x):.2f} on average, {min(x):.2f}-{max(x):.2f} "
+                         f"({len(x)} runs).")
+    return "\n".join(lines) + "\n"
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--runs", type=Path, nargs="+", default=[tc.RUNS],
+                    help="folders of the sweep's run folders, looked in in order (default runs/thermal_cutting)")
+    args = ap.parse_args(argv)
+    rows = json.loads(OUT_JSON.read_text()) if OUT_JSON.exists() else {}
+    for key, (options, _) in dict(tc.jobs(), **tc.retry_jobs(tc.load()["runs"])).items():   # retries too
+        if float(options.get("n_tu", 0.0)) != 10.0:
+            continue
+        r = next((r for r in (row(d / tc.run_folder(key).name) for d in args.runs) if r is not None), None)
+        if r is not None:
+            rows[key] = r
+    rows = dict(sorted(rows.items(), key=lambda kv: (kv[1]["method"], kv[0])))
+    OUT_JSON.write_text(json.dumps(rows, indent=1) + "\n")
+    OUT_MD.write_text(report(rows))
+    print(report(rows))
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -1,0 +1,39 @@
+"""benchmarks/chip_strain.py: Merchant's strain from the chip thickness in closed form, the chip's body picked out of
+the rake-face frame, and the page made from the committed JSON."""
+import json
+import math
+import sys
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "benchmarks"))
+
+
+def test_merchant_strain_in_closed_form():
+    import chip_strain as cs
+    assert math.isclose(cs.merchant_strain(1.0, 1.0, 0.0), 2.0 / math.sqrt(3.0))        # r = 1, no rake: phi 45 deg
+    g = math.radians(10.0)                                                              # r = 1: phi = 45 + gamma / 2
+    phi = math.pi / 4 + g / 2
+    assert math.isclose(cs.merchant_strain(0.1, 0.1, 10.0), math.cos(g) / (math.sin(phi) * math.cos(phi - g)) / 3**0.5)
+    assert cs.merchant_strain(0.1, 0.4, 10.0) > cs.merchant_strain(0.1, 0.3, 10.0)      # a thicker chip: more shear
+
+
+def test_the_chips_body_and_secondary_zone_are_picked_out():
+    import chip_strain as cs
+    tu, tc = 1e-4, 3e-4
+    u, n = np.meshgrid(np.linspace(0.0, 8 * tu, 161), np.linspace(-tc, 2 * tc, 121))
+    u, n = u.ravel(), n.ravel()
+    body = (u >= 1.5 * tu) & (u < 3 * tu) & (n >= 0.25 * tc) & (n < 0.75 * tc)
+    face = (u >= 1.5 * tu) & (u < 3 * tu) & (n >= 0) & (n < 0.1 * tc)
+    eps = np.where(body, 1.0, np.where(face, 3.0, 7.0))
+    out = cs.body_means(u, n, eps, 300.0 + 100.0 * eps, tu, tc)
+    assert out["eps_body"] == 1.0 and out["eps_face"] == 3.0 and out["T_body_K"] == 400.0
+    assert out["n_body"] == body.sum() > 0 and out["n_face"] == face.sum() > 0
+
+
+def test_page_is_made_from_the_json():
+    import chip_strain as cs
+    rows = json.loads((ROOT / "benchmarks" / "chip_strain.json").read_text())
+    assert cs.report(rows) == (ROOT / "benchmarks" / "chip_strain_report.md").read_text()

@@ -14,8 +14,10 @@ secondary zone and the free surface): past the primary shear plane (which meets 
 edge for shear angles of 10-45 deg), and made after the cut's start (material 3 t_u along left the shear plane
 3 t_c / v_c ago, 1.1 ms in case 1 of its 1.6; farther along, the chip holds the start's transient), in the rake-face
 frame of :func:`refsph.scenes.thermal_cutting.rake_frame`; also the rows within 10 % of t_c of the face (the
-secondary zone). Their mean temperature too. Read from the run folders (made by the sweep; not in git), kept in
-chip_strain.json (a key whose folder is gone keeps its earlier row) and tabulated in chip_strain_report.md.
+secondary zone). Their mean temperature too. For SPH runs also how the body's particles crowd (:func:`compaction`:
+neighbours within 1.5 dx now and at the start, the area ratio of their starting neighbourhoods). Read from the run
+folders (made by the sweep; not in git), kept in chip_strain.json (a key whose folder is gone keeps its earlier row)
+and tabulated in chip_strain_report.md.
 
     python benchmarks/chip_strain.py [--runs DIR ...]   # read the folders, write the JSON and the page
 """
@@ -64,6 +66,25 @@ def body_means(u, n, eps_p, T, tu: float, tc_: float) -> dict:
     return out
 
 
+def compaction(X0: np.ndarray, x: np.ndarray, rows: np.ndarray, dx: float) -> dict:
+    """How the SPH chip's particles crowd: for the particles ``rows`` (indices into X0, x: the positions at the start
+    and now), the mean number of others within 1.5 dx now and at the start, and the median area ratio J of the
+    affine map that best carries each one's starting neighbours (within 2.1 dx at the start) to where they are now,
+    F = (sum dx (x) dX) (sum dX (x) dX)^-1. A material that keeps its volume has J = 1 and its particles keep their
+    number of neighbours; J < 1 with more neighbours: particles crowd into each other's room, where the deformation
+    gradient of Eq. (18) on a reference configuration does not look."""
+    from scipy.spatial import cKDTree
+    start, now = cKDTree(X0), cKDTree(x)
+    J = []
+    for i in rows:
+        nb = [j for j in start.query_ball_point(X0[i], 2.1 * dx) if j != i]
+        dX, dx_ = X0[nb] - X0[i], x[nb] - x[i]
+        J.append(np.linalg.det((dx_.T @ dX) @ np.linalg.inv(dX.T @ dX)))
+    count = lambda tree, pts: float(np.mean([len(tree.query_ball_point(p, 1.5 * dx)) - 1 for p in pts]))  # noqa: E731
+    return dict(neighbours_now=count(now, x[rows]), neighbours_start=count(start, X0[rows]),
+                area_ratio=float(np.median(J)) if J else math.nan)
+
+
 def row(folder: Path) -> dict | None:
     """The chip's strain of one finished run folder (None without a summary, a good status or a snapshot)."""
     from refsph.io import load_snapshot
@@ -83,6 +104,12 @@ def row(folder: Path) -> dict | None:
     out = dict(method=s["method"], tu_mm=1e3 * tu, chip_mm=m["chip_thickness_mm"], eps_merchant=eps_m,
                **body_means(u, n, z["eps_p"][:n_work], z["T"][:n_work], tu, tc_))
     out["body_over_merchant"] = out["eps_body"] / eps_m
+    if s["method"] != "pfem":                                   # SPH particles keep their identity; PFEM nodes not
+        z0 = load_snapshot(folder / "snapshots" / s["snapshots"][0])
+        if np.array_equal(z0["id"][:n_work], z["id"][:n_work]):
+            along = (u >= ALONG[0] * tu) & (u < ALONG[1] * tu)
+            body = np.flatnonzero(along & (n >= ACROSS[0] * tc_) & (n < ACROSS[1] * tc_))
+            out.update(compaction(z0["x"][:n_work], z["x"][:n_work], body, s["dp"]))
     return out
 
 
@@ -95,17 +122,24 @@ def report(rows: dict) -> str:
              "snapshot, against Merchant's thin-shear-plane strain for the t_c the run measured; the secondary "
              f"zone: within {100 * SECONDARY:g} % of t_c of the face.", "",
              "| run | method | t_u [mm] | t_c [mm] | Merchant eps | body eps | body / Merchant | body T [K] | "
-             "secondary-zone eps | its T [K] | rows (body, zone) |", "|---" * 11 + "|"]
+             "secondary-zone eps | its T [K] | rows (body, zone) | neighbours now / start | area ratio J |",
+             "|---" * 13 + "|"]
     for key, r in rows.items():
         lines.append(f"| {key} | {r['method']} | {r['tu_mm']:.2f} | {r['chip_mm']:.3f} | {f(r['eps_merchant'], '.2f')} "
                      f"| {f(r['eps_body'], '.2f')} | {f(r['body_over_merchant'], '.2f')} | {f(r['T_body_K'], '.0f')} "
-                     f"| {f(r['eps_face'], '.2f')} | {f(r['T_face_K'], '.0f')} | {r['n_body']}, {r['n_face']} |")
+                     f"| {f(r['eps_face'], '.2f')} | {f(r['T_face_K'], '.0f')} | {r['n_body']}, {r['n_face']} | "
+                     f"{f(r.get('neighbours_now'), '.1f')} / {f(r.get('neighbours_start'), '.1f')} | "
+                     f"{f(r.get('area_ratio'), '.2f')} |")
     for method in sorted({r["method"] for r in rows.values()}):
         x = [r["body_over_merchant"] for r in rows.values() if r["method"] == method
              and math.isfinite(r["body_over_merchant"])]
         if x:
             lines.append(f"\n{method}: body / Merchant {np.mean(x):.2f} on average, {min(x):.2f}-{max(x):.2f} "
                          f"({len(x)} runs).")
+        J = [r["area_ratio"] for r in rows.values() if r["method"] == method and "area_ratio" in r]
+        if J:
+            lines.append(f"{method}: the body's particles crowd, area ratio J {min(J):.2f}-{max(J):.2f} (a material "
+                         "that keeps its volume: 1; neighbours within 1.5 dx in the table).")
     return "\n".join(lines) + "\n"
 
 

@@ -37,3 +37,18 @@ def test_page_is_made_from_the_json():
     import chip_strain as cs
     rows = json.loads((ROOT / "benchmarks" / "chip_strain.json").read_text())
     assert cs.report(rows) == (ROOT / "benchmarks" / "chip_strain_report.md").read_text()
+
+
+def test_compaction_of_a_lattice_squeezed_to_half_its_area():
+    """A square lattice squeezed to half its width in x: every neighbourhood's area ratio is 0.5 and the particles
+    have more neighbours within 1.5 dx; a lattice moved rigidly keeps J = 1 and its neighbour count."""
+    import chip_strain as cs
+    dx = 1.0
+    g = np.arange(12) * dx
+    X0 = np.stack(np.meshgrid(g, g), axis=-1).reshape(-1, 2)
+    inner = np.flatnonzero(np.all((X0 > 3) & (X0 < 8), axis=1))
+    squeezed = cs.compaction(X0, X0 * [0.5, 1.0], inner, dx)
+    assert np.isclose(squeezed["area_ratio"], 0.5) and squeezed["neighbours_now"] > squeezed["neighbours_start"]
+    c, s = np.cos(0.3), np.sin(0.3)
+    moved = cs.compaction(X0, X0 @ np.array([[c, s], [-s, c]]) + 5.0, inner, dx)
+    assert np.isclose(moved["area_ratio"], 1.0) and np.isclose(moved["neighbours_now"], moved["neighbours_start"])

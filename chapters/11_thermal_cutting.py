@@ -331,7 +331,7 @@ display(Markdown(split_page.split("\n\n", 1)[1]))             # the page without
 #   secondary shear zone; the resolution table and the drift columns say which digits hold.
 # * **The SPH chip is too cold for its shape.** Continuity says a chip $t_c$ thick cut from $t_u$ has been sheared
 #   by $\cos\gamma / (\sin\phi \cos(\phi-\gamma))$ (Merchant); the TLSPH chip's body carries 0.36–0.53 of that
-#   plastic strain (the PFEM's 0.84–1.11; `benchmarks/chip_strain_report.md`). At $t_u/10$ its particles also crowd
+#   plastic strain (the PFEM's 0.84–1.11 mostly; `chip_strain_report.md`). At $t_u/10$ its particles also crowd
 #   (area 0.58–0.71 of their start, unseen by Eq. (18)), at $t_u/5$ not, with the same deficit: a candidate cause
 #   of the cold steel rake face whose mechanism is still open.
 #

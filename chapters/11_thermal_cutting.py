@@ -294,6 +294,7 @@ page = (repository_root() / "benchmarks" / "thermal_cutting_report.md").read_tex
 for title in ("## Mass scaling", "## The mass scale", "## Run-to-run scatter at t_u/5", "## Run-to-run scatter at s/2",
               "## Resolution", "## Tool and workpiece", "## Contact and heat"):
     heading, _, body = (title[3:] + page.split(title)[1].split("\n## ")[0]).partition("\n")
+    body = "\n".join(line for line in body.split("\n") if not line.startswith("!["))   # the page's figures: there
     display(Markdown(f"**{heading}**\n{body}"))
 
 # %% [markdown]

@@ -23,7 +23,6 @@ and tabulated in chip_strain_report.md.
 """
 from __future__ import annotations
 
-import argparse
 import json
 import math
 import sys
@@ -144,17 +143,9 @@ def report(rows: dict) -> str:
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--runs", type=Path, nargs="+", default=[tc.RUNS],
-                    help="folders of the sweep's run folders, looked in in order (default runs/thermal_cutting)")
-    args = ap.parse_args(argv)
+    args = tc.folders_parser(__doc__).parse_args(argv)
     rows = json.loads(OUT_JSON.read_text()) if OUT_JSON.exists() else {}
-    for key, (options, _) in dict(tc.jobs(), **tc.retry_jobs(tc.load()["runs"])).items():   # retries too
-        if float(options.get("n_tu", 0.0)) != 10.0:
-            continue
-        r = next((r for r in (row(d / tc.run_folder(key).name) for d in args.runs) if r is not None), None)
-        if r is not None:
-            rows[key] = r
+    rows = tc.folder_rows(row, args.runs, rows, lambda options, numerics: float(options.get("n_tu", 0.0)) == 10.0)
     rows = dict(sorted(rows.items(), key=lambda kv: (kv[1]["method"], kv[0])))
     OUT_JSON.write_text(json.dumps(rows, indent=1) + "\n")
     OUT_MD.write_text(report(rows))

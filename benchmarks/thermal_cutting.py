@@ -42,6 +42,7 @@ The dask path needs ``pip install -e '.[dask]'`` on the client and every worker 
 """
 from __future__ import annotations
 
+import argparse
 import json
 import math
 import sys
@@ -1116,6 +1117,27 @@ def resolution_figure(res: dict, plt) -> None:
     fig.suptitle("Resolution: t_u/5, t_u/10, t_u/15 (courant 0.15), bars: run-to-run standard deviation; "
                  "star: Richardson limit where an order is seen", fontsize=9)
     study.save_figure(fig, FIG / "11_thermal_cutting_resolution.png", dpi=100)
+
+
+def folder_rows(row, folders, rows: dict, wanted) -> dict:
+    """``rows`` updated with ``row(folder)`` of each job (``jobs()`` and the retries) for which ``wanted(options,
+    numerics)`` holds and whose run folder, looked for in ``folders`` in order, gives a row (not None): what the
+    studies that read the sweep's run folders (pfem_ringing.py, chip_strain.py) share. A key whose folder is gone
+    keeps its earlier row."""
+    for key, (options, numerics) in dict(jobs(), **retry_jobs(load()["runs"])).items():
+        if wanted(options, numerics):
+            r = next((r for r in (row(d / run_folder(key).name) for d in folders) if r is not None), None)
+            if r is not None:
+                rows[key] = r
+    return rows
+
+
+def folders_parser(doc: str) -> argparse.ArgumentParser:
+    """The command line of a study that reads the sweep's run folders: ``--runs DIR ...``."""
+    ap = argparse.ArgumentParser(description=doc.split("\n\n")[0])
+    ap.add_argument("--runs", type=Path, nargs="+", default=[RUNS],
+                    help="folders of the sweep's run folders, looked in in order (default runs/thermal_cutting)")
+    return ap
 
 
 def run_folder(key: str, quick: bool = False) -> Path:

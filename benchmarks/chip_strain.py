@@ -143,14 +143,8 @@ def report(rows: dict) -> str:
 
 
 def main(argv=None) -> int:
-    args = tc.folders_parser(__doc__).parse_args(argv)
-    rows = json.loads(OUT_JSON.read_text()) if OUT_JSON.exists() else {}
-    rows = tc.folder_rows(row, args.runs, rows, lambda options, numerics: float(options.get("n_tu", 0.0)) == 10.0)
-    rows = dict(sorted(rows.items(), key=lambda kv: (kv[1]["method"], kv[0])))
-    OUT_JSON.write_text(json.dumps(rows, indent=1) + "\n")
-    OUT_MD.write_text(report(rows))
-    print(report(rows))
-    return 0
+    return tc.folder_study(argv, __doc__, row, lambda options, numerics: float(options.get("n_tu", 0.0)) == 10.0,
+                           OUT_JSON, OUT_MD, report, sort_key=lambda kv: (kv[1]["method"], kv[0]))
 
 
 if __name__ == "__main__":

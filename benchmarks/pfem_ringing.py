@@ -64,13 +64,8 @@ def report(rows: dict) -> str:
 
 
 def main(argv=None) -> int:
-    args = tc.folders_parser(__doc__).parse_args(argv)
-    rows = json.loads(OUT_JSON.read_text()) if OUT_JSON.exists() else {}
-    rows = tc.folder_rows(row, args.runs, rows, lambda options, numerics: numerics.get("method") == "pfem")
-    OUT_JSON.write_text(json.dumps(rows, indent=1) + "\n")
-    OUT_MD.write_text(report(rows))
-    print(report(rows))
-    return 0
+    return tc.folder_study(argv, __doc__, row, lambda options, numerics: numerics.get("method") == "pfem", OUT_JSON,
+                           OUT_MD, report)
 
 
 if __name__ == "__main__":

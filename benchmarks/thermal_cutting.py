@@ -1121,9 +1121,8 @@ def resolution_figure(res: dict, plt) -> None:
 
 def folder_rows(row, folders, rows: dict, wanted) -> dict:
     """``rows`` updated with ``row(folder)`` of each job (``jobs()`` and the retries) for which ``wanted(options,
-    numerics)`` holds and whose run folder, looked for in ``folders`` in order, gives a row (not None): what the
-    studies that read the sweep's run folders (pfem_ringing.py, chip_strain.py) share. A key whose folder is gone
-    keeps its earlier row."""
+    numerics)`` holds and whose run folder, looked for in ``folders`` in order, gives a row (not None). A key whose
+    folder is gone keeps its earlier row."""
     for key, (options, numerics) in dict(jobs(), **retry_jobs(load()["runs"])).items():
         if wanted(options, numerics):
             r = next((r for r in (row(d / run_folder(key).name) for d in folders) if r is not None), None)
@@ -1132,12 +1131,21 @@ def folder_rows(row, folders, rows: dict, wanted) -> dict:
     return rows
 
 
-def folders_parser(doc: str) -> argparse.ArgumentParser:
-    """The command line of a study that reads the sweep's run folders: ``--runs DIR ...``."""
+def folder_study(argv, doc: str, row, wanted, out_json: Path, out_md: Path, page, sort_key=None) -> int:
+    """The command of a study that reads the sweep's run folders (pfem_ringing.py, chip_strain.py): ``--runs DIR
+    ...`` (default runs/thermal_cutting), its rows (:func:`folder_rows`) merged into ``out_json``, optionally sorted,
+    and ``page(rows)`` written to ``out_md`` and printed."""
     ap = argparse.ArgumentParser(description=doc.split("\n\n")[0])
     ap.add_argument("--runs", type=Path, nargs="+", default=[RUNS],
                     help="folders of the sweep's run folders, looked in in order (default runs/thermal_cutting)")
-    return ap
+    args = ap.parse_args(argv)
+    rows = folder_rows(row, args.runs, json.loads(out_json.read_text()) if out_json.exists() else {}, wanted)
+    if sort_key is not None:
+        rows = dict(sorted(rows.items(), key=sort_key))
+    out_json.write_text(json.dumps(rows, indent=1) + "\n")
+    out_md.write_text(page(rows))
+    print(page(rows))
+    return 0
 
 
 def run_folder(key: str, quick: bool = False) -> Path:

@@ -52,12 +52,16 @@ def merchant_strain(tu: float, tc_: float, rake_deg: float) -> float:
     return math.cos(g) / (math.sin(phi) * math.cos(phi - g)) / math.sqrt(3.0)
 
 
-def body_means(u, n, eps_p, T, tu: float, tc_: float) -> dict:
-    """Mean eps_p and T of the rows of the chip's body and of its secondary zone (module text); u, n [m] in the
-    rake-face frame, tu, tc_ [m]."""
+def zones(u, n, tu: float, tc_: float) -> tuple[np.ndarray, np.ndarray]:
+    """The masks of the chip's body and of its secondary zone (module text); u, n [m] in the rake-face frame, tu,
+    tc_ [m]."""
     along = (u >= ALONG[0] * tu) & (u < ALONG[1] * tu)
-    body = along & (n >= ACROSS[0] * tc_) & (n < ACROSS[1] * tc_)
-    face = along & (n >= 0.0) & (n < SECONDARY * tc_)
+    return along & (n >= ACROSS[0] * tc_) & (n < ACROSS[1] * tc_), along & (n >= 0.0) & (n < SECONDARY * tc_)
+
+
+def body_means(u, n, eps_p, T, tu: float, tc_: float) -> dict:
+    """Mean eps_p and T of the rows of the chip's body and of its secondary zone (:func:`zones`)."""
+    body, face = zones(u, n, tu, tc_)
     out = dict(n_body=int(body.sum()), n_face=int(face.sum()))
     for name, sel in (("body", body), ("face", face)):
         out[f"eps_{name}"] = float(eps_p[sel].mean()) if sel.any() else math.nan
@@ -106,8 +110,7 @@ def row(folder: Path) -> dict | None:
     if s["method"] != "pfem":                                   # SPH particles keep their identity; PFEM nodes not
         z0 = load_snapshot(folder / "snapshots" / s["snapshots"][0])
         if np.array_equal(z0["id"][:n_work], z["id"][:n_work]):
-            along = (u >= ALONG[0] * tu) & (u < ALONG[1] * tu)
-            body = np.flatnonzero(along & (n >= ACROSS[0] * tc_) & (n < ACROSS[1] * tc_))
+            body = np.flatnonzero(zones(u, n, tu, tc_)[0])
             out.update(compaction(z0["x"][:n_work], z["x"][:n_work], body, s["dp"]))
     return out
 

@@ -788,6 +788,7 @@ SCATTER_TI10 = ("case 10", "case 10 jitter 1", "case 10 jitter 2")              
 RESOLUTION_N = (5.0, 10.0, 15.0)
 RESOLUTION_KEYS = {1: ("case 1 n_tu 5 courant 0.15", "case 1", "case 1 n_tu 15"),
                    10: ("case 10 n_tu 5 courant 0.15", "case 10", "case 10 n_tu 15")}
+RESOLUTION_RUNS = tuple(k for keys in RESOLUTION_KEYS.values() for k in keys)     # the study's table, in order
 RESOLUTION_NOISE = {1: (SCATTER_T5, SCATTER_KEYS),
                     10: (("case 10 n_tu 5", "case 10 n_tu 5 jitter 1", "case 10 n_tu 5 jitter 2",
                           "case 10 n_tu 5 jitter 3"), SCATTER_TI10)}
@@ -816,7 +817,7 @@ STUDIES = (
      "at s/2 (one run) moves by more than the scatter", SCATTER_TI10, BASIC),
     ("Run-to-run scatter of Ti6Al4V at t_u/5 (case 10, the same perturbation)",
      ("case 10 n_tu 5", "case 10 n_tu 5 jitter 1", "case 10 n_tu 5 jitter 2", "case 10 n_tu 5 jitter 3"), BASIC),
-    ("Resolution (particles across t_u; at courant 0.15)", RESOLUTION_KEYS[1] + RESOLUTION_KEYS[10],
+    ("Resolution (particles across t_u; at courant 0.15)", RESOLUTION_RUNS,
      (("across t_u", "across", ".0f"), ("dx [um]", "dx_um", ".1f"), ("particles", "n_particles", "d")) + BASIC
      + (("steps", "n_steps", "d"), ("wall [s]", "wall", ".0f"))),
     ("Tool and workpiece size (the sweep: the tool 10 t_u x 6 t_u, 12 t_u left uncut at the end of the cut; the "
@@ -910,7 +911,7 @@ def _study_lines(res: dict) -> list[str]:
             if other is not None:
                 lines += ["", _difference_line(res, keys, other)]
             lines += [_single_run_line(res, k, keys) for k in SINGLES.get(keys, ())]
-        if keys == RESOLUTION_KEYS[1] + RESOLUTION_KEYS[10]:
+        if keys == RESOLUTION_RUNS:
             lines += _resolution_lines(res)
     return lines
 

@@ -23,7 +23,8 @@ t_u/10 sweep runs), ``scaling`` (s halved: cases 1 and 10), ``scatter`` (case 1 
 dx, three seeds; first at t_u/5), ``resolution`` (t_u/5 and t_u/15 for cases 1 and 10), ``timestep`` (case 10 at the
 scene's step, which fails, case 1 at Ti6Al4V's, and case 10 at t_u/5 at both), ``tool`` (the first sweep's tool 5
 t_u x 3 t_u and 4 t_u left uncut, one change at a time, at t_u/5 and t_u/10), ``contact`` (the pinball; all the
-frictional heat to the chip). Resumable twice over: a finished run is a record in
+frictional heat to the chip), ``refupdate`` (how often TLSPH's reference configuration is updated,
+:func:`reference_update_jobs`). Resumable twice over: a finished run is a record in
 ``benchmarks/thermal_cutting.json`` and is skipped; a run that was killed continues from its last checkpoint
 (``refsph run --restart``; one at every snapshot and every 10 minutes of wall time between them). A run that fails
 (non-finite state, lost chip) is a record with its status and error; it stays in the table until ``--redo`` runs it
@@ -90,13 +91,17 @@ def _s(case: int) -> float:
 
 
 STUDY_NAMES = ("cases", "coarse", "pfem", "detector", "scaling", "scatter", "resolution", "timestep", "tool",
-               "contact")
+               "contact", "refupdate")
 COURANT = 0.15                             # every run at dx <= t_u / 10: half the scene's step (module text)
 COARSE = " n_tu 5"                         # the key suffix of the 'coarse' study: all 18 cases at dx = t_u / 5
 PFEM = " pfem n_tu 5"                      # the key suffix of the 'pfem' study: the 18 cases with the PFEM at t_u / 5
 PFEM10 = " pfem"                           # ... and at t_u / 10 (the paper's resolution for t_u = 0.1 mm)
 RETRY_COURANT = 0.075                      # a case of the t_u / 10 table that failed at COURANT, again at half of it,
 RETRY = f" courant {RETRY_COURANT:g}"        # under the key 'case N' + RETRY
+REF_KEY = " ref update "                   # the 'refupdate' study's key part: TLSPH's ref_update_strain (the scene's
+REF_UPDATES = (1.5, 0.2, 0.1, 0.05, 0.02)  # 0.5) at these values at t_u/5 (reference_update_jobs) ...
+REF_UPDATE = 0.1                           # ... and at this one at t_u/10 and for the scatter
+SCENE_REF_UPDATE = 0.5                     # the scene's (refsph.scenes.thermal_cutting; a test holds them equal)
 DAMPED_GAMMA = 0.6                         # a PFEM case of the t_u / 10 table that failed with the trapezoidal rule,
 DAMPED = f" n_tu 10 gamma {DAMPED_GAMMA:g}"  # again with Newmark's damped rule, under 'case N pfem' + DAMPED
 BOSSAK_ALPHA = -0.1                        # the Bossak-Newmark rule (second order, damped) beside the damped rule:
@@ -208,9 +213,28 @@ def more_jobs() -> list[tuple[str, str, dict, dict]]:
     cases cut to the paper's 2 mm (20 t_u; the sweep's 16 t_u is 1.6 mm) on its 3 mm workpiece (TO_2MM), the
     PFEM's first."""
     pfem = dict(method="pfem")
-    out = [("pfem", key, options, pfem) for key, options in time_rule_jobs() + remesh_jobs() + pfem_resolution_jobs()]
+    out = [("refupdate", key, options, numerics) for key, (options, numerics) in reference_update_jobs().items()]
+    out += [("pfem", key, options, pfem) for key, options in time_rule_jobs() + remesh_jobs() + pfem_resolution_jobs()]
     out += [("pfem", f"case {n}{PFEM10}{TO_2MM}", to_2mm(n, n_tu=10.0), pfem) for n in TU_01]
     return out + [("cases", f"case {n}{TO_2MM}", to_2mm(n), sweep_numerics()) for n in TU_01]
+
+
+def reference_update_jobs() -> dict:
+    """{key: (options, numerics)} of the 'refupdate' study: how often TLSPH's reference configuration is updated
+    (Numerics.ref_update_strain, the largest Green-Lagrange strain |E| it lets grow; the scene's 0.5; the first paper
+    says only 'when the deviation is considerable'), at t_u/5 for cases 1 and 10 at REF_UPDATES, the run-to-run
+    scatter at REF_UPDATE (case 1, two more seeds), and cases 1 and 10 at t_u/10 at REF_UPDATE: at the scene's 0.5
+    the chip carries about half the plastic strain its thickness implies (benchmarks/chip_strain.py)."""
+    out = {}
+    for n in (1, 10):
+        for r in REF_UPDATES:
+            out[f"case {n}{COARSE}{REF_KEY}{r:g}"] = (converged(n, n_tu=5.0), dict(ref_update_strain=r))
+    for seed in (1, 2):
+        out[f"case 1{COARSE}{REF_KEY}{REF_UPDATE:g} jitter {seed}"] = (
+            converged(1, n_tu=5.0, jitter=0.01, seed=seed), dict(ref_update_strain=REF_UPDATE))
+    for n in (1, 10):
+        out[f"case {n}{REF_KEY}{REF_UPDATE:g}"] = (converged(n), sweep_numerics(ref_update_strain=REF_UPDATE))
+    return out
 
 
 def to_2mm(n: int, **more) -> dict:
@@ -755,7 +779,8 @@ def _values(r: dict) -> dict:
                wall=r.get("wall_time_s"), lost=hb.get("lost_J"),
                cpu_min=(r.get("cpu_time_s") or math.nan) / 60.0,
                made=sum(hb.get(k, math.nan) for k in ("plastic_J", "friction_J", "dissipation_J")),
-               residual=hb.get("residual_rel"))
+               residual=hb.get("residual_rel"),
+               ref_update=(r.get("numerics") or {}).get("ref_update_strain", SCENE_REF_UPDATE))
     for key, name in (("cutting_force_N_per_m", "Fc"), ("passive_force_N_per_m", "Fp")):
         out[f"{name}_drift_pct"] = 100.0 * drift.get(key, math.nan) / m.get(key, math.nan)
     for key, name in (("rake_face_temperature_K", "TRF"), ("free_chip_surface_temperature_K", "TFCS")):
@@ -785,6 +810,10 @@ SCATTER_S2 = tuple(k.replace("n_tu 5", "n_tu 5 s/2") for k in SCATTER_T5)       
 SCATTER_TI10 = ("case 10", "case 10 jitter 1", "case 10 jitter 2")                     # Ti6Al4V at t_u/10
 # the resolution study: case -> its runs at 5, 10 and 15 particles across t_u (at courant 0.15), and the scatter
 # groups that measure its run-to-run spread at t_u/5 and t_u/10 (the t_u/5 groups at the scene's courant 0.3)
+REF_SCATTER = tuple(f"case 1{COARSE}{REF_KEY}{REF_UPDATE:g}" + k[len("case 1 n_tu 5"):] for k in SCATTER_T5[:3])
+REF_RUNS = tuple(f"case {n}{COARSE}{REF_KEY}{r:g}" if r != SCENE_REF_UPDATE else f"case {n}{COARSE}"
+                 for n in (1, 10) for r in sorted(REF_UPDATES + (SCENE_REF_UPDATE,), reverse=True)) + tuple(
+    k for n in (1, 10) for k in (f"case {n}", f"case {n}{REF_KEY}{REF_UPDATE:g}"))
 RESOLUTION_N = (5.0, 10.0, 15.0)
 RESOLUTION_KEYS = {1: ("case 1 n_tu 5 courant 0.15", "case 1", "case 1 n_tu 15"),
                    10: ("case 10 n_tu 5 courant 0.15", "case 10", "case 10 n_tu 15")}
@@ -870,6 +899,15 @@ STUDIES = (
      "are the sweep's records, made by earlier versions of the solver (the PFEM's path moves its forces by up to 12 %)",
      tuple(k for n, suffix, _ in REMESH_RUNS for k in (f"case {n}{suffix}", f"case {n}{suffix}{REMESH}")),
      BASIC + (("steps", "n_steps", "d"), ("wall [s]", "wall", ".0f"))),
+    ("How often TLSPH's reference configuration is updated (Numerics.ref_update_strain: the largest Green-Lagrange "
+     "strain |E| a particle may reach before X <- x; the scene's 0.5; the first paper: 'when the deviation is "
+     "considerable'): t_u/5 for cases 1 and 10, then t_u/10 at 0.1; read with the scatter tables at t_u/5 and t_u/10 "
+     "and the chip's plastic strain in benchmarks/chip_strain_report.md",
+     REF_RUNS, (("ref update", "ref_update", ".2f"),) + BASIC
+     + (("plastic heat [% of work]", "plastic_of_work", ".1f"),
+        ("viscosity + damping heat [% of work]", "dissipation_of_work", ".1f"), ("wall [s]", "wall", ".0f"))),
+    (f"Run-to-run scatter at ref update {REF_UPDATE:g} (t_u/5, case 1, the same perturbation as at the scene's 0.5)",
+     REF_SCATTER, BASIC),
     ("Contact and heat split (case 1: penalty contact, half the frictional heat into the chip)",
      ("case 1", "case 1 pinball", "case 1 all friction heat to the chip"),
      BASIC + (("friction heat [% of work]", "friction_of_work", ".1f"),
@@ -1012,7 +1050,8 @@ def _change_cell(d: float, z: float = math.nan) -> str:
     return f"{d:+.1f} %" + (f" ({z:+.1f})" if math.isfinite(z) else "")
 
 
-COMPARED = {SCATTER_S2: SCATTER_T5}         # a scatter group -> the group it is compared with (_difference_line)
+# a scatter group -> the group it is compared with (_difference_line)
+COMPARED = {SCATTER_S2: SCATTER_T5, REF_SCATTER: SCATTER_T5}
 SINGLES = {SCATTER_KEYS: ("case 1 s/2", "case 1 heat every 8"), SCATTER_TI10: ("case 10 s/2",)}   # one run each
 
 

@@ -473,3 +473,27 @@ def test_thermal_cutting_sweep_takes_a_failed_case_again_in_the_same_call(tmp_pa
     rec = runs.records()[retries[0]]
     assert rec["status"] == "ok" and rec["options"]["bossak"] == mod.BOSSAK_ALPHA
     assert "retrying what failed: " + ", ".join(retries) in capsys.readouterr().out
+
+
+def test_thermal_cutting_reference_update_study_runs_what_its_keys_say():
+    """The 'refupdate' study (reference_update_jobs): every key's ref_update_strain is the number in the key, the
+    rest of its run the sweep's of the same resolution; the key without 'ref update' in its table is the scene's own
+    value (SCENE_REF_UPDATE, read from the scene), and the table's column says which."""
+    mod = _script("thermal_cutting")
+    from refsph.scenes import get_scene
+    assert get_scene("thermal_cutting").setup(case=1, quick=True).numerics.ref_update_strain == mod.SCENE_REF_UPDATE
+    todo = mod.reference_update_jobs()
+    assert set(todo) <= set(mod.jobs(studies=("refupdate",))) and set(mod.REF_SCATTER) <= set(todo)
+    for key, (options, numerics) in todo.items():
+        r = float(key.split(mod.REF_KEY)[1].split()[0])
+        assert numerics["ref_update_strain"] == r
+        n_tu = 5.0 if mod.COARSE in key else mod.N_TU
+        assert options["n_tu"] == n_tu and numerics == mod.sweep_numerics(n_tu, ref_update_strain=r)
+        assert ("jitter" in key) == ("jitter" in options)
+    assert [k for k in mod.REF_RUNS if mod.REF_KEY not in k] == ["case 1 n_tu 5", "case 10 n_tu 5", "case 1", "case 10"]
+    runs = json.loads((ROOT / "benchmarks" / "thermal_cutting.json").read_text())["runs"]
+    ok = runs["case 1 n_tu 5"]
+    res = dict(runs={"case 1 n_tu 5": ok,
+                     "case 1 n_tu 5 ref update 0.1": dict(ok, numerics={"ref_update_strain": 0.1})})
+    page = "\n".join(mod._study_lines(res))
+    assert "| case 1 n_tu 5 | 0.50 |" in page and "| case 1 n_tu 5 ref update 0.1 | 0.10 |" in page

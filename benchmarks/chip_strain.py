@@ -1,7 +1,7 @@
 """How much plastic strain the chip carries against what its thickness implies (issues 22 and 24): for each run folder
-of benchmarks/thermal_cutting.py's t_u/10 cuts (SPH and PFEM), from its last snapshot, the mean effective plastic
-strain of the chip's body against the strain of Merchant's thin shear plane for the chip thickness the run itself
-measured (``chip_thickness_mm`` of its summary):
+of benchmarks/thermal_cutting.py's t_u/10 cuts (SPH and PFEM) and of its 'refupdate' study (:func:`wanted`), from its
+last snapshot, the mean effective plastic strain of the chip's body against the strain of Merchant's thin shear
+plane for the chip thickness the run itself measured (``chip_thickness_mm`` of its summary):
 
     r = t_u / t_c,   tan(phi) = r cos(gamma) / (1 - r sin(gamma)),   shear = cos(gamma) / (sin(phi) cos(phi - gamma)),
     eps_Merchant = shear / sqrt(3)                                        (von Mises equivalent of simple shear)
@@ -107,6 +107,8 @@ def row(folder: Path) -> dict | None:
     out = dict(method=s["method"], tu_mm=1e3 * tu, chip_mm=m["chip_thickness_mm"], eps_merchant=eps_m,
                **body_means(u, n, z["eps_p"][:n_work], z["T"][:n_work], tu, tc_))
     out["body_over_merchant"] = out["eps_body"] / eps_m
+    out["ref_update"] = s.get("numerics", {}).get("ref_update_strain") if s["method"] == "tlsph" else None
+    out["across"] = tu / s["dp"]
     if s["method"] != "pfem":                                   # SPH particles keep their identity; PFEM nodes not
         z0 = load_snapshot(folder / "snapshots" / s["snapshots"][0])
         if np.array_equal(z0["id"][:n_work], z["id"][:n_work]):
@@ -123,30 +125,46 @@ def report(rows: dict) -> str:
              f"{100 * ACROSS[0]:g}-{100 * ACROSS[1]:g} % of the chip thickness t_c from it) in the run's last "
              "snapshot, against Merchant's thin-shear-plane strain for the t_c the run measured; the secondary "
              f"zone: within {100 * SECONDARY:g} % of t_c of the face.", "",
-             "| run | method | t_u [mm] | t_c [mm] | Merchant eps | body eps | body / Merchant | body T [K] | "
-             "secondary-zone eps | its T [K] | rows (body, zone) | neighbours now / start | area ratio J |",
-             "|---" * 13 + "|"]
+             "| run | method | ref update | t_u [mm] | t_c [mm] | Merchant eps | body eps | body / Merchant | "
+             "body T [K] | secondary-zone eps | its T [K] | rows (body, zone) | neighbours now / start | "
+             "area ratio J |",
+             "|---" * 14 + "|"]
     for key, r in rows.items():
-        lines.append(f"| {key} | {r['method']} | {r['tu_mm']:.2f} | {r['chip_mm']:.3f} | {f(r['eps_merchant'], '.2f')} "
+        lines.append(f"| {key} | {r['method']} | {f(r.get('ref_update'), '.2f')} | {r['tu_mm']:.2f} "
+                     f"| {r['chip_mm']:.3f} | {f(r['eps_merchant'], '.2f')} "
                      f"| {f(r['eps_body'], '.2f')} | {f(r['body_over_merchant'], '.2f')} | {f(r['T_body_K'], '.0f')} "
                      f"| {f(r['eps_face'], '.2f')} | {f(r['T_face_K'], '.0f')} | {r['n_body']}, {r['n_face']} | "
                      f"{f(r.get('neighbours_now'), '.1f')} / {f(r.get('neighbours_start'), '.1f')} | "
                      f"{f(r.get('area_ratio'), '.2f')} |")
-    for method in sorted({r["method"] for r in rows.values()}):
-        x = [r["body_over_merchant"] for r in rows.values() if r["method"] == method
-             and math.isfinite(r["body_over_merchant"])]
+    for group in sorted({_group(r) for r in rows.values()}):       # method, reference update, particles across t_u
+        sel = [r for r in rows.values() if _group(r) == group]
+        method, ref, across = group
+        name = f"{method} (ref update {ref:g}, t_u/{across})" if ref else f"{method} (t_u/{across})"
+        x = [r["body_over_merchant"] for r in sel if math.isfinite(r["body_over_merchant"])]
         if x:
-            lines.append(f"\n{method}: body / Merchant {np.mean(x):.2f} on average, {min(x):.2f}-{max(x):.2f} "
+            lines.append(f"\n{name}: body / Merchant {np.mean(x):.2f} on average, {min(x):.2f}-{max(x):.2f} "
                          f"({len(x)} runs).")
-        J = [r["area_ratio"] for r in rows.values() if r["method"] == method and "area_ratio" in r]
+        J = [r["area_ratio"] for r in sel if "area_ratio" in r]
         if J:
-            lines.append(f"{method}: the body's particles crowd, area ratio J {min(J):.2f}-{max(J):.2f} (a material "
+            lines.append(f"{name}: the body's particles crowd, area ratio J {min(J):.2f}-{max(J):.2f} (a material "
                          "that keeps its volume: 1; neighbours within 1.5 dx in the table).")
     return "\n".join(lines) + "\n"
 
 
+def _group(r: dict) -> tuple:
+    """(method, TLSPH's ref_update_strain or 0, particles across t_u) of a row (rows kept from before these were
+    recorded: t_u/10, the only resolution read then)."""
+    return r["method"], r.get("ref_update") or 0.0, int(round(r.get("across", 10.0)))
+
+
+def wanted(options: dict, numerics: dict) -> bool:
+    """The runs read: the sweep's at t_u/10, and the 'refupdate' study's (TLSPH's reference updated more or less
+    often, at t_u/5 too)."""
+    return float(options.get("n_tu", 0.0)) == 10.0 or "ref_update_strain" in numerics
+
+
 def main(argv=None) -> int:
-    return tc.folder_study(argv, __doc__, row, lambda options, numerics: float(options.get("n_tu", 0.0)) == 10.0,
+    return tc.folder_study(argv, __doc__, row, wanted,
                            OUT_JSON, OUT_MD, report, sort_key=lambda kv: (kv[1]["method"], kv[0]))
 
 

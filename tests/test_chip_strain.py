@@ -52,3 +52,18 @@ def test_compaction_of_a_lattice_squeezed_to_half_its_area():
     c, s = np.cos(0.3), np.sin(0.3)
     moved = cs.compaction(X0, X0 @ np.array([[c, s], [-s, c]]) + 5.0, inner, dx)
     assert np.isclose(moved["area_ratio"], 1.0) and np.isclose(moved["neighbours_now"], moved["neighbours_start"])
+
+
+def test_the_reference_update_runs_are_read_and_summarised_apart():
+    """wanted: the sweep's t_u/10 runs and the 'refupdate' study's (any resolution); the page's summary lines keep
+    each method, reference update and resolution apart."""
+    import chip_strain as cs
+    assert cs.wanted(dict(n_tu=10.0), {}) and cs.wanted(dict(n_tu=5.0), dict(ref_update_strain=0.1))
+    assert not cs.wanted(dict(n_tu=5.0), {}) and not cs.wanted(dict(n_tu=15.0), dict(courant=0.15))
+    base = dict(method="tlsph", tu_mm=0.1, chip_mm=0.3, eps_merchant=2.0, eps_body=1.0, body_over_merchant=0.5,
+                T_body_K=600.0, eps_face=1.5, T_face_K=650.0, n_body=10, n_face=2)
+    rows = {"a": dict(base, ref_update=0.5, across=10.0), "b": dict(base, ref_update=0.1, across=5.0,
+                                                                      body_over_merchant=0.9)}
+    page = cs.report(rows)
+    assert "tlsph (ref update 0.5, t_u/10): body / Merchant 0.50" in page
+    assert "tlsph (ref update 0.1, t_u/5): body / Merchant 0.90" in page

@@ -1368,10 +1368,10 @@ def sweep(runs: study.RunStore, todo: dict, args) -> list:
 def _sweep_round(runs: study.RunStore, todo: dict, args) -> list:
     """One pass of ``sweep`` over ``todo``: the keys that ran."""
     stale = [k for k, r in runs.records().items() if k in todo and k not in args.redo
-             and not _same_options(r.get("options", {}), todo[k][0])]
+             and (not _same_options(r.get("options", {}), todo[k][0]) or r.get("numerics", {}) != todo[k][1])]
     if stale:
-        raise SystemExit(f"error: the records of {stale} were made with other scene options than jobs() gives "
-                         "now; --redo them (their old runs are kept until a good one replaces them)")
+        raise SystemExit(f"error: the records of {stale} were made with other scene options or numerics than "
+                         "jobs() gives now; --redo them (their old runs are kept until a good one replaces them)")
     todo = {k: todo[k] for k in runs.pending(todo, redo=args.redo)}
     print(f"{len(todo)} runs to do ({len(runs.records())} recorded)", flush=True)
     t0 = time.perf_counter()

@@ -497,3 +497,18 @@ def test_thermal_cutting_reference_update_study_runs_what_its_keys_say():
                      "case 1 n_tu 5 ref update 0.1": dict(ok, numerics={"ref_update_strain": 0.1})})
     page = "\n".join(mod._study_lines(res))
     assert "| case 1 n_tu 5 | 0.50 |" in page and "| case 1 n_tu 5 ref update 0.1 | 0.10 |" in page
+
+
+def test_thermal_cutting_refuses_to_skip_a_record_made_with_other_numerics(tmp_path):
+    """_sweep_round: a key recorded with other scene options or other numerics than its job now asks for is not
+    skipped as done, and not run over either: the sweep stops and names it (--redo runs it again)."""
+    from types import SimpleNamespace
+    mod = _script("thermal_cutting")
+    runs = mod.study.RunStore(tmp_path / "tc.json")
+    options, numerics = mod.converged(1, n_tu=5.0), dict(ref_update_strain=0.1)
+    runs.commit("k", dict(key="k", status="ok", options=options, numerics=numerics, metrics={}))
+    args = SimpleNamespace(redo=[], jobs=1, scheduler=None, quick=False)
+    for asked in ((options, dict(ref_update_strain=0.5)), (dict(options, n_tu=10.0), numerics)):
+        with pytest.raises(SystemExit, match="other scene options or numerics"):
+            mod._sweep_round(runs, {"k": asked}, args)
+    assert mod._sweep_round(runs, {"k": (options, numerics)}, args) == []          # the same: recorded, skipped

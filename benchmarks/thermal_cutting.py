@@ -951,6 +951,8 @@ def _study_lines(res: dict) -> list[str]:
             lines += [_single_run_line(res, k, keys) for k in SINGLES.get(keys, ())]
         if keys == RESOLUTION_RUNS:
             lines += _resolution_lines(res)
+        if keys == REF_RUNS:
+            lines += [_single_run_line(res, k, group) for group, singles in REF_SINGLES for k in singles]
     return lines
 
 
@@ -1053,6 +1055,15 @@ def _change_cell(d: float, z: float = math.nan) -> str:
 # a scatter group -> the group it is compared with (_difference_line)
 COMPARED = {SCATTER_S2: SCATTER_T5, REF_SCATTER: SCATTER_T5}
 SINGLES = {SCATTER_KEYS: ("case 1 s/2", "case 1 heat every 8"), SCATTER_TI10: ("case 10 s/2",)}   # one run each
+# the 'refupdate' study's single runs, each against the scatter group of its resolution and material (at the
+# scene's reference update, or at REF_UPDATE for case 1 at t_u/5): which changes the scatter does not explain
+REF_SINGLES = ((SCATTER_T5, tuple(f"case 1{COARSE}{REF_KEY}{r:g}" for r in REF_UPDATES if r > SCENE_REF_UPDATE)
+                + REF_SCATTER[:1]),
+               (REF_SCATTER, tuple(f"case 1{COARSE}{REF_KEY}{r:g}" for r in REF_UPDATES
+                                   if r < SCENE_REF_UPDATE and r != REF_UPDATE)),
+               (RESOLUTION_NOISE[10][0], tuple(f"case 10{COARSE}{REF_KEY}{r:g}" for r in REF_UPDATES)),
+               (SCATTER_KEYS, (f"case 1{REF_KEY}{REF_UPDATE:g}",)),
+               (SCATTER_TI10, (f"case 10{REF_KEY}{REF_UPDATE:g}",)))
 
 
 def _single_run_line(res: dict, key: str, group) -> str:

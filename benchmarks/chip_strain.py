@@ -146,8 +146,9 @@ def report(rows: dict) -> str:
                          f"({len(x)} runs).")
         J = [r["area_ratio"] for r in sel if "area_ratio" in r]
         if J:
-            lines.append(f"{name}: the body's particles crowd, area ratio J {min(J):.2f}-{max(J):.2f} (a material "
-                         "that keeps its volume: 1; neighbours within 1.5 dx in the table).")
+            lines.append(f"{name}: the area ratio J of the body's starting neighbourhoods {min(J):.2f}-{max(J):.2f} (a "
+                         "material that keeps its volume: 1; particles that crowd: below 1; neighbours within 1.5 dx "
+                         "in the table).")
     return "\n".join(lines) + "\n"
 
 

@@ -812,13 +812,15 @@ SCATTER_KEYS = ("case 1", "case 1 jitter 1", "case 1 jitter 2", "case 1 jitter 3
 SCATTER_T5 = tuple(k.replace("case 1", "case 1 n_tu 5") for k in SCATTER_KEYS)         # at t_u/5
 SCATTER_S2 = tuple(k.replace("n_tu 5", "n_tu 5 s/2") for k in SCATTER_T5)               # at t_u/5 and s/2
 SCATTER_TI10 = ("case 10", "case 10 jitter 1", "case 10 jitter 2")                     # Ti6Al4V at t_u/10
-# the resolution study: case -> its runs at 5, 10 and 15 particles across t_u (at courant 0.15), and the scatter
-# groups that measure its run-to-run spread at t_u/5 and t_u/10 (the t_u/5 groups at the scene's courant 0.3)
+# the 'refupdate' study: case 1's scatter at REF_UPDATE (t_u/5, the seeds of SCATTER_T5) and the study's table (each
+# case at t_u/5 from the loosest threshold to the tightest, the scene's among them, then t_u/10)
 REF_SCATTER = tuple(f"case 1{COARSE}{REF_KEY}{REF_UPDATE:g}" + k[len("case 1 n_tu 5"):] for k in SCATTER_T5[:3])
 REF_RUNS = tuple(f"case {n}{COARSE}{REF_KEY}{r:g}" if r != SCENE_REF_UPDATE else f"case {n}{COARSE}"
                  for n in (1, 10) for r in sorted(REF_UPDATES + (SCENE_REF_UPDATE,), reverse=True)) + tuple(
     k for n in (1, 10) for k in (f"case {n}", f"case {n}{REF_KEY}{REF_UPDATE:g}")) + (
     f"case 1{REF_KEY}{REF_UPDATE:g}{RETRY}",)
+# the resolution study: case -> its runs at 5, 10 and 15 particles across t_u (at courant 0.15), and the scatter
+# groups that measure its run-to-run spread at t_u/5 and t_u/10 (the t_u/5 groups at the scene's courant 0.3)
 RESOLUTION_N = (5.0, 10.0, 15.0)
 RESOLUTION_KEYS = {1: ("case 1 n_tu 5 courant 0.15", "case 1", "case 1 n_tu 15"),
                    10: ("case 10 n_tu 5 courant 0.15", "case 10", "case 10 n_tu 15")}

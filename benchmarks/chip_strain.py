@@ -89,14 +89,15 @@ def compaction(X0: np.ndarray, x: np.ndarray, rows: np.ndarray, dx: float) -> di
 
 
 def row(folder: Path) -> dict | None:
-    """The chip's strain of one finished run folder (None without a summary, a good status or a snapshot)."""
+    """The chip's strain of one finished run folder (None without a summary, a good status or a snapshot, or with a
+    particle past the blow-up limit: the sweep's 'blow-up', whose summary says 'ok')."""
     from refsph.io import load_snapshot
     from refsph.scenes.thermal_cutting import RAKE_DEG, rake_frame
     path = folder / "summary.json"
     if not path.exists():
         return None
     s = json.loads(path.read_text())
-    if s.get("status") != "ok" or not s.get("snapshots"):
+    if s.get("status") != "ok" or not s.get("snapshots") or "blow_up" in s.get("metrics", {}):
         return None
     info, m = s["scene_info"], s["metrics"]
     z = load_snapshot(folder / "snapshots" / s["snapshots"][-1])

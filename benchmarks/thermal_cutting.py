@@ -234,8 +234,8 @@ def reference_update_jobs() -> dict:
             converged(1, n_tu=5.0, jitter=0.01, seed=seed), dict(ref_update_strain=REF_UPDATE))
     for n in (1, 10):
         out[f"case {n}{REF_KEY}{REF_UPDATE:g}"] = (converged(n), sweep_numerics(ref_update_strain=REF_UPDATE))
-    # case 1's blew up at 0.93 of 1.6 ms: a chip-surface particle left with 2 neighbours within 2h heated past 5000 K
-    # and flew off at 40 m/s, the trigger then updating every step; again at half the step (as 'case 9' + RETRY)
+    # case 1's failed at 0.93 of 1.6 ms; replayed, its trouble starts at 0.81 ms, where two chip-surface particles
+    # crowded to 0.33 dx are taken into a fresh reference (history): again at half the step (as 'case 9' + RETRY)
     out[f"case 1{REF_KEY}{REF_UPDATE:g}{RETRY}"] = (converged(1), sweep_numerics(ref_update_strain=REF_UPDATE,
                                                                                  courant=RETRY_COURANT))
     return out

@@ -334,16 +334,17 @@ display(Markdown(split_page.split("\n\n", 1)[1]))             # the page without
 # %% [markdown]
 # * **The SPH chip is too cold for its shape: the reference update.** Continuity says a chip $t_c$ thick cut from
 #   $t_u$ has been sheared by $\cos\gamma / (\sin\phi \cos(\phi-\gamma))$ (Merchant); the TLSPH chip's body
-#   carries 0.36–0.53 of that plastic strain (the PFEM's 0.84–1.11 mostly; `chip_strain_report.md`). The cause is
+#   carries 0.36–0.53 of that plastic strain (the PFEM's 0.84–1.11 mostly; `chip_strain_report.md`). One cause is
 #   how often the reference configuration is updated, which the paper leaves open. Updated when some
 #   $\lVert\mathbf E\rVert_F$ passes 0.5, Eq. (18) sees 71 % of the particles' own deformation; at 0.1, 91 %
-#   (`registered_strain_report.md`). The rest is particles sliding past non-neighbours (chapter 3, exercise 2),
-#   resisted by the artificial viscosity: its heat falls from 16–22 % of the tool's work to 6–8 %. At 0.1 the chip
-#   is 25–32 % thinner, $F_c$ 19–32 % lower and the rake face hotter: steel at $t_u/5$ 655 → 775 K (measured 668),
-#   Ti6Al4V at $t_u/10$ 835 → 959 K (measured 701). For steel 0.05 lies within 2 % of 0.1; Ti6Al4V's chip surface
-#   cools 8 % more. But 3 of 12 runs at 0.2 and below failed: two particles that crowded to a third of a spacing,
-#   taken into a fresh reference, turn any relative motion into a large strain (case 1 at $t_u/10$). So the
-#   default stays at 0.5 until that is cured.
+#   (`registered_strain_report.md`). The unseen part is particles sliding past non-neighbours (chapter 3, exercise
+#   2), resisted by the artificial viscosity: its heat falls from 14–22 % of the tool's work to 6–8 %. At 0.1 the
+#   chip is 22–31 % thinner, $F_c$ 19–26 % lower and the rake face hotter: steel at $t_u/5$ 655 → 775 K (four runs
+#   against three; measured 668), Ti6Al4V at $t_u/10$ 835 → 959 K (measured 701). Steel at 0.05 stays within the
+#   scatter of the three runs at 0.1 but for $T_{RF}$ (−2 %); Ti6Al4V's chip surface cools 8 % more.
+#   But 3 of 12 runs at 0.2 and below failed. In the one diagnosed (case 1 at $t_u/10$) two particles crowded to a
+#   third of a spacing, and a fresh reference turned their relative motion into a large strain. So the default
+#   stays at 0.5 until that is cured.
 #
 # %% [markdown]
 # * **Mass scaling** changes inertia by the factor $s$, and with it the artificial viscosity's stress ($\propto

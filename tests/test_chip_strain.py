@@ -67,3 +67,12 @@ def test_the_reference_update_runs_are_read_and_summarised_apart():
     page = cs.report(rows)
     assert "tlsph (ref update 0.5, t_u/10): body / Merchant 0.50" in page
     assert "tlsph (ref update 0.1, t_u/5): body / Merchant 0.90" in page
+
+
+def test_a_run_with_a_blow_up_gives_no_row(tmp_path):
+    """row: a run folder whose summary says 'ok' but whose metrics flag a blow-up (the sweep records it 'blow-up')
+    is not read."""
+    import chip_strain as cs
+    (tmp_path / "summary.json").write_text(json.dumps(dict(status="ok", snapshots=["snap_00000.npz"],
+                                                           metrics=dict(blow_up="a particle at 44351 K"))))
+    assert cs.row(tmp_path) is None

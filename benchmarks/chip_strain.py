@@ -59,9 +59,8 @@ def zones(u, n, tu: float, tc_: float) -> tuple[np.ndarray, np.ndarray]:
     return along & (n >= ACROSS[0] * tc_) & (n < ACROSS[1] * tc_), along & (n >= 0.0) & (n < SECONDARY * tc_)
 
 
-def body_means(u, n, eps_p, T, tu: float, tc_: float) -> dict:
-    """Mean eps_p and T of the rows of the chip's body and of its secondary zone (:func:`zones`)."""
-    body, face = zones(u, n, tu, tc_)
+def body_means(body: np.ndarray, face: np.ndarray, eps_p, T) -> dict:
+    """Mean eps_p and T of the rows of the chip's body and of its secondary zone (the masks of :func:`zones`)."""
     out = dict(n_body=int(body.sum()), n_face=int(face.sum()))
     for name, sel in (("body", body), ("face", face)):
         out[f"eps_{name}"] = float(eps_p[sel].mean()) if sel.any() else math.nan
@@ -69,23 +68,39 @@ def body_means(u, n, eps_p, T, tu: float, tc_: float) -> dict:
     return out
 
 
+def affine_maps(xa: np.ndarray, xb: np.ndarray, radius: float, weight=None) -> np.ndarray:
+    """Each particle's affine map F (N, 2, 2) that best carries its neighbours (within ``radius`` of it in ``xa``)
+    from ``xa`` to ``xb`` in the least squares weighted by ``weight(|dX|)`` (None: 1):
+    F = (sum w dy (x) dX) (sum w dX (x) dX)^-1; the identity where the neighbours do not span the plane."""
+    from scipy.spatial import cKDTree
+    I, J = cKDTree(xa).query_pairs(radius, output_type="ndarray").T
+    dX, dy = xa[J] - xa[I], xb[J] - xb[I]
+    w = np.ones(len(I)) if weight is None else weight(np.linalg.norm(dX, axis=1))
+    n = len(xa)
+    A, B = np.zeros((n, 2, 2)), np.zeros((n, 2, 2))
+    for a in range(2):
+        for b in range(2):
+            A[:, a, b] = np.bincount(I, w * dy[:, a] * dX[:, b], n) + np.bincount(J, w * dy[:, a] * dX[:, b], n)
+            B[:, a, b] = np.bincount(I, w * dX[:, a] * dX[:, b], n) + np.bincount(J, w * dX[:, a] * dX[:, b], n)
+    ok = np.abs(np.linalg.det(B)) > 1e-12 * np.einsum("nii->n", B) ** 2
+    F = np.tile(np.eye(2), (n, 1, 1))
+    F[ok] = A[ok] @ np.linalg.inv(B[ok])
+    return F
+
+
 def compaction(X0: np.ndarray, x: np.ndarray, rows: np.ndarray, dx: float) -> dict:
     """How the SPH chip's particles crowd: for the particles ``rows`` (indices into X0, x: the positions at the start
     and now), the mean number of others within 1.5 dx now and at the start, and the median area ratio J of the
     affine map that best carries each one's starting neighbours (within 2.1 dx at the start) to where they are now,
-    F = (sum dx (x) dX) (sum dX (x) dX)^-1. A material that keeps its volume has J = 1 and its particles keep their
+    :func:`affine_maps`. A material that keeps its volume has J = 1 and its particles keep their
     number of neighbours; J < 1 with more neighbours: particles crowd into each other's room, where the deformation
     gradient of Eq. (18) on a reference configuration does not look."""
     from scipy.spatial import cKDTree
     start, now = cKDTree(X0), cKDTree(x)
-    J = []
-    for i in rows:
-        nb = [j for j in start.query_ball_point(X0[i], 2.1 * dx) if j != i]
-        dX, dx_ = X0[nb] - X0[i], x[nb] - x[i]
-        J.append(np.linalg.det((dx_.T @ dX) @ np.linalg.inv(dX.T @ dX)))
+    J = np.linalg.det(affine_maps(X0, x, 2.1 * dx)[rows])
     count = lambda tree, pts: float(np.mean([len(tree.query_ball_point(p, 1.5 * dx)) - 1 for p in pts]))  # noqa: E731
     return dict(neighbours_now=count(now, x[rows]), neighbours_start=count(start, X0[rows]),
-                area_ratio=float(np.median(J)) if J else math.nan)
+                area_ratio=float(np.median(J)) if len(J) else math.nan)
 
 
 def row(folder: Path) -> dict | None:
@@ -105,16 +120,16 @@ def row(folder: Path) -> dict | None:
     u, n = rake_frame(z["x"][:n_work], float(z["t"]), info)
     tu, tc_ = info["tu_m"], 1e-3 * m["chip_thickness_mm"]
     eps_m = merchant_strain(tu, tc_, RAKE_DEG)
+    body, face = zones(u, n, tu, tc_)
     out = dict(method=s["method"], tu_mm=1e3 * tu, chip_mm=m["chip_thickness_mm"], eps_merchant=eps_m,
-               **body_means(u, n, z["eps_p"][:n_work], z["T"][:n_work], tu, tc_))
+               **body_means(body, face, z["eps_p"][:n_work], z["T"][:n_work]))
     out["body_over_merchant"] = out["eps_body"] / eps_m
     out["ref_update"] = s.get("numerics", {}).get("ref_update_strain") if s["method"] == "tlsph" else None
     out["across"] = tu / s["dp"]
     if s["method"] != "pfem":                                   # SPH particles keep their identity; PFEM nodes not
         z0 = load_snapshot(folder / "snapshots" / s["snapshots"][0])
         if np.array_equal(z0["id"][:n_work], z["id"][:n_work]):
-            body = np.flatnonzero(zones(u, n, tu, tc_)[0])
-            out.update(compaction(z0["x"][:n_work], z["x"][:n_work], body, s["dp"]))
+            out.update(compaction(z0["x"][:n_work], z["x"][:n_work], np.flatnonzero(body), s["dp"]))
     return out
 
 

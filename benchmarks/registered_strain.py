@@ -45,20 +45,10 @@ EVERY = 10                      # steps between two affine fits
 
 def strain_increment(xa: np.ndarray, xb: np.ndarray, h: float, kernel) -> np.ndarray:
     """The kinematic equivalent strain increment of each particle from positions ``xa`` to ``xb`` (N, 2): the
-    kernel-weighted affine fit of its neighbours' relative motion (module text); 0 where the fit is singular."""
-    from scipy.spatial import cKDTree
-    I, J = cKDTree(xa).query_pairs(kernel.support * h, output_type="ndarray").T
-    dX, dy = xa[J] - xa[I], xb[J] - xb[I]
-    w = kernel.w(np.linalg.norm(dX, axis=1), h, 2)
-    n = len(xa)
-    A, B = np.zeros((n, 2, 2)), np.zeros((n, 2, 2))
-    for a in range(2):
-        for b in range(2):
-            A[:, a, b] = np.bincount(I, w * dy[:, a] * dX[:, b], n) + np.bincount(J, w * dy[:, a] * dX[:, b], n)
-            B[:, a, b] = np.bincount(I, w * dX[:, a] * dX[:, b], n) + np.bincount(J, w * dX[:, a] * dX[:, b], n)
-    ok = np.abs(np.linalg.det(B)) > 1e-12 * np.einsum("nii->n", B) ** 2
-    F = np.tile(np.eye(2), (n, 1, 1))
-    F[ok] = A[ok] @ np.linalg.inv(B[ok])
+    kernel-weighted affine fit of its neighbours' relative motion (module text,
+    :func:`chip_strain.affine_maps`); 0 where the fit is singular."""
+    import chip_strain as cs
+    F = cs.affine_maps(xa, xb, kernel.support * h, lambda r: kernel.w(r, h, 2))
     E = 0.5 * (F + np.swapaxes(F, 1, 2)) - np.eye(2)
     mean = (E[:, 0, 0] + E[:, 1, 1]) / 3.0
     dev = np.stack([E[:, 0, 0] - mean, E[:, 1, 1] - mean, -mean], axis=1)

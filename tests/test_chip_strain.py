@@ -28,7 +28,7 @@ def test_the_chips_body_and_secondary_zone_are_picked_out():
     body = (u >= 1.5 * tu) & (u < 3 * tu) & (n >= 0.25 * tc) & (n < 0.75 * tc)
     face = (u >= 1.5 * tu) & (u < 3 * tu) & (n >= 0) & (n < 0.1 * tc)
     eps = np.where(body, 1.0, np.where(face, 3.0, 7.0))
-    out = cs.body_means(u, n, eps, 300.0 + 100.0 * eps, tu, tc)
+    out = cs.body_means(*cs.zones(u, n, tu, tc), eps, 300.0 + 100.0 * eps)
     assert out["eps_body"] == 1.0 and out["eps_face"] == 3.0 and out["T_body_K"] == 400.0
     assert out["n_body"] == body.sum() > 0 and out["n_face"] == face.sum() > 0
 

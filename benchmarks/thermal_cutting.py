@@ -91,7 +91,7 @@ def _s(case: int) -> float:
 
 
 STUDY_NAMES = ("cases", "coarse", "pfem", "detector", "scaling", "scatter", "resolution", "timestep", "tool",
-               "contact", "refupdate")
+               "contact", "refupdate", "selfcontact")
 COURANT = 0.15                             # every run at dx <= t_u / 10: half the scene's step (module text)
 COARSE = " n_tu 5"                         # the key suffix of the 'coarse' study: all 18 cases at dx = t_u / 5
 PFEM = " pfem n_tu 5"                      # the key suffix of the 'pfem' study: the 18 cases with the PFEM at t_u / 5
@@ -102,6 +102,10 @@ REF_KEY = " ref update "                   # the 'refupdate' study's key part: T
 REF_UPDATES = (1.5, 0.2, 0.1, 0.05, 0.02)  # 0.5) at these values at t_u/5 (reference_update_jobs) ...
 REF_UPDATE = 0.1                           # ... and at this one at t_u/10 and for the scatter
 SCENE_REF_UPDATE = 0.5                     # the scene's (refsph.scenes.thermal_cutting; a test holds them equal)
+SELF_KEY = " self contact"                 # the 'selfcontact' study's key part: Numerics.self_contact at SELF_CONTACT
+SELF_CONTACT = 0.5                         # (refsph.self_contact: LAMMPS SMD's r_c = dp/2), self_contact_jobs
+SELF_REF_UPDATES = (0.2, 0.1, 0.02)        # ... with these reference updates too (the refupdate study's failures)
+RERUN = " rerun"                           # a run again with today's code, beside its record (its crowding)
 DAMPED_GAMMA = 0.6                         # a PFEM case of the t_u / 10 table that failed with the trapezoidal rule,
 DAMPED = f" n_tu 10 gamma {DAMPED_GAMMA:g}"  # again with Newmark's damped rule, under 'case N pfem' + DAMPED
 BOSSAK_ALPHA = -0.1                        # the Bossak-Newmark rule (second order, damped) beside the damped rule:
@@ -213,7 +217,8 @@ def more_jobs() -> list[tuple[str, str, dict, dict]]:
     cases cut to the paper's 2 mm (20 t_u; the sweep's 16 t_u is 1.6 mm) on its 3 mm workpiece (TO_2MM), the
     PFEM's first."""
     pfem = dict(method="pfem")
-    out = [("refupdate", key, options, numerics) for key, (options, numerics) in reference_update_jobs().items()]
+    out = [("selfcontact", key, options, numerics) for key, (options, numerics) in self_contact_jobs().items()]
+    out += [("refupdate", key, options, numerics) for key, (options, numerics) in reference_update_jobs().items()]
     out += [("pfem", key, options, pfem) for key, options in time_rule_jobs() + remesh_jobs() + pfem_resolution_jobs()]
     out += [("pfem", f"case {n}{PFEM10}{TO_2MM}", to_2mm(n, n_tu=10.0), pfem) for n in TU_01]
     return out + [("cases", f"case {n}{TO_2MM}", to_2mm(n), sweep_numerics()) for n in TU_01]
@@ -238,6 +243,28 @@ def reference_update_jobs() -> dict:
     # crowded to 0.33 dx are taken into a fresh reference (history): again at half the step (as 'case 9' + RETRY)
     out[f"case 1{REF_KEY}{REF_UPDATE:g}{RETRY}"] = (converged(1), sweep_numerics(ref_update_strain=REF_UPDATE,
                                                                                  courant=RETRY_COURANT))
+    return out
+
+
+def self_contact_jobs() -> dict:
+    """{key: (options, numerics)} of the 'selfcontact' study: TLSPH's particles of one body repel below
+    SELF_CONTACT dp (refsph.self_contact; without it the chip's particles pair up, and with frequent reference
+    updates such pairs blew up three of the refupdate study's runs). Case 1 at t_u/10 at REF_UPDATE first (it
+    failed at 0.93 ms without), then cases 1 and 10 at t_u/5 without self-contact again (RERUN: the record then
+    says how crowded the particles are, ``crowding``), with it at the scene's reference update and at
+    SELF_REF_UPDATES (0.2 failed for case 10, 0.02 for case 1), case 1's scatter (two more seeds), and case 1 at
+    t_u/10 at the scene's reference update."""
+    sc = dict(self_contact=SELF_CONTACT)
+    out = {f"case 1{REF_KEY}{REF_UPDATE:g}{SELF_KEY}": (converged(1), sweep_numerics(ref_update_strain=REF_UPDATE,
+                                                                                      **sc))}
+    for n in (10, 1):
+        out[f"case {n}{COARSE}{RERUN}"] = (converged(n, n_tu=5.0), {})     # the record with its crowding
+        out[f"case {n}{COARSE}{SELF_KEY}"] = (converged(n, n_tu=5.0), dict(sc))
+        for r in SELF_REF_UPDATES:
+            out[f"case {n}{COARSE}{REF_KEY}{r:g}{SELF_KEY}"] = (converged(n, n_tu=5.0), dict(ref_update_strain=r, **sc))
+    for seed in (1, 2):
+        out[f"case 1{COARSE}{SELF_KEY} jitter {seed}"] = (converged(1, n_tu=5.0, jitter=0.01, seed=seed), dict(sc))
+    out[f"case 1{SELF_KEY}"] = (converged(1), sweep_numerics(**sc))
     return out
 
 
@@ -335,11 +362,23 @@ def run_case(key: str, options: dict, numerics: dict, quick: bool = False) -> di
                metrics={k: m[k] for k in KEEP if k in m},
                histories={k: _thin(m[k]) for k in ("cutting_force_history", "passive_force_history",
                                                      "temperature_history") if k in m})
+    if s.get("status") in ("ok", "blow-up") and numerics.get("method") != "pfem":
+        rec["crowding"] = crowding(res.state, s.get("dp"))
     rec["commits"] = run_commits(s.get("provenance") or {})       # the code that ran it (a restart: each part's)
     if s.get("heat_dissipation"):                                    # the ledger's dissipation split (newer runs)
         rec["heat_dissipation"] = s["heat_dissipation"]
     rec["script_wall_s"] = time.perf_counter() - t0
     return rec
+
+
+def crowding(state, dp: float) -> dict:
+    """How the workpiece's particles have paired up by the end of the cut: the fraction of them with a neighbour
+    closer than dp/2, and the closest pair's distance in dp (a lattice at rest: none, 1)."""
+    from scipy.spatial import cKDTree
+    from refsph.scenes.measure import TOOL_BODY
+    x = state.x[state.body != TOOL_BODY]
+    d = cKDTree(x).query(x, k=2)[0][:, 1] / dp
+    return dict(fraction_below_half_dp=float(np.mean(d < 0.5)), min_distance_dp=float(d.min()))
 
 
 def _thin(a, n: int = 100) -> list:

@@ -99,6 +99,9 @@ def make_solver(method: str, setup: Setup) -> Solver:
                              "modes are the tensile instability's, see gamma)")
         if nm.max_condition is not None:
             raise ValueError("max_condition limits TLSPH's kernel-gradient correction; ESPH has none to limit")
+        if nm.self_contact is not None:
+            raise ValueError("self_contact is a TLSPH option (ESPH's particles keep apart through the pressure of "
+                             "their current neighbours, and its artificial pressure, gamma)")
         prm = ESPHParams(h=h, dp=setup.dp, beta1=nm.beta1, beta2=nm.beta2, gamma=nm.gamma, n_ap=nm.n_ap,
                          eps=nm.eps, kernel=kernel, correction=bool(nm.esph_correction))
         return ESPHSolver(setup.material, prm, skin_factor=nm.skin_factor, **common)
@@ -121,7 +124,8 @@ def make_solver(method: str, setup: Setup) -> Solver:
         elif setup.rigid or len(_deformable_bodies(setup)) > 1:
             k = nm.contact_k if nm.contact_k is not None else setup.dp / (2.0 * h)
             contact = PinballContact(k=k, K_p=nm.contact_Kp, friction=setup.friction)
-        return TLSPHSolver(setup.material, prm, contact=contact, dp=setup.dp, **common)
+        r_c = None if nm.self_contact is None else nm.self_contact * setup.dp
+        return TLSPHSolver(setup.material, prm, contact=contact, dp=setup.dp, self_contact=r_c, **common)
     raise ValueError(f"unknown method {method!r}; choose one of {', '.join(METHODS)}")
 
 

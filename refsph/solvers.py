@@ -30,6 +30,7 @@ from .material import ElasticMaterial, eos_pressure
 from .neighbours import PairBlocks, VerletList, check_threads
 from .penalty import PenaltyContact
 from .reference import ReferenceConfiguration, with_identity
+from .self_contact import reduced_modulus, self_contact_forces
 from .state import Rates, State
 from .strength import Elastic, StrengthModel, check_strength_fields, strength_stage
 from .tensor import det
@@ -216,15 +217,21 @@ class TLSPHSolver(SolverBase):
     rigid bodies the operator covers the deformable rows only, and the bodies meet through the ``contact``: the
     pinball (a :class:`~refsph.contact.PinballContact`, :class:`~refsph.coupling.PinballCoupling`; ``dp`` gives the
     2D force per unit thickness) or, with the tools, the penalty contact on their exact geometry (a
-    :class:`~refsph.penalty.PenaltyContact`, :class:`~refsph.coupling.PenaltyCoupling`)."""
+    :class:`~refsph.penalty.PenaltyContact`, :class:`~refsph.coupling.PenaltyCoupling`). ``self_contact``: the
+    distance r_c [m] below which two particles of one body repel (:mod:`refsph.self_contact`; None: off, as in the
+    paper; pairs across symmetry planes are not included)."""
 
     method = "tlsph"
     evolved = ("x", "v", "S", "S_zz")
 
     def __init__(self, material: ElasticMaterial, params: TLSPHParams, *, strength: StrengthModel | None = None,
                  mirror: MirrorPlanes | None = None, walls=(), rigid=(), clamps=(),
-                 contact: PinballContact | PenaltyContact | None = None, dp: float | None = None, threads: int = 1):
+                 contact: PinballContact | PenaltyContact | None = None, dp: float | None = None, threads: int = 1,
+                 self_contact: float | None = None):
         super().__init__(material, params, strength, mirror, Constraints(walls, rigid, clamps, mirror), threads)
+        if self_contact is not None and not (np.isfinite(self_contact) and self_contact > 0.0):
+            raise ValueError(f"self_contact is the self-contact distance r_c [m] (> 0, or None), got {self_contact!r}")
+        self.self_contact = self_contact
         if self.constraints.rigid and contact is None:
             raise ValueError("TLSPH with rigid bodies needs a contact model (PinballContact or PenaltyContact)")
         self.contact = contact
@@ -285,6 +292,10 @@ class TLSPHSolver(SolverBase):
                        pair_i=op.I, pair_j=op.J)
         if part != "deformation" and self.several_bodies:
             r.v = r.v + self.coupling.between_bodies(body, self.constraints.deformable_bodies, dt)
+        if part != "deformation" and self.self_contact is not None:
+            f = self_contact_forces(body.x, body.body if self.several_bodies else None, self.self_contact,
+                                    reduced_modulus(self.material.E, self.material.nu))
+            r.v = r.v + f / body.m[:, None]
         if body is not state:
             r = self._with_rigid(state, r, dt, contact=part != "deformation")
         return self.constraints.constrain(state, r, record=part != "deformation")

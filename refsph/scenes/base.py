@@ -41,7 +41,9 @@ class Numerics:
     only up to it (:func:`refsph.kernels.correction_matrix`; None = no limit, as in the paper); heat_every: the
     heat step (conduction, frictional heat, losses, :class:`refsph.thermal.HeatFlow`) runs once every this many
     mechanical steps, over their summed step with the heat they made (1 = every step; the plastic heat of the return
-    map still raises T every step). The numbers of a run do not depend on ``threads``, only its speed does.
+    map still raises T every step); self_contact: TLSPH particles of one body closer than self_contact dp repel
+    (:mod:`refsph.self_contact`, LAMMPS SMD's self-contact at 0.5; None = off, as in the paper). The numbers of a
+    run do not depend on ``threads``, only its speed does.
     """
 
     h_over_dp: float = 1.5
@@ -66,6 +68,7 @@ class Numerics:
     penalty_damping: float = 0.5
     max_condition: float | None = None
     heat_every: int = 1
+    self_contact: float | None = None
 
     def __post_init__(self):
         """Every parameter checked when the Numerics is made (a scene's, or ``--set``'s replacement of it), so that
@@ -91,6 +94,7 @@ class Numerics:
         real("contact_k", 0.0, lo_open=True, optional=True)
         real("penalty_alpha", 0.0, 4.0, lo_open=True)
         real("max_condition", 1.0, lo_open=True, optional=True)
+        real("self_contact", 0.0, 1.0, lo_open=True, optional=True)
         if not (isinstance(self.threads, int) and not isinstance(self.threads, bool) and self.threads >= 0):
             raise ValueError(f"numerical parameter threads must be a whole number >= 0, got {self.threads!r}")
         if not (isinstance(self.heat_every, int) and not isinstance(self.heat_every, bool) and self.heat_every >= 1):

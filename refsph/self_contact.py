@@ -1,0 +1,59 @@
+"""Self-contact of a TLSPH body: a short-range repulsion between particles of the same body that come closer than
+r_c (not in the paper; an option, off by default).
+
+Why. TLSPH's forces come from the deformation gradient F of Eq. (18), a kernel-weighted average over each
+particle's reference neighbours. Two neighbours can approach each other without changing any particle's F much
+(a zero-energy mode of the particle sum, as hourglassing is), and after a reference update (X <- x) the crowded
+pair is the new reference and nothing pushes it apart. In the cutting scenes this pairs particles in the chip:
+at ``ref_update_strain`` 0.5 about a third of the workpiece's particles of ``thermal_cutting`` case 10 (dx = t_u/5)
+have a neighbour closer than dx/2 by the end of the cut, some closer than dx/100; with frequent updates (0.2,
+0.02) such pairs end in a particle thrown off at tens of m/s and a local blow-up
+(``benchmarks/registered_strain.py``, ``benchmarks/thermal_cutting.py``'s self-contact study).
+
+What. LAMMPS's SMD package (Ganzenmueller's Smooth Mach Dynamics, ``pair_style smd/hertz``) gives particles of
+one body that are SPH neighbours a Hertzian contact at half the contact diameter; refsph does the same with the
+contact distance r_c (``Numerics.self_contact`` dp; LAMMPS: contact radius dp/2, halved, so r_c = dp/2). For a pair
+of the same deformable body at distance r < r_c, overlap delta = r_c - r, along e_ij = (x_i - x_j) / r:
+
+    3D (two spheres of radius r_c/2, Hertz):   f_ij = (4/3) E* sqrt(r_c/4) delta^(3/2) e_ij
+    2D (per unit thickness, a linear spring):  f_ij = E* delta e_ij
+    E* = E / (2 (1 - nu^2))                    (the reduced modulus of two bodies of one material)
+
+f_ji = -f_ij, so momentum is conserved; the force has a potential, so it makes no heat. The 2D law is a penalty
+with the reduced modulus as its stiffness (Hertz's line contact has no closed force-overlap law without a length
+scale); its spring, with the particle's mass m = rho dp^2, has omega dt = sqrt(2 E* / (rho dp^2)) dt, about 0.3 at
+the scenes' CFL steps, well inside the leapfrog's limit of 2.
+"""
+from __future__ import annotations
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+__all__ = ["reduced_modulus", "self_contact_forces"]
+
+
+def reduced_modulus(E: float, nu: float) -> float:
+    """E* = E / (2 (1 - nu^2)): the contact modulus of two bodies of one material (Hertz; K. L. Johnson, Contact Mechanics, 1985, ch. 4)."""
+    return E / (2.0 * (1.0 - nu * nu))
+
+
+def self_contact_forces(x: np.ndarray, body: np.ndarray | None, r_c: float, E_star: float) -> np.ndarray:
+    """The self-contact force on every particle (module text): (N, d), N per unit thickness in 2D, N in 3D.
+    ``x``: positions of the deformable particles (N, d); ``body``: their body ids (None: one body), pairs of two
+    bodies are left out (they meet through the contact model); ``r_c``: the contact distance [m]."""
+    n, dim = x.shape
+    pairs = cKDTree(x).query_pairs(r_c, output_type="ndarray")
+    f = np.zeros((n, dim))
+    if body is not None and len(pairs):
+        pairs = pairs[body[pairs[:, 0]] == body[pairs[:, 1]]]
+    if not len(pairs):
+        return f
+    i, j = pairs[:, 0], pairs[:, 1]
+    d = x[i] - x[j]
+    r = np.sqrt(np.einsum("pd,pd->p", d, d))
+    delta = r_c - r
+    size = E_star * delta if dim == 2 else (4.0 / 3.0) * E_star * np.sqrt(0.25 * r_c) * delta ** 1.5
+    f_ij = np.where(r > 0.0, size / np.where(r > 0.0, r, 1.0), 0.0)[:, None] * d   # coincident pair: no direction
+    for k in range(dim):
+        f[:, k] = np.bincount(i, f_ij[:, k], n) - np.bincount(j, f_ij[:, k], n)
+    return f

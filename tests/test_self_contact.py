@@ -1,0 +1,82 @@
+"""Self-contact of a TLSPH body (refsph.self_contact): the pair force against its formula, only below r_c, only
+within one body, momentum conserved; off by default (the golden cases hold that); refused for ESPH; and on a
+crowded pair in a TLSPH run it pushes the pair apart where the run without it lets the pair stay."""
+import dataclasses
+
+import numpy as np
+import pytest
+
+from refsph.self_contact import reduced_modulus, self_contact_forces
+from refsph.scenes.base import Numerics
+
+
+def test_pair_force_matches_the_formula_in_2d_and_3d():
+    E_star, r_c = 2.0e11, 5e-6
+    for dim in (2, 3):
+        x = np.zeros((2, dim))
+        x[1, 0] = 0.7 * r_c
+        f = self_contact_forces(x, None, r_c, E_star)
+        delta = 0.3 * r_c
+        size = E_star * delta if dim == 2 else (4 / 3) * E_star * np.sqrt(r_c / 4) * delta ** 1.5
+        np.testing.assert_allclose(f[0], -size * np.eye(dim)[0], rtol=1e-12)   # pushed away from particle 1
+        np.testing.assert_allclose(f[1], size * np.eye(dim)[0], rtol=1e-12)
+
+
+def test_only_closer_than_r_c_and_within_one_body():
+    x = np.array([[0.0, 0.0], [1.01, 0.0], [0.0, 0.5], [5.0, 5.0], [5.2, 5.0]])
+    f = self_contact_forces(x, np.array([0, 0, 0, 1, 2]), 1.0, 1.0)
+    assert np.all(f[1] == 0.0)                  # 1.01 > r_c: no force
+    assert f[0, 1] < 0.0 < f[2, 1]              # 0.5 apart, one body: pushed apart along y
+    assert np.all(f[3:] == 0.0)                 # 0.2 apart, two bodies: the contact model's business
+
+
+def test_momentum_is_conserved_and_a_coincident_pair_is_left_alone():
+    rng = np.random.default_rng(3)
+    x = rng.random((400, 2))
+    f = self_contact_forces(x, None, 0.05, 7.0)
+    assert np.abs(f).max() > 0.0
+    np.testing.assert_allclose(f.sum(axis=0), 0.0, atol=1e-12 * np.abs(f).max())
+    g = self_contact_forces(np.zeros((2, 2)), None, 0.05, 7.0)
+    assert np.all(g == 0.0)                     # no direction to push: no force (not NaN)
+
+
+def test_reduced_modulus():
+    assert reduced_modulus(2.0e11, 0.3) == pytest.approx(2.0e11 / (2 * 0.91))
+
+
+def test_numerics_checks_and_esph_refuses():
+    assert Numerics().self_contact is None
+    for bad in (0.0, -0.5, 1.5, float("nan")):
+        with pytest.raises(ValueError, match="self_contact"):
+            Numerics(self_contact=bad)
+    from refsph.scenes import get_scene
+    from refsph.simulate import make_solver
+    setup = get_scene("taylor").setup(2, None, True)
+    setup.numerics = dataclasses.replace(setup.numerics, self_contact=0.5)
+    with pytest.raises(ValueError, match="self_contact is a TLSPH option"):
+        make_solver("esph", setup)
+
+
+def test_a_crowded_pair_is_pushed_apart_in_a_tlsph_run():
+    """A free square block whose two middle particles start 0.2 dp apart (the reference configuration itself, so
+    TLSPH sees no strain there): without self-contact they stay crowded, with it they part to about r_c."""
+    from refsph.material import ElasticMaterial
+    from refsph.scenes.base import Setup
+    from refsph.simulate import simulate
+    from refsph.state import make_state
+    dp = 1e-4
+    g = np.arange(8) * dp
+    x = np.stack(np.meshgrid(g, g), -1).reshape(-1, 2)
+    a, b = 3 * 8 + 3, 3 * 8 + 4
+    x[a, 0] += 0.4 * dp
+    x[b, 0] -= 0.4 * dp
+    mat = ElasticMaterial(rho0=7800.0, E=2.0e11, nu=0.3)
+    gaps = {}
+    for sc in (None, 0.5):
+        state = make_state(x, [0.0, 0.0], mat.rho0, dp * dp)
+        setup = Setup(state=state, material=mat, dp=dp, t_end=40 * dp / mat.c_longitudinal, n_snapshots=1,
+                      numerics=Numerics(self_contact=sc, threads=1, ref_update_strain=None))
+        res = simulate(setup, "tlsph", progress=False)
+        gaps[sc] = np.linalg.norm(res.state.x[a] - res.state.x[b]) / dp
+    assert gaps[None] < 0.3
+    assert gaps[0.5] > 0.4

@@ -33,7 +33,8 @@ __all__ = ["reduced_modulus", "self_contact_forces"]
 
 
 def reduced_modulus(E: float, nu: float) -> float:
-    """E* = E / (2 (1 - nu^2)): the contact modulus of two bodies of one material (Hertz; K. L. Johnson, Contact Mechanics, 1985, ch. 4)."""
+    """E* = E / (2 (1 - nu^2)): the contact modulus of two bodies of one material (Hertz; K. L. Johnson, Contact
+    Mechanics, 1985, ch. 4)."""
     return E / (2.0 * (1.0 - nu * nu))
 
 

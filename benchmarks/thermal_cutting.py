@@ -337,6 +337,7 @@ def run_case(key: str, options: dict, numerics: dict, quick: bool = False) -> di
     restart = (out / "snapshots" / "restart.npz").exists()
     t0 = time.perf_counter()
     rec = dict(key=key, options=options, numerics=numerics, quick=quick)
+    res = None
     try:
         if numerics.get("method") == "pfem":
             from refsph.pfem_run import run_pfem
@@ -362,7 +363,7 @@ def run_case(key: str, options: dict, numerics: dict, quick: bool = False) -> di
                metrics={k: m[k] for k in KEEP if k in m},
                histories={k: _thin(m[k]) for k in ("cutting_force_history", "passive_force_history",
                                                      "temperature_history") if k in m})
-    if s.get("status") in ("ok", "blow-up") and numerics.get("method") != "pfem":
+    if getattr(res, "state", None) is not None and numerics.get("method") != "pfem":
         rec["crowding"] = crowding(res.state, s.get("dp"))
     rec["commits"] = run_commits(s.get("provenance") or {})       # the code that ran it (a restart: each part's)
     if s.get("heat_dissipation"):                                    # the ledger's dissipation split (newer runs)
@@ -823,7 +824,10 @@ def _values(r: dict) -> dict:
                cpu_min=(r.get("cpu_time_s") or math.nan) / 60.0,
                made=sum(hb.get(k, math.nan) for k in ("plastic_J", "friction_J", "dissipation_J")),
                residual=hb.get("residual_rel"),
-               ref_update=(r.get("numerics") or {}).get("ref_update_strain", SCENE_REF_UPDATE))
+               ref_update=(r.get("numerics") or {}).get("ref_update_strain", SCENE_REF_UPDATE),
+               self_contact=(r.get("numerics") or {}).get("self_contact"),
+               crowded_pct=100.0 * (r.get("crowding") or {}).get("fraction_below_half_dp", math.nan),
+               closest_dp=(r.get("crowding") or {}).get("min_distance_dp", math.nan))
     for key, name in (("cutting_force_N_per_m", "Fc"), ("passive_force_N_per_m", "Fp")):
         out[f"{name}_drift_pct"] = 100.0 * drift.get(key, math.nan) / m.get(key, math.nan)
     for key, name in (("rake_face_temperature_K", "TRF"), ("free_chip_surface_temperature_K", "TFCS")):
@@ -858,6 +862,13 @@ REF_RUNS = tuple(f"case {n}{COARSE}{REF_KEY}{r:g}" if r != SCENE_REF_UPDATE else
                  for n in (1, 10) for r in sorted(REF_UPDATES + (SCENE_REF_UPDATE,), reverse=True)) + tuple(
     k for n in (1, 10) for k in (f"case {n}", f"case {n}{REF_KEY}{REF_UPDATE:g}")) + (
     f"case 1{REF_KEY}{REF_UPDATE:g}{RETRY}",)
+# the 'selfcontact' study: case 1's scatter with self-contact (t_u/5, the seeds of SCATTER_T5) and the study's table
+SELF_SCATTER = tuple(f"case 1{COARSE}{SELF_KEY}" + k[len("case 1 n_tu 5"):] for k in SCATTER_T5[:3])
+SELF_RUNS = tuple(k for n in (1, 10) for k in (
+    f"case {n}{COARSE}", f"case {n}{COARSE}{RERUN}", f"case {n}{COARSE}{SELF_KEY}",
+    *(k2 for r in SELF_REF_UPDATES for k2 in (f"case {n}{COARSE}{REF_KEY}{r:g}",
+                                              f"case {n}{COARSE}{REF_KEY}{r:g}{SELF_KEY}")))) + (
+    "case 1", f"case 1{SELF_KEY}", f"case 1{REF_KEY}{REF_UPDATE:g}", f"case 1{REF_KEY}{REF_UPDATE:g}{SELF_KEY}")
 # the resolution study: case -> its runs at 5, 10 and 15 particles across t_u (at courant 0.15), and the scatter
 # groups that measure its run-to-run spread at t_u/5 and t_u/10 (the t_u/5 groups at the scene's courant 0.3)
 RESOLUTION_N = (5.0, 10.0, 15.0)
@@ -954,6 +965,14 @@ STUDIES = (
         ("viscosity + damping heat [% of work]", "dissipation_of_work", ".1f"), ("wall [s]", "wall", ".0f"))),
     (f"Run-to-run scatter at ref update {REF_UPDATE:g} (t_u/5, case 1, the same perturbation as at the scene's 0.5)",
      REF_SCATTER, BASIC),
+    ("Self-contact (Numerics.self_contact = 0.5: particles of the workpiece closer than dx/2 repel, "
+     "refsph.self_contact; off in the scene, as in the paper): each run without it (the record, and the record "
+     "made again with today's code, 'rerun') beside the same run with it; 'crowded': the workpiece's particles "
+     "with a neighbour closer than dx/2 at the end of the cut ('-' where the record predates the measure)",
+     SELF_RUNS, (("self contact", "self_contact", ".1f"), ("ref update", "ref_update", ".2f"),
+                 ("crowded [%]", "crowded_pct", ".1f"), ("closest pair [dx]", "closest_dp", ".2f")) + BASIC
+     + (("max T [K]", "max_temperature_K", ".0f"), ("wall [s]", "wall", ".0f"))),
+    ("Run-to-run scatter with self-contact (t_u/5, case 1, the same perturbation as without)", SELF_SCATTER, BASIC),
     ("Contact and heat split (case 1: penalty contact, half the frictional heat into the chip)",
      ("case 1", "case 1 pinball", "case 1 all friction heat to the chip"),
      BASIC + (("friction heat [% of work]", "friction_of_work", ".1f"),
@@ -1099,7 +1118,7 @@ def _change_cell(d: float, z: float = math.nan) -> str:
 
 
 # a scatter group -> the group it is compared with (_difference_line)
-COMPARED = {SCATTER_S2: SCATTER_T5, REF_SCATTER: SCATTER_T5}
+COMPARED = {SCATTER_S2: SCATTER_T5, REF_SCATTER: SCATTER_T5, SELF_SCATTER: SCATTER_T5}
 SINGLES = {SCATTER_KEYS: ("case 1 s/2", "case 1 heat every 8"), SCATTER_TI10: ("case 10 s/2",)}   # one run each
 # the 'refupdate' study's single runs, each against the scatter group of its resolution and material (at the
 # scene's reference update, or at REF_UPDATE for case 1 at t_u/5): which changes the scatter does not explain

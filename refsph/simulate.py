@@ -645,6 +645,11 @@ def _one_step(setup: Setup, parts: RunParts, rec: RunRecord, state: State, dt: f
             k = int(np.flatnonzero(~np.isfinite(state.T))[0])
             raise rec.fail("nan", f"non-finite T at particle {k} after the {p.name} step of step {rec.n_steps} "
                                   f"(t = {prev.t:.6e} s)", prev)
+    if setup.T_limit is not None and state.T is not None and np.max(state.T) > setup.T_limit:
+        k = int(np.argmax(state.T))
+        raise rec.fail("blow-up", f"particle {k} at {state.T[k]:.0f} K after step {rec.n_steps} (t = {state.t:.6e} s), "
+                                  f"over the scene's limit T_limit = {setup.T_limit:.0f} K: a local numerical blow-up",
+                       prev)
     if hook is not None:
         state = hook(state, parts.solver) or state
         if not (np.isfinite(state.v).all() and np.isfinite(state.x).all()):

@@ -213,3 +213,25 @@ def test_threads_change_speed_not_numbers(tmp_path, monkeypatch, method):
 def test_bad_thread_count():
     with pytest.raises(ValueError, match="threads"):
         run("bar", "esph", quick=True, progress=False, numerics={"threads": -1})
+
+
+def test_a_run_stops_when_a_particle_passes_the_setups_temperature_limit(tmp_path):
+    """Setup.T_limit: the run stops at the first step with a particle hotter than it (status 'blow-up', the
+    particle named, the last good state kept), instead of running on with a blown-up particle."""
+    from refsph.scenes.base import Numerics, Setup
+    from refsph.state import make_state
+    dp = 1e-4
+    g = np.arange(6) * dp
+    x = np.stack(np.meshgrid(g, g), -1).reshape(-1, 2)
+    mat = ElasticMaterial(rho0=7800.0, E=2.0e11, nu=0.3)
+    state = make_state(x, [0.0, 0.0], mat.rho0, dp * dp, T0=300.0)
+    state.T[7] = 900.0
+    setup = Setup(state=state, material=mat, dp=dp, t_end=20 * dp / mat.c_longitudinal, n_snapshots=1,
+                  numerics=Numerics(threads=1), T_limit=800.0)
+    with pytest.raises(SimulationError, match="particle 7 at 900 K after step 1 .*T_limit = 800 K"):
+        simulate(setup, "tlsph", progress=False, out=tmp_path / "run")
+    summary = json.loads((tmp_path / "run" / "summary.json").read_text())
+    assert summary["status"] == "blow-up" and summary["n_steps"] == 1
+    assert (tmp_path / "run" / "snapshots" / "last_good.npz").exists()
+    setup.T_limit = None
+    assert simulate(setup, "tlsph", progress=False).summary["status"] == "ok"

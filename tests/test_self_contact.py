@@ -80,3 +80,39 @@ def test_a_crowded_pair_is_pushed_apart_in_a_tlsph_run():
         gaps[sc] = np.linalg.norm(res.state.x[a] - res.state.x[b]) / dp
     assert gaps[None] < 0.3
     assert gaps[0.5] > 0.4
+
+
+def _bench():
+    import importlib.util
+    from pathlib import Path
+    spec = importlib.util.spec_from_file_location(
+        "bench_tc_sc", Path(__file__).resolve().parent.parent / "benchmarks" / "thermal_cutting.py")
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod
+
+
+def test_the_sweeps_crowding_measure_and_self_contact_study():
+    """benchmarks/thermal_cutting.py: ``crowding`` counts the workpiece's particles with a neighbour closer than
+    dp/2 (the tool's left out); every run of the 'selfcontact' study but the reruns has self_contact set, and each
+    rerun has the options and numerics of the record it repeats."""
+    from types import SimpleNamespace
+
+    from refsph.scenes.measure import TOOL_BODY
+    mod = _bench()
+    dp = 1e-5
+    g = np.arange(4) * dp
+    x = np.stack(np.meshgrid(g, g), -1).reshape(-1, 2)
+    x[5] = x[4] + [0.3 * dp, 0.0]                   # one crowded pair in the workpiece
+    body = np.zeros(16, dtype=int)
+    body[-2:] = TOOL_BODY
+    x[-1] = x[-2] + [0.1 * dp, 0.0]                 # a closer pair in the tool: not counted
+    c = mod.crowding(SimpleNamespace(x=x, body=body), dp)
+    assert c["fraction_below_half_dp"] == pytest.approx(2 / 14)
+    assert c["min_distance_dp"] == pytest.approx(0.3)
+    jobs = mod.self_contact_jobs()
+    for key, (options, numerics) in jobs.items():
+        if key.endswith(mod.RERUN):
+            assert mod.jobs(("coarse",))[key[:-len(mod.RERUN)]] == (options, numerics)
+        else:
+            assert numerics["self_contact"] == mod.SELF_CONTACT and mod.SELF_KEY in key

@@ -134,6 +134,8 @@ class Setup:
     ``dissipation_heat``: the numerical dissipation (TLSPH's artificial viscosity, the penalty contact's normal
     damping; ``Rates.heat_power``) becomes heat in the particle where it is taken from the motion, so that the
     tool's work ends up as heat (with a heat flow only; False: it leaves the energy balance, the paper's model).
+    ``T_limit`` [K]: the run stops (status 'blow-up', the last good state kept) when a particle gets hotter than
+    this, a temperature no material model of the scene means anything at (a local numerical blow-up); None: no limit.
     """
 
     state: State
@@ -154,6 +156,7 @@ class Setup:
     thermal: object = None
     friction_heat: object = None
     dissipation_heat: bool = False
+    T_limit: float | None = None
 
     def __post_init__(self):
         if self.strength is None:

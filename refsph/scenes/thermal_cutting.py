@@ -81,7 +81,7 @@ __all__ = ["SCENE", "MATERIALS", "tool_particles", "tool_shape", "mass_scale_for
            "drift", "thermal_cutting_metrics", "thermal_cutting_table", "STEADY_FROM"]
 
 STEADY_FROM = 0.75              # means over the last quarter of the cut
-BLOW_UP = 2.0                   # a particle above this multiple of T_melt [K] is a numerical blow-up (metrics)
+BLOW_UP = 2.0                   # a particle above this multiple of T_melt [K] is a numerical blow-up (Setup.T_limit)
 RAKE_DEG, CLEARANCE_DEG, EDGE_RADIUS = 10.0, 10.0, 10e-6
 MATERIALS = {"AISI1045": AISI1045_RLA, "Ti6Al4V": TI6AL4V_RLA}
 OPTIONS = {
@@ -235,7 +235,8 @@ def _build(dim, dp, quick, *, case, material, vc, tu, n_tu, travel, length, mass
                  dp=dx, numerics=numerics, t_end=travel * tu / vc, n_snapshots=8, info=info,
                  strength=_strength(mat, s), rigid=(body,),
                  clamps=(Clamp("held", held),), friction=mu if parse_bool(friction, "option friction") else None,
-                 thermal=thermal, friction_heat=friction_heat, dissipation_heat=heat_of_dissipation)
+                 thermal=thermal, friction_heat=friction_heat, dissipation_heat=heat_of_dissipation,
+                 T_limit=BLOW_UP * mat["T_melt_K"])
 
 
 def rake_frame(x: np.ndarray, t: float, info: dict) -> tuple[np.ndarray, np.ndarray]:

@@ -365,6 +365,9 @@ def run_case(key: str, options: dict, numerics: dict, quick: bool = False) -> di
                                                      "temperature_history") if k in m})
     if getattr(res, "state", None) is not None and numerics.get("method") != "pfem":
         rec["crowding"] = crowding(res.state, s.get("dp"))
+    last_good = out / "snapshots" / "last_good.npz"
+    if s.get("status") != "ok" and last_good.exists() and numerics.get("method") != "pfem":
+        rec["failure_site"] = failure_site(last_good, s.get("dp"), 2.0 * s.get("h"))
     rec["commits"] = run_commits(s.get("provenance") or {})       # the code that ran it (a restart: each part's)
     if s.get("heat_dissipation"):                                    # the ledger's dissipation split (newer runs)
         rec["heat_dissipation"] = s["heat_dissipation"]
@@ -380,6 +383,23 @@ def crowding(state, dp: float) -> dict:
     x = state.x[state.body != TOOL_BODY]
     d = cKDTree(x).query(x, k=2)[0][:, 1] / dp
     return dict(fraction_below_half_dp=float(np.mean(d < 0.5)), min_distance_dp=float(d.min()))
+
+
+def failure_site(path: Path, dp: float, support: float) -> dict:
+    """Where a failed SPH run broke, from its last good state: the hottest workpiece particle, its temperature, how
+    many particles lie within the kernel's support of it in the reference configuration (X: its reference
+    neighbours; about 20 inside the body at h = 1.3 dp) and now (x), and its nearest neighbour [dp]."""
+    from scipy.spatial import cKDTree
+    from refsph.scenes.measure import TOOL_BODY
+    with np.load(path) as z:
+        work = z["body"] != TOOL_BODY
+        x, X, T, v = z["x"][work], z["X"][work], z["T"][work], z["v"][work]
+    k = int(np.argmax(T))
+    near = cKDTree(x).query(x[k], k=2)[0][1]
+    return dict(particle=k, T_K=float(T[k]), speed_m_s=float(np.linalg.norm(v[k])),
+                reference_neighbours=len(cKDTree(X).query_ball_point(X[k], support)) - 1,
+                current_neighbours=len(cKDTree(x).query_ball_point(x[k], support)) - 1,
+                nearest_dp=float(near / dp))
 
 
 def _thin(a, n: int = 100) -> list:

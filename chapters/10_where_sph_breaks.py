@@ -270,6 +270,27 @@ print(f"{len(runs)} runs; failed: ESPH {failed['esph']}, TLSPH {failed['tlsph']}
 # A run whose settings the map shows failing warns when it starts (`refsph.stability`): the warning names the case
 # that failed and the remedy.
 #
+# ## 6. Pairs in a chip: self-contact
+#
+# SECTION6_TEXT
+
+# %%
+tc = json.loads((repository_root() / "benchmarks" / "thermal_cutting.json").read_text())["runs"]
+print(f"{'run (t_u/5 unless t_u/10)':46} {'status':8} {'closest pair':>12} {'crowded':>8} {'Fc':>6} {'T_RF':>5}")
+for n in (1, 10):
+    for upd in ("", " ref update 0.2", " ref update 0.1", " ref update 0.02"):
+        for sc in ("", " self contact"):
+            key = f"case {n} n_tu 5{upd}{sc}" if upd or sc else f"case {n} n_tu 5 rerun"
+            r = tc.get(key)
+            if r is None:
+                continue
+            m, c = r.get("metrics") or {}, r.get("crowding") or {}
+            print(f"{key:46} {r['status']:8} {c.get('min_distance_dp', np.nan):9.3f} dp {100 * c.get('fraction_below_half_dp', np.nan):7.0f} % "
+                  f"{1e-3 * m.get('cutting_force_N_per_m', np.nan):6.0f} {m.get('rake_face_temperature_K', np.nan):5.0f}")
+
+# %% [markdown]
+# SECTION6_AFTER
+#
 # ## Where it fails
 #
 # * Every remedy is a numerical device with a free constant ($\gamma$, $\alpha$, $\beta$); none is derived from

@@ -355,7 +355,7 @@ display(Markdown(split_page.split("\n\n", 1)[1]))             # the page without
 #   inverts at 1.1 ms, and in case 2 two particles of the chip's free surface oscillate against each other until
 #   their artificial viscosity heats the chip past 1500 K. The step $C h/(c_L + |v|_{max})$ leaves out the
 #   viscosity's own signal speed; at 0.15 both run, and the sweep uses 0.15 at $t_u/10$ (the page's time-step
-#   study). A particle above twice the melting temperature marks a run 'blow-up', never 'ok'.
+#   study). A particle above twice the melting temperature stops the run as 'blow-up' (`Setup.T_limit`).
 #
 # ## Your turn
 #

@@ -116,3 +116,26 @@ def test_the_sweeps_crowding_measure_and_self_contact_study():
             assert mod.jobs(("coarse",))[key[:-len(mod.RERUN)]] == (options, numerics)
         else:
             assert numerics["self_contact"] == mod.SELF_CONTACT and mod.SELF_KEY in key
+
+
+def test_the_sweeps_failure_site(tmp_path):
+    """benchmarks/thermal_cutting.py's ``failure_site``: the hottest workpiece particle of a last good state (the
+    tool's left out), with its reference and current neighbours within the support and its nearest neighbour."""
+    from refsph.scenes.measure import TOOL_BODY
+    mod = _bench()
+    dp = 1e-5
+    g = np.arange(5) * dp
+    X = np.stack(np.meshgrid(g, g), -1).reshape(-1, 2)
+    x = X.copy()
+    x[24] += [3 * dp, 0.0]                          # the corner particle, torn off
+    T = np.full(25, 300.0)
+    T[24] = 5000.0
+    body = np.zeros(25, dtype=int)
+    xt = np.array([[9 * dp, 4 * dp]])               # a tool particle next to it, hotter still: not counted
+    np.savez(tmp_path / "last_good.npz", x=np.vstack([x, xt]), X=np.vstack([X, xt]), T=np.append(T, 9000.0),
+             v=np.zeros((26, 2)), body=np.append(body, TOOL_BODY))
+    site = mod.failure_site(tmp_path / "last_good.npz", dp, 1.5 * dp)
+    assert site["particle"] == 24 and site["T_K"] == 5000.0
+    assert site["reference_neighbours"] == 3         # (3, 4), (4, 3), (3, 3) within 1.5 dp of (4, 4)
+    assert site["current_neighbours"] == 0
+    assert site["nearest_dp"] == pytest.approx(np.sqrt(10.0))     # (4, 3) from (7, 4)

@@ -237,6 +237,9 @@ def reference_update_jobs() -> dict:
     for seed in (1, 2):
         out[f"case 1{COARSE}{REF_KEY}{REF_UPDATE:g} jitter {seed}"] = (
             converged(1, n_tu=5.0, jitter=0.01, seed=seed), dict(ref_update_strain=REF_UPDATE))
+    for n, r in ((10, 0.2), (1, 0.02)):                      # the two that failed at t_u/5, at half the step
+        out[f"case {n}{COARSE}{REF_KEY}{r:g} courant {COURANT:g}"] = (converged(n, n_tu=5.0),
+                                                                      dict(ref_update_strain=r, courant=COURANT))
     for n in (1, 10):
         out[f"case {n}{REF_KEY}{REF_UPDATE:g}"] = (converged(n), sweep_numerics(ref_update_strain=REF_UPDATE))
     # case 1's failed at 0.93 of 1.6 ms; replayed, its trouble starts at 0.81 ms, where two chip-surface particles
@@ -265,6 +268,9 @@ def self_contact_jobs() -> dict:
     for seed in (1, 2):
         out[f"case 1{COARSE}{SELF_KEY} jitter {seed}"] = (converged(1, n_tu=5.0, jitter=0.01, seed=seed), dict(sc))
     out[f"case 1{SELF_KEY}"] = (converged(1), sweep_numerics(**sc))
+    # case 10's at the scene's step blew up at 1.22 ms (a hot particle with 4 reference neighbours after an
+    # update, thrown to 28 m/s in 5 steps): again at half the step, the sweep's at t_u/10
+    out[f"case 10{COARSE}{SELF_KEY} courant {COURANT:g}"] = (converged(10, n_tu=5.0), dict(sc, courant=COURANT))
     return out
 
 
@@ -881,11 +887,13 @@ REF_SCATTER = tuple(f"case 1{COARSE}{REF_KEY}{REF_UPDATE:g}" + k[len("case 1 n_t
 REF_RUNS = tuple(f"case {n}{COARSE}{REF_KEY}{r:g}" if r != SCENE_REF_UPDATE else f"case {n}{COARSE}"
                  for n in (1, 10) for r in sorted(REF_UPDATES + (SCENE_REF_UPDATE,), reverse=True)) + tuple(
     k for n in (1, 10) for k in (f"case {n}", f"case {n}{REF_KEY}{REF_UPDATE:g}")) + (
-    f"case 1{REF_KEY}{REF_UPDATE:g}{RETRY}",)
+    f"case 1{REF_KEY}{REF_UPDATE:g}{RETRY}",) + tuple(
+    f"case {n}{COARSE}{REF_KEY}{r:g} courant {COURANT:g}" for n, r in ((10, 0.2), (1, 0.02)))
 # the 'selfcontact' study: case 1's scatter with self-contact (t_u/5, the seeds of SCATTER_T5) and the study's table
 SELF_SCATTER = tuple(f"case 1{COARSE}{SELF_KEY}" + k[len("case 1 n_tu 5"):] for k in SCATTER_T5[:3])
 SELF_RUNS = tuple(k for n in (1, 10) for k in (
     f"case {n}{COARSE}", f"case {n}{COARSE}{RERUN}", f"case {n}{COARSE}{SELF_KEY}",
+    *((f"case {n}{COARSE} courant {COURANT:g}", f"case {n}{COARSE}{SELF_KEY} courant {COURANT:g}") if n == 10 else ()),
     *(k2 for r in SELF_REF_UPDATES for k2 in (f"case {n}{COARSE}{REF_KEY}{r:g}",
                                               f"case {n}{COARSE}{REF_KEY}{r:g}{SELF_KEY}")))) + (
     "case 1", f"case 1{SELF_KEY}", f"case 1{REF_KEY}{REF_UPDATE:g}", f"case 1{REF_KEY}{REF_UPDATE:g}{SELF_KEY}")

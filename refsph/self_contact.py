@@ -4,11 +4,12 @@ r_c (not in the paper; an option, off by default).
 Why. TLSPH's forces come from the deformation gradient F of Eq. (18), a kernel-weighted average over each
 particle's reference neighbours. Two neighbours can approach each other without changing any particle's F much
 (a zero-energy mode of the particle sum, as hourglassing is), and after a reference update (X <- x) the crowded
-pair is the new reference and nothing pushes it apart. In the cutting scenes this pairs particles in the chip:
-at ``ref_update_strain`` 0.5 about a third of the workpiece's particles of ``thermal_cutting`` case 10 (dx = t_u/5)
-have a neighbour closer than dx/2 by the end of the cut, some closer than dx/100; with frequent updates (0.2,
-0.02) such pairs end in a particle thrown off at tens of m/s and a local blow-up
-(``benchmarks/registered_strain.py``, ``benchmarks/thermal_cutting.py``'s self-contact study).
+pair is the new reference and nothing pushes it apart. In the cutting scenes the chip's particles pair up: at the
+scene's ``ref_update_strain`` 0.5, 27-31 % of the workpiece's particles of ``thermal_cutting`` cases 1 and 10 at
+dx = t_u/5 end the cut with a neighbour closer than dx/2, the closest pair at 0.01-0.03 dx (the sweep's
+'selfcontact' study, ``benchmarks/thermal_cutting_report.md``). Self-contact holds every pair at about 0.46 dx.
+It does not cure the cuts' blow-ups, which start elsewhere: at a hot particle left with few reference neighbours by
+an update (chapter 10, section 6).
 
 What. LAMMPS's SMD package (Ganzenmueller's Smooth Mach Dynamics, ``pair_style smd/hertz``) gives particles of
 one body that are SPH neighbours a Hertzian contact at half the contact diameter; refsph does the same with the

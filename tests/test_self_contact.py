@@ -113,7 +113,7 @@ def test_the_sweeps_crowding_measure_and_self_contact_study():
     jobs = mod.self_contact_jobs()
     for key, (options, numerics) in jobs.items():
         if key.endswith(mod.RERUN):
-            assert mod.jobs(("coarse",))[key[:-len(mod.RERUN)]] == (options, numerics)
+            assert mod.jobs()[key[:-len(mod.RERUN)]] == (options, numerics)
         else:
             assert numerics["self_contact"] == mod.SELF_CONTACT and mod.SELF_KEY in key
 

@@ -102,6 +102,7 @@ REF_KEY = " ref update "                   # the 'refupdate' study's key part: T
 REF_UPDATES = (1.5, 0.2, 0.1, 0.05, 0.02)  # 0.5) at these values at t_u/5 (reference_update_jobs) ...
 REF_UPDATE = 0.1                           # ... and at this one at t_u/10 and for the scatter
 SCENE_REF_UPDATE = 0.5                     # the scene's (refsph.scenes.thermal_cutting; a test holds them equal)
+HALF_STEP = f"{REF_KEY}{REF_UPDATE:g} courant {COURANT:g}"   # the 18 cuts at t_u/5 at REF_UPDATE and half the step
 SELF_KEY = " self contact"                 # the 'selfcontact' study's key part: Numerics.self_contact at SELF_CONTACT
 SELF_CONTACT = 0.5                         # (refsph.self_contact: LAMMPS SMD's r_c = dp/2), self_contact_jobs
 SELF_REF_UPDATES = (0.2, 0.1, 0.02)        # ... with these reference updates too (the refupdate study's failures)
@@ -237,6 +238,9 @@ def reference_update_jobs() -> dict:
     for seed in (1, 2):
         out[f"case 1{COARSE}{REF_KEY}{REF_UPDATE:g} jitter {seed}"] = (
             converged(1, n_tu=5.0, jitter=0.01, seed=seed), dict(ref_update_strain=REF_UPDATE))
+    for n in range(1, 19):                                   # the 18 cuts at t_u/5 at REF_UPDATE and half the step
+        out[f"case {n}{COARSE}{HALF_STEP}"] = (converged(n, n_tu=5.0),
+                                               dict(ref_update_strain=REF_UPDATE, courant=COURANT))
     for n, r in ((10, 0.2), (1, 0.02)):                      # the two that failed at t_u/5, at half the step
         out[f"case {n}{COARSE}{REF_KEY}{r:g} courant {COURANT:g}"] = (converged(n, n_tu=5.0),
                                                                       dict(ref_update_strain=r, courant=COURANT))
@@ -994,6 +998,11 @@ STUDIES = (
      REF_RUNS, (("ref update", "ref_update", ".2f"),) + BASIC
      + (("plastic heat [% of work]", "plastic_of_work", ".1f"),
         ("viscosity + damping heat [% of work]", "dissipation_of_work", ".1f"), ("wall [s]", "wall", ".0f"))),
+    (f"The 18 cuts at t_u/5 at ref update {REF_UPDATE:g} and half the step (Courant 0.15; the 'coarse' table's at the "
+     "scene's 0.5 and 0.3): at 0.3 the SPH cuts' blow-ups come by chance at every threshold, at 0.15 none of the "
+     "four tried failed (the self-contact tables below)",
+     tuple(f"case {n}{COARSE}{HALF_STEP}" for n in range(1, 19)),
+     BASIC + (("max T [K]", "max_temperature_K", ".0f"), ("wall [s]", "wall", ".0f"))),
     (f"Run-to-run scatter at ref update {REF_UPDATE:g} (t_u/5, case 1, the same perturbation as at the scene's 0.5)",
      REF_SCATTER, BASIC),
     ("Self-contact (Numerics.self_contact = 0.5: particles of the workpiece closer than dx/2 repel, "

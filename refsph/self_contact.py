@@ -7,9 +7,9 @@ particle's reference neighbours. Two neighbours can approach each other without 
 pair is the new reference and nothing pushes it apart. In the cutting scenes the chip's particles pair up: at the
 scene's ``ref_update_strain`` 0.5, 27-31 % of the workpiece's particles of ``thermal_cutting`` cases 1 and 10 at
 dx = t_u/5 end the cut with a neighbour closer than dx/2, the closest pair at 0.01-0.03 dx (the sweep's
-'selfcontact' study, ``benchmarks/thermal_cutting_report.md``). Self-contact holds every pair at about 0.46 dx.
-It does not cure the cuts' blow-ups, which start elsewhere: at a hot particle left with few reference neighbours by
-an update (chapter 10, section 6).
+'selfcontact' study, ``benchmarks/thermal_cutting_report.md``). Self-contact holds every pair at about 0.46 dx
+(and case 1's chip 29 % thicker), but it does not make the cuts safer: their blow-ups are a time-step instability,
+which half the step cured in the four cuts tried (chapter 10, section 6).
 
 What. LAMMPS's SMD package (Ganzenmueller's Smooth Mach Dynamics, ``pair_style smd/hertz``) gives particles of
 one body that are SPH neighbours a Hertzian contact at half the contact diameter; refsph does the same with the
@@ -22,7 +22,7 @@ of the same deformable body at distance r < r_c, overlap delta = r_c - r, along 
 
 f_ji = -f_ij, so momentum is conserved; the force has a potential, so it makes no heat. The 2D law is a penalty
 with the reduced modulus as its stiffness (Hertz's line contact has no closed force-overlap law without a length
-scale); its spring, with the particle's mass m = rho dp^2, has omega dt = sqrt(2 E* / (rho dp^2)) dt, about 0.3 at
+scale); its spring, with the particle's mass m = rho dp^2, has omega dt = sqrt(2 E* / (rho dp^2)) dt, about 0.35 at
 the scenes' CFL steps, well inside the leapfrog's limit of 2.
 """
 from __future__ import annotations

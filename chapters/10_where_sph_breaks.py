@@ -304,13 +304,13 @@ for key in [f"case {n} n_tu 5 {x}" for n in (1, 10) for x in (
 
 # %% [markdown]
 # Without self-contact a quarter to a third of the workpiece's particles end the cut paired at the scene's
-# threshold, fewer with frequent updates. With it no pair comes closer than 0.46 dp, yet the cuts do not run more
-# safely: at the scene's step (Courant 0.3) 4 of 10 cuts with it failed, against 3 of 14 without. The one traced
+# threshold, fewer with frequent updates. With it no pair comes closer than 0.45 dp, yet the cuts do not run more
+# safely: at the scene's step (Courant 0.3), of the 8 configurations run both ways, 4 failed with it and 3 without. The one traced
 # (case 10 at 0.5) broke where an update left a particle at 1858 K (Ti6Al4V melts at 1877 K) with 4 reference
 # neighbours instead of about 20: in five steps it went from 0.06 to 28 m/s. At half the step that cut and the two
-# failed cuts without self-contact (case 10 at 0.2, case 1 at 0.02) ran to the end: the blow-ups are a time-step
-# instability, and the step is their cure, not the contact (at $t_u/10$, at half the step already, case 1 at 0.1
-# ran to the end with self-contact where it had failed without: one run each). The step rule $C h/(c_L + |v|_{max})$ leaves the
+# failed cuts without self-contact (case 10 at 0.2, case 1 at 0.02) ran to the end, one run each: the blow-ups look
+# mainly like a time-step instability, with the step as the cure rather than the contact. Not only: at $t_u/10$,
+# at half the step already, case 1 at 0.1 failed without self-contact (and ran to the end with it). The step rule $C h/(c_L + |v|_{max})$ leaves the
 # artificial viscosity's own signal speed out, and mass scaling brings $c_L$ down to 305 m/s in case 1 and 45 m/s
 # in case 10, where the traced particle's 28 m/s is not small beside it.
 

@@ -5,11 +5,11 @@ Why. TLSPH's forces come from the deformation gradient F of Eq. (18), a kernel-w
 particle's reference neighbours. Two neighbours can approach each other without changing any particle's F much
 (a zero-energy mode of the particle sum, as hourglassing is), and after a reference update (X <- x) the crowded
 pair is the new reference and nothing pushes it apart. In the cutting scenes the chip's particles pair up: at the
-scene's ``ref_update_strain`` 0.5, 27-31 % of the workpiece's particles of ``thermal_cutting`` cases 1 and 10 at
-dx = t_u/5 end the cut with a neighbour closer than dx/2, the closest pair at 0.01-0.03 dx (the sweep's
-'selfcontact' study, ``benchmarks/thermal_cutting_report.md``). Self-contact holds every pair at about 0.46 dx
-(and case 1's chip 29 % thicker), but it does not make the cuts safer: their blow-ups are a time-step instability,
-which half the step cured in the four cuts tried (chapter 10, section 6).
+scene's ``ref_update_strain`` 0.5, 29-31 % of the workpiece's particles of ``thermal_cutting`` cases 1 and 10 at
+dx = t_u/5 end the cut with a neighbour closer than dx/2, the closest pair at 0.01-0.015 dx (the sweep's
+'selfcontact' study, ``benchmarks/thermal_cutting_report.md``). Self-contact holds every pair at 0.45 dx or more
+(and case 1's chip 29 % thicker), but it does not make the cuts safer: their blow-ups look mainly like a time-step
+instability; half the step ran each of the four failed cuts tried to the end (chapter 10, section 6).
 
 What. LAMMPS's SMD package (Ganzenmueller's Smooth Mach Dynamics, ``pair_style smd/hertz``) gives particles of
 one body that are SPH neighbours a Hertzian contact at half the contact diameter; refsph does the same with the

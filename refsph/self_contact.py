@@ -20,17 +20,17 @@ of the same deformable body at distance r < r_c, overlap delta = r_c - r, along 
     2D (per unit thickness, a linear spring):  f_ij = E* delta e_ij
     E* = E / (2 (1 - nu^2))                    (the reduced modulus of two bodies of one material)
 
-f_ji = -f_ij, so momentum is conserved; the force has a potential, so it makes no heat. The 2D law is a penalty
-with the reduced modulus as its stiffness (Hertz's line contact has no closed force-overlap law without a length
-scale); its spring, with the particle's mass m = rho dp^2, has omega dt = sqrt(2 E* / (rho dp^2)) dt, about 0.35 at
-the scenes' CFL steps, well inside the leapfrog's limit of 2.
+Pairs across symmetry planes are not included. f_ji = -f_ij, so momentum is conserved; the force has a potential, so
+it makes no heat. The 2D law is a penalty with the reduced modulus as its stiffness (Hertz's line contact has no
+closed force-overlap law without a length scale); its spring, with the particle's mass m = rho dp^2, has omega dt =
+sqrt(2 E* / (rho dp^2)) dt, about 0.35 at the scenes' CFL steps, well inside the leapfrog's limit of 2.
 """
 from __future__ import annotations
 
 import numpy as np
 from scipy.spatial import cKDTree
 
-__all__ = ["reduced_modulus", "self_contact_forces"]
+__all__ = ["reduced_modulus", "self_contact_forces", "self_contact_acceleration", "contact_distance"]
 
 
 def reduced_modulus(E: float, nu: float) -> float:
@@ -59,3 +59,18 @@ def self_contact_forces(x: np.ndarray, body: np.ndarray | None, r_c: float, E_st
     for k in range(dim):
         f[:, k] = np.bincount(i, f_ij[:, k], n) - np.bincount(j, f_ij[:, k], n)
     return f
+
+
+def self_contact_acceleration(body, r_c: float, material, several_bodies: bool) -> np.ndarray:
+    """dv/dt of the self-contact on the deformable rows ``body`` (a State): :func:`self_contact_forces` / m, with
+    the reduced modulus of ``material`` (E, nu); ``several_bodies``: pairs only within each body's own ids."""
+    f = self_contact_forces(body.x, body.body if several_bodies else None, r_c,
+                            reduced_modulus(material.E, material.nu))
+    return f / body.m[:, None]
+
+
+def contact_distance(r_c: float | None) -> float | None:
+    """The self-contact distance r_c [m] checked: a finite number > 0, or None (off); ValueError otherwise."""
+    if r_c is not None and not (np.isfinite(r_c) and r_c > 0.0):
+        raise ValueError(f"self_contact is the self-contact distance r_c [m] (> 0, or None), got {r_c!r}")
+    return r_c

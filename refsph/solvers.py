@@ -30,7 +30,7 @@ from .material import ElasticMaterial, eos_pressure
 from .neighbours import PairBlocks, VerletList, check_threads
 from .penalty import PenaltyContact
 from .reference import ReferenceConfiguration, with_identity
-from .self_contact import reduced_modulus, self_contact_forces
+from .self_contact import contact_distance, self_contact_acceleration
 from .state import Rates, State
 from .strength import Elastic, StrengthModel, check_strength_fields, strength_stage
 from .tensor import det
@@ -215,11 +215,9 @@ class TLSPHSolver(SolverBase):
     (:class:`~refsph.reference.ReferenceConfiguration`). With symmetry planes the ghosts are the mirror images of
     the reference configuration (fixed with the operator); a ghost's F is the mirror image of its source's. With
     rigid bodies the operator covers the deformable rows only, and the bodies meet through the ``contact``: the
-    pinball (a :class:`~refsph.contact.PinballContact`, :class:`~refsph.coupling.PinballCoupling`; ``dp`` gives the
-    2D force per unit thickness) or, with the tools, the penalty contact on their exact geometry (a
-    :class:`~refsph.penalty.PenaltyContact`, :class:`~refsph.coupling.PenaltyCoupling`). ``self_contact``: the
-    distance r_c [m] below which two particles of one body repel (:mod:`refsph.self_contact`; None: off, as in the
-    paper; pairs across symmetry planes are not included)."""
+    pinball (:class:`~refsph.contact.PinballContact`, :class:`~refsph.coupling.PinballCoupling`; ``dp``: 2D force
+    per unit thickness) or the tools' penalty contact (:class:`~refsph.penalty.PenaltyContact`,
+    :class:`~refsph.coupling.PenaltyCoupling`). ``self_contact``: r_c [m] of :mod:`refsph.self_contact` (None: off)."""
 
     method = "tlsph"
     evolved = ("x", "v", "S", "S_zz")
@@ -229,9 +227,7 @@ class TLSPHSolver(SolverBase):
                  contact: PinballContact | PenaltyContact | None = None, dp: float | None = None, threads: int = 1,
                  self_contact: float | None = None):
         super().__init__(material, params, strength, mirror, Constraints(walls, rigid, clamps, mirror), threads)
-        if self_contact is not None and not (np.isfinite(self_contact) and self_contact > 0.0):
-            raise ValueError(f"self_contact is the self-contact distance r_c [m] (> 0, or None), got {self_contact!r}")
-        self.self_contact = self_contact
+        self.self_contact = contact_distance(self_contact)
         if self.constraints.rigid and contact is None:
             raise ValueError("TLSPH with rigid bodies needs a contact model (PinballContact or PenaltyContact)")
         self.contact = contact
@@ -293,9 +289,7 @@ class TLSPHSolver(SolverBase):
         if part != "deformation" and self.several_bodies:
             r.v = r.v + self.coupling.between_bodies(body, self.constraints.deformable_bodies, dt)
         if part != "deformation" and self.self_contact is not None:
-            f = self_contact_forces(body.x, body.body if self.several_bodies else None, self.self_contact,
-                                    reduced_modulus(self.material.E, self.material.nu))
-            r.v = r.v + f / body.m[:, None]
+            r.v = r.v + self_contact_acceleration(body, self.self_contact, self.material, self.several_bodies)
         if body is not state:
             r = self._with_rigid(state, r, dt, contact=part != "deformation")
         return self.constraints.constrain(state, r, record=part != "deformation")

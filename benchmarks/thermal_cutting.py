@@ -895,6 +895,7 @@ REF_RUNS = tuple(f"case {n}{COARSE}{REF_KEY}{r:g}" if r != SCENE_REF_UPDATE else
     k for n in (1, 10) for k in (f"case {n}", f"case {n}{REF_KEY}{REF_UPDATE:g}")) + (
     f"case 1{REF_KEY}{REF_UPDATE:g}{RETRY}",) + tuple(
     f"case {n}{COARSE}{REF_KEY}{r:g} courant {COURANT:g}" for n, r in ((10, 0.2), (1, 0.02)))
+HALF_STEP_RUNS = tuple(f"case {n}{COARSE}{HALF_STEP}" for n in range(1, 19))
 # the 'selfcontact' study: case 1's scatter with self-contact (t_u/5, the seeds of SCATTER_T5) and the study's table
 SELF_SCATTER = tuple(f"case 1{COARSE}{SELF_KEY}" + k[len("case 1 n_tu 5"):] for k in SCATTER_T5[:3])
 SELF_RUNS = tuple(k for n in (1, 10) for k in (
@@ -1001,8 +1002,7 @@ STUDIES = (
     (f"The 18 cuts at t_u/5 at ref update {REF_UPDATE:g} and half the step (Courant 0.15; the 'coarse' table's at the "
      "scene's 0.5 and 0.3): at 0.3 the SPH cuts' blow-ups come by chance at every threshold, at 0.15 none of the "
      "four tried failed (the self-contact tables below)",
-     tuple(f"case {n}{COARSE}{HALF_STEP}" for n in range(1, 19)),
-     BASIC + (("max T [K]", "max_temperature_K", ".0f"), ("wall [s]", "wall", ".0f"))),
+     HALF_STEP_RUNS, BASIC + (("max T [K]", "max_temperature_K", ".0f"), ("wall [s]", "wall", ".0f"))),
     (f"Run-to-run scatter at ref update {REF_UPDATE:g} (t_u/5, case 1, the same perturbation as at the scene's 0.5)",
      REF_SCATTER, BASIC),
     ("Self-contact (Numerics.self_contact = 0.5: particles of the workpiece closer than dx/2 repel, "
@@ -1058,7 +1058,40 @@ def _study_lines(res: dict) -> list[str]:
             lines += _resolution_lines(res)
         if keys == REF_RUNS:
             lines += [_single_run_line(res, k, group) for group, singles in REF_SINGLES for k in singles]
+        if keys == HALF_STEP_RUNS:
+            lines += ["", _half_step_errors(res)]
     return lines
+
+
+def _half_step_errors(res: dict) -> str:
+    """Mean |error| against the measurements of T_RF, T_FCS and Fp/Fc per material over the cases the half-step
+    group has recorded 'ok', beside the 'coarse' table's (0.5, Courant 0.3) over the same cases."""
+    runs, parts = res["runs"], []
+    for material in ("AISI1045", "Ti6Al4V"):
+        errs = {}
+        for suffix, name in ((HALF_STEP, "here"), ("", "coarse")):
+            rows = []
+            for n in (n for n in range(1, 19) if _both_ok(runs, n, material)):
+                m = runs[f"case {n}{COARSE}{suffix}"]["metrics"]
+                meas = m["measured"]
+                rows.append([abs(m["rake_face_temperature_K"] / meas["T_RF_K"] - 1),
+                             abs(m["free_chip_surface_temperature_K"] / meas["T_FCS_K"] - 1),
+                             abs(m["force_ratio"] / meas["force_ratio"] - 1)])
+            errs[name] = 100 * np.mean(rows, axis=0) if rows else None
+        if errs["here"] is not None:
+            h, c = errs["here"], errs["coarse"]
+            parts.append(f"{material} ({sum(_both_ok(runs, n, material) for n in range(1, 19))} cases): "
+                         f"T_RF {h[0]:.1f} % (coarse {c[0]:.1f} %), T_FCS {h[1]:.1f} % ({c[1]:.1f} %), "
+                         f"Fp/Fc {h[2]:.1f} % ({c[2]:.1f} %)")
+    return ("Mean |error| against the measurements over the cases recorded here, beside the 'coarse' table's on the "
+            "same cases: " + ("; ".join(parts) if parts else "none recorded yet") + ".")
+
+
+def _both_ok(runs: dict, n: int, material: str) -> bool:
+    """Case ``n`` of ``material`` recorded 'ok' both in the half-step group and in the 'coarse' table."""
+    r, base = runs.get(f"case {n}{COARSE}{HALF_STEP}"), runs.get(f"case {n}{COARSE}")
+    return bool(r and base and r.get("status") == base.get("status") == "ok"
+                and r["scene_info"]["material"] == material)
 
 
 def resolution_convergence(res: dict) -> list[dict]:

@@ -375,11 +375,13 @@ def run_case(key: str, options: dict, numerics: dict, quick: bool = False) -> di
                metrics={k: m[k] for k in KEEP if k in m},
                histories={k: _thin(m[k]) for k in ("cutting_force_history", "passive_force_history",
                                                      "temperature_history") if k in m})
-    if getattr(res, "state", None) is not None and numerics.get("method") != "pfem":
-        rec["crowding"] = crowding(res.state, s.get("dp"))
-    last_good = out / "snapshots" / "last_good.npz"
-    if s.get("status") != "ok" and last_good.exists() and numerics.get("method") != "pfem":
-        rec["failure_site"] = failure_site(last_good, s.get("dp"), 2.0 * s.get("h"))
+    if numerics.get("method") != "pfem":                            # how the SPH particles ended, where they broke
+        last_good = out / "snapshots" / "last_good.npz"
+        if getattr(res, "state", None) is not None:
+            rec["crowding"] = crowding(res.state, s.get("dp"))
+        if s.get("status") != "ok" and last_good.exists():
+            from refsph.kernels import get_kernel
+            rec["failure_site"] = failure_site(last_good, s["dp"], get_kernel(s["numerics"]["kernel"]).support * s["h"])
     rec["commits"] = run_commits(s.get("provenance") or {})       # the code that ran it (a restart: each part's)
     if s.get("heat_dissipation"):                                    # the ledger's dissipation split (newer runs)
         rec["heat_dissipation"] = s["heat_dissipation"]
@@ -406,12 +408,11 @@ def failure_site(path: Path, dp: float, support: float) -> dict:
     with np.load(path) as z:
         work = z["body"] != TOOL_BODY
         x, X, T, v = z["x"][work], z["X"][work], z["T"][work], z["v"][work]
-    k = int(np.argmax(T))
-    near = cKDTree(x).query(x[k], k=2)[0][1]
+    k, now = int(np.argmax(T)), cKDTree(x)
     return dict(particle=k, T_K=float(T[k]), speed_m_s=float(np.linalg.norm(v[k])),
                 reference_neighbours=len(cKDTree(X).query_ball_point(X[k], support)) - 1,
-                current_neighbours=len(cKDTree(x).query_ball_point(x[k], support)) - 1,
-                nearest_dp=float(near / dp))
+                current_neighbours=len(now.query_ball_point(x[k], support)) - 1,
+                nearest_dp=float(now.query(x[k], k=2)[0][1] / dp))
 
 
 def _thin(a, n: int = 100) -> list:
@@ -1065,33 +1066,20 @@ def _study_lines(res: dict) -> list[str]:
 
 def _half_step_errors(res: dict) -> str:
     """Mean |error| against the measurements of T_RF, T_FCS and Fp/Fc per material over the cases the half-step
-    group has recorded 'ok', beside the 'coarse' table's (0.5, Courant 0.3) over the same cases."""
-    runs, parts = res["runs"], []
+    group has recorded 'ok', beside the 'coarse' table's (0.5, Courant 0.3) over the same cases (both from
+    :func:`comparison`)."""
+    here, coarse = comparison(res, COARSE + HALF_STEP), comparison(res, COARSE)
+    parts = []
     for material in ("AISI1045", "Ti6Al4V"):
-        errs = {}
-        for suffix, name in ((HALF_STEP, "here"), ("", "coarse")):
-            rows = []
-            for n in (n for n in range(1, 19) if _both_ok(runs, n, material)):
-                m = runs[f"case {n}{COARSE}{suffix}"]["metrics"]
-                meas = m["measured"]
-                rows.append([abs(m["rake_face_temperature_K"] / meas["T_RF_K"] - 1),
-                             abs(m["free_chip_surface_temperature_K"] / meas["T_FCS_K"] - 1),
-                             abs(m["force_ratio"] / meas["force_ratio"] - 1)])
-            errs[name] = 100 * np.mean(rows, axis=0) if rows else None
-        if errs["here"] is not None:
-            h, c = errs["here"], errs["coarse"]
-            parts.append(f"{material} ({sum(_both_ok(runs, n, material) for n in range(1, 19))} cases): "
-                         f"T_RF {h[0]:.1f} % (coarse {c[0]:.1f} %), T_FCS {h[1]:.1f} % ({c[1]:.1f} %), "
-                         f"Fp/Fc {h[2]:.1f} % ({c[2]:.1f} %)")
+        pairs = [(h, c) for h, c in zip(here, coarse)
+                 if h["material"] == material and h["status"] == c["status"] == "ok"]
+        if pairs:
+            h, c = [p[0] for p in pairs], [p[1] for p in pairs]
+            errs = [f"{name} {_mean(h, q):.1f} % ({'coarse ' if q == 'TRF_err' else ''}{_mean(c, q):.1f} %)"
+                    for name, q in (("T_RF", "TRF_err"), ("T_FCS", "TFCS_err"), ("Fp/Fc", "ratio_err"))]
+            parts.append(f"{material} ({len(pairs)} cases): " + ", ".join(errs))
     return ("Mean |error| against the measurements over the cases recorded here, beside the 'coarse' table's on the "
             "same cases: " + ("; ".join(parts) if parts else "none recorded yet") + ".")
-
-
-def _both_ok(runs: dict, n: int, material: str) -> bool:
-    """Case ``n`` of ``material`` recorded 'ok' both in the half-step group and in the 'coarse' table."""
-    r, base = runs.get(f"case {n}{COARSE}{HALF_STEP}"), runs.get(f"case {n}{COARSE}")
-    return bool(r and base and r.get("status") == base.get("status") == "ok"
-                and r["scene_info"]["material"] == material)
 
 
 def resolution_convergence(res: dict) -> list[dict]:

@@ -142,17 +142,21 @@ def test_the_sweeps_failure_site(tmp_path):
 
 
 def test_the_half_step_groups_mean_errors():
-    """_half_step_errors: mean |error| against the measurements over the cases recorded 'ok' in both the half-step
-    group and the 'coarse' table, per material; a case recorded in only one of them is left out."""
+    """_half_step_errors: mean |error| against the measurements (refsph.paper_data, through ``comparison``) of the
+    cases recorded 'ok' in both the half-step group and the 'coarse' table, per material; a case recorded in only one
+    of them is left out."""
+    from refsph.paper_data import rla_cutting_case
     mod = _bench()
-    meas = dict(T_RF_K=600.0, T_FCS_K=500.0, force_ratio=0.8)
+    c = rla_cutting_case(1)                          # AISI 1045
+    ratio = c["Fp_exp_N"] / c["Fc_exp_N"]
 
-    def rec(T_RF, status="ok"):
-        return dict(status=status, scene_info=dict(material="AISI1045"),
-                    metrics=dict(rake_face_temperature_K=T_RF, free_chip_surface_temperature_K=550.0,
-                                 force_ratio=0.4, measured=meas))
-    runs = {"case 1 n_tu 5": rec(660.0), f"case 1 n_tu 5{mod.HALF_STEP}": rec(540.0),
-            "case 2 n_tu 5": rec(900.0), f"case 2 n_tu 5{mod.HALF_STEP}": rec(900.0, status="blow-up")}
+    def rec(f_T, status="ok"):
+        return dict(status=status, metrics=dict(rake_face_temperature_K=f_T * c["TRF_exp_K"],
+                                                free_chip_surface_temperature_K=1.1 * c["TFCS_exp_K"],
+                                                force_ratio=0.5 * ratio, cutting_force_N_per_m=4e5,
+                                                passive_force_N_per_m=2e5 * ratio))
+    runs = {"case 1 n_tu 5": rec(1.1), f"case 1 n_tu 5{mod.HALF_STEP}": rec(0.9),
+            "case 2 n_tu 5": rec(1.5), f"case 2 n_tu 5{mod.HALF_STEP}": rec(1.5, status="blow-up")}
     line = mod._half_step_errors(dict(runs=runs))
     assert "AISI1045 (1 cases): T_RF 10.0 % (coarse 10.0 %), T_FCS 10.0 % (10.0 %), Fp/Fc 50.0 % (50.0 %)" in line
     assert "Ti6Al4V" not in line

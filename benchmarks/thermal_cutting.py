@@ -630,7 +630,8 @@ def report(res: dict, before: dict | None = None) -> str:
     lines += ["", P("paper_length")] + [x for m, rows_ in at2.items() for x in _paper_length_lines(rows_, m)]
     lines += ["", P("paper_length_errors")] + [x for m, rows_ in at2.items() for x in _paper_length_errors(rows_, m)]
     lines += ["", P("pfem_forces")] + [_pfem_force_line(r, res) for r in pfem]
-    lines += ["", P("dof")] + _dof_lines(pfem, coarse, res, pfem10, rows)
+    dof = dof_rows(res)
+    lines += ["", P("dof", **dof_changes(dof))] + _dof_lines(dof)
     lines += ["", P("forces")]
     for r in rows:
         lines.append(f"| {r['case']} | {_f(r['Fc_N_per_mm'], '.1f')} | {_f(r['Fp_N_per_mm'], '.1f')} | "
@@ -666,25 +667,52 @@ def _pfem_force_line(r: dict, res: dict) -> str:
             f"{_f(pf.get('wall_time_s'), '.0f')} | {_f(sph.get('wall_time_s'), '.0f')} |")
 
 
-def _dof_lines(pfem: list, coarse: list, res: dict, pfem10: list = (), fine: list = ()) -> list[str]:
+DOF_QUANTITIES = (("TRF", "T_RF"), ("TFCS", "T_FCS"), ("ratio", "Fp/Fc"))   # the DOF table's errors, in order
+
+
+def dof_rows(res: dict) -> list[dict]:
     """Degrees of freedom against accuracy, per resolution and material, over the cases both methods ran (t_u / 5:
-    ``pfem`` and ``coarse``; t_u / 10: ``pfem10`` and ``fine``, the sweep's table): the mean node and particle
-    counts, DOF (PFEM: u_x, u_y, p per node; SPH: x, y per particle), the mean errors and the mean wall time."""
-    lines = []
-    for label, pf_rows, sph_rows in (("t_u/5", pfem, coarse), ("t_u/10", pfem10, fine)):
+    the 'pfem' and 'coarse' studies; t_u / 10: the PFEM's and the sweep's tables): the mean node and particle
+    counts, DOF (PFEM: u_x, u_y, p per node; SPH: x, y per particle), each method's mean errors (DOF_QUANTITIES)
+    and mean wall time, and the paper's SPH and PFEM mean errors on the same cases."""
+    out = []
+    for label, sfx_pf, sfx_sph in (("t_u/5", PFEM, COARSE), ("t_u/10", PFEM10, "")):
+        pf_rows, sph_rows = comparison(res, sfx_pf), comparison(res, sfx_sph)
         for mat in ("AISI1045", "Ti6Al4V"):
             both = [(a, b) for a, b in zip(pf_rows, sph_rows)
                     if a["material"] == mat and a["status"] == b["status"] == "ok"]
             if not both:
                 continue
-            n = [float(np.mean([res["runs"][r["key"]]["n_particles"] for r in rows])) for rows in zip(*both)]
-            n = [round(v) for v in n]
-            cells = [label, mat, str(len(both)), f"{n[0]} / {3 * n[0]}", f"{n[1]} / {2 * n[1]}"]
             pf, sph = [a for a, _ in both], [b for _, b in both]
-            cells += [f"{_mean(pf, f'{q}_err'):.1f} / {_mean(sph, f'{q}_err'):.1f}" for q in ("TRF", "TFCS", "ratio")]
-            cells.append(f"{_mean(pf, 'wall_s') / 60:.1f} / {_mean(sph, 'wall_s') / 60:.1f}" if label == "t_u/5" else
-                         "-")                   # t_u/10: runs three and four at a time over sessions (page text)
-            lines.append("| " + " | ".join(cells) + " |")
+            n = [round(float(np.mean([res["runs"][r["key"]]["n_particles"] for r in rows]))) for rows in (pf, sph)]
+            row = dict(dx=label, material=mat, cases=len(both), nodes=n[0], dof_pfem=3 * n[0], particles=n[1],
+                       dof_sph=2 * n[1], wall_min_pfem=_mean(pf, "wall_s") / 60, wall_min_sph=_mean(sph, "wall_s") / 60)
+            for q, _ in DOF_QUANTITIES:
+                row.update({f"{q}_pfem": _mean(pf, f"{q}_err"), f"{q}_sph": _mean(sph, f"{q}_err"),
+                            f"{q}_paper_pfem": _mean(pf, f"{q}_pfem_err"), f"{q}_paper_sph": _mean(pf, f"{q}_sph_err")})
+            out.append(row)
+    return out
+
+
+def dof_changes(rows: list[dict]) -> dict:
+    """How the DOF table's mean errors move from t_u / 5 to t_u / 10 (both methods, both materials, DOF_QUANTITIES):
+    how many fall and rise (of n), and the smallest and largest change in percentage points."""
+    d = [b[f"{q}_{m}"] - a[f"{q}_{m}"] for a in rows for b in rows if a["dx"] == "t_u/5" and b["dx"] == "t_u/10"
+         and a["material"] == b["material"] for q, _ in DOF_QUANTITIES for m in ("pfem", "sph")]
+    d = [v for v in d if np.isfinite(v)]
+    return dict(n=len(d), fall=sum(v < 0 for v in d), rise=sum(v > 0 for v in d),
+                lo=f"{min(d, default=math.nan):+.1f}", hi=f"{max(d, default=math.nan):+.1f}")
+
+
+def _dof_lines(rows: list[dict]) -> list[str]:
+    """The DOF table's rows (dof_rows); wall time at t_u / 5 only (t_u / 10: runs three and four at a time, page)."""
+    lines = []
+    for r in rows:
+        cells = [r["dx"], r["material"], str(r["cases"]), f"{r['nodes']} / {r['dof_pfem']}",
+                 f"{r['particles']} / {r['dof_sph']}"]
+        cells += [f"{r[f'{q}_pfem']:.1f} / {r[f'{q}_sph']:.1f}" for q, _ in DOF_QUANTITIES]
+        cells.append(f"{r['wall_min_pfem']:.1f} / {r['wall_min_sph']:.1f}" if r["dx"] == "t_u/5" else "-")
+        lines.append("| " + " | ".join(cells) + " |")
     return lines
 
 
@@ -1266,6 +1294,40 @@ def figures(res: dict) -> None:
     fig.savefig(FIG / "11_thermal_cutting_trends.png", dpi=100)
     plt.close(fig)
     resolution_figure(res, plt)
+    dof_figure(dof_rows(res), plt)
+
+
+def dof_figure(rows: list[dict], plt) -> None:
+    """figures/11_thermal_cutting_dof.png: the DOF table (dof_rows) drawn: each method's mean error against the
+    measurements over its degrees of freedom, t_u/5 then t_u/10, the paper's SPH and PFEM means on the same cases as
+    lines (over the cases of the table's last row of that material)."""
+    fig, axes = plt.subplots(2, len(DOF_QUANTITIES), figsize=(12, 6.2), constrained_layout=True, squeeze=False)
+    for i, mat in enumerate(("AISI1045", "Ti6Al4V")):
+        sel = [r for r in rows if r["material"] == mat]
+        for j, (q, name) in enumerate(DOF_QUANTITIES):
+            ax = axes[i][j]
+            for k, (m, label, mark) in enumerate((("pfem", "refsph PFEM", "^"), ("sph", "refsph SPH", "o"))):
+                ax.plot([r[f"dof_{m}"] for r in sel], [r[f"{q}_{m}"] for r in sel], mark + "-", color=f"C{k}",
+                        label=label)
+                for r in sel:
+                    ax.annotate(r["dx"], (r[f"dof_{m}"], r[f"{q}_{m}"]), fontsize=7, xytext=(3, 3),
+                                textcoords="offset points")
+                if sel:
+                    ax.axhline(sel[-1][f"{q}_paper_{m}"], ls="--", color=f"C{k}", lw=1,
+                               label=f"the paper's {m.upper()}")
+            ax.set_xscale("log")
+            ax.set_ylim(bottom=0.0)
+            ax.set_title(f"{mat}: {name}", fontsize=10)
+            ax.grid(alpha=0.3)
+            if i == 1:
+                ax.set_xlabel("degrees of freedom")
+            if j == 0:
+                ax.set_ylabel("mean error [%]")
+    axes[0][0].legend(fontsize=7)
+    fig.suptitle("Degrees of freedom against the mean error against the measurements: the cases both methods ran "
+                 "(the page's DOF table)",
+                 fontsize=10)
+    study.save_figure(fig, FIG / "11_thermal_cutting_dof.png", dpi=100)
 
 
 RESOLUTION_SHOWN = ("Fc [N/mm]", "Fp/Fc", "T_RF [K]", "T_FCS [K]")

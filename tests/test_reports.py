@@ -515,3 +515,29 @@ def test_thermal_cutting_refuses_to_skip_a_record_made_with_other_numerics(tmp_p
         with pytest.raises(SystemExit, match="other scene options or numerics"):
             mod._sweep_round(runs, {"k": asked}, args)
     assert mod._sweep_round(runs, {"k": (options, numerics)}, args) == []          # the same: recorded, skipped
+
+
+def test_thermal_cutting_dof_figure_is_what_the_code_draws(tmp_path):
+    """The 18 cuts' degrees-of-freedom figure is drawn from the page's DOF table (dof_rows of the committed JSON)."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    mod = _script("thermal_cutting")
+    mod.FIG = tmp_path
+    rows = mod.dof_rows(json.loads((ROOT / "benchmarks" / "thermal_cutting.json").read_text()))
+    assert {(r["dx"], r["material"]) for r in rows} == {(d, m) for d in ("t_u/5", "t_u/10")
+                                                        for m in ("AISI1045", "Ti6Al4V")}
+    for r in rows:                                      # the table's DOF: 3 per PFEM node, 2 per SPH particle
+        assert r["dof_pfem"] == 3 * r["nodes"] and r["dof_sph"] == 2 * r["particles"]
+    mod.dof_figure(rows, plt)
+    figure = "11_thermal_cutting_dof.png"
+    new, old = matplotlib.image.imread(tmp_path / figure), matplotlib.image.imread(ROOT / "figures" / figure)
+    assert new.shape == old.shape and np.abs(new - old).max() < 0.05
+
+
+def test_dof_changes_counts_the_moves_between_resolutions():
+    mod = _script("thermal_cutting")
+    base = {f"{q}_{m}": 10.0 for q, _ in mod.DOF_QUANTITIES for m in ("pfem", "sph")}
+    fine = dict(base, TRF_pfem=12.5, ratio_sph=4.0, TFCS_sph=float("nan"))
+    rows = [dict(base, dx="t_u/5", material="AISI1045"), dict(fine, dx="t_u/10", material="AISI1045")]
+    assert mod.dof_changes(rows) == dict(n=5, fall=1, rise=1, lo="-6.0", hi="+2.5")

@@ -181,6 +181,11 @@ def jobs(studies=STUDY_NAMES, only=None) -> dict:
     add("timestep", "case 10 courant 0.3", converged(10))        # the scene's step: breaks down at 1.1 ms
     add("cases", "case 10", converged(10), sweep_numerics())
     add("scaling", "case 10 s/2", converged(10, mass_scale=_s(10) / 2), sweep_numerics())
+    # case 10 at s/2 moved Fc by -21 %, T_RF by -12 %, one run against case 10's scatter of three: its scatter at s/2
+    # too (the same two seeds), so that the forces' dependence on s is read between two groups of three
+    for seed in (1, 2):
+        add("scaling", f"case 10 s/2 jitter {seed}", converged(10, mass_scale=_s(10) / 2, jitter=0.01, seed=seed),
+            sweep_numerics())
     for seed in (1, 2, 3):
         add("scatter", f"case 1 jitter {seed}", converged(1, jitter=0.01, seed=seed), sweep_numerics())
     # case 10 at s/2 moved Fc by -21 % at t_u/10 (one run each): Ti6Al4V's scatter at t_u/10, to read it by
@@ -916,6 +921,7 @@ SCATTER_KEYS = ("case 1", "case 1 jitter 1", "case 1 jitter 2", "case 1 jitter 3
 SCATTER_T5 = tuple(k.replace("case 1", "case 1 n_tu 5") for k in SCATTER_KEYS)         # at t_u/5
 SCATTER_S2 = tuple(k.replace("n_tu 5", "n_tu 5 s/2") for k in SCATTER_T5)               # at t_u/5 and s/2
 SCATTER_TI10 = ("case 10", "case 10 jitter 1", "case 10 jitter 2")                     # Ti6Al4V at t_u/10
+SCATTER_TI10_S2 = tuple(k.replace("case 10", "case 10 s/2") for k in SCATTER_TI10)        # ... and at s/2
 # the 'refupdate' study: case 1's scatter at REF_UPDATE (t_u/5, the seeds of SCATTER_T5) and the study's table (each
 # case at t_u/5 from the loosest threshold to the tightest, the scene's among them, then t_u/10)
 REF_SCATTER = tuple(f"case 1{COARSE}{REF_KEY}{REF_UPDATE:g}" + k[len("case 1 n_tu 5"):] for k in SCATTER_T5[:3])
@@ -966,6 +972,8 @@ STUDIES = (
     ("Run-to-run scatter at t_u/5 (the same, where a run costs an eighth)", SCATTER_T5, BASIC),
     ("Run-to-run scatter of Ti6Al4V at t_u/10 (case 10 and two runs with the same perturbation): whether case 10 "
      "at s/2 (one run) moves by more than the scatter", SCATTER_TI10, BASIC),
+    ("Run-to-run scatter of Ti6Al4V at t_u/10 and s/2 (case 10 at s/2 and two runs with the same perturbations): "
+     "whether halving s moves case 10 by more than the scatter, two groups of three runs", SCATTER_TI10_S2, BASIC),
     ("Run-to-run scatter of Ti6Al4V at t_u/5 (case 10, the same perturbation)",
      ("case 10 n_tu 5", "case 10 n_tu 5 jitter 1", "case 10 n_tu 5 jitter 2", "case 10 n_tu 5 jitter 3"), BASIC),
     ("Resolution (particles across t_u; at courant 0.15)", RESOLUTION_RUNS,
@@ -1207,7 +1215,7 @@ def _change_cell(d: float, z: float = math.nan) -> str:
 
 
 # a scatter group -> the group it is compared with (_difference_line)
-COMPARED = {SCATTER_S2: SCATTER_T5, REF_SCATTER: SCATTER_T5, SELF_SCATTER: SCATTER_T5}
+COMPARED = {SCATTER_S2: SCATTER_T5, REF_SCATTER: SCATTER_T5, SELF_SCATTER: SCATTER_T5, SCATTER_TI10_S2: SCATTER_TI10}
 SINGLES = {SCATTER_KEYS: ("case 1 s/2", "case 1 heat every 8"), SCATTER_TI10: ("case 10 s/2",)}   # one run each
 # the 'refupdate' study's single runs, each against the scatter group of its resolution and material (at the
 # scene's reference update, or at REF_UPDATE for case 1 at t_u/5): which changes the scatter does not explain

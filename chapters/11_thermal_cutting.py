@@ -249,8 +249,8 @@ assert abs(hb["residual_rel"]) < 1e-9
 # `python benchmarks/thermal_cutting.py` runs the 18 cases at $\Delta x = t_u/10$ and 16 $t_u$ of cut (means over
 # the last quarter, with the drift over that quarter reported), resumably, on local processes or a
 # `dask.distributed` cluster; one case takes 20–52 min of CPU (case 9, at a quarter of the step, 182 min; 13.2 h
-# for the 18), so the sweep spans sessions and its page says which cases are still to run. The measured values are not printed in the paper: they are recovered
-# from each printed prediction and its printed error. Every case against the measurement and the paper's own SPH
+# for the 18), so the sweep spans sessions and its page says which cases are still to run. The measured values
+# are not printed in the paper: they are recovered from each printed prediction and its printed error. Every case against the measurement and the paper's own SPH
 # and PFEM (the mean errors, and issue 19's first sweep, are on the page,
 # [`benchmarks/thermal_cutting_report.md`](../benchmarks/thermal_cutting_report.md)):
 

@@ -91,7 +91,7 @@ def _s(case: int) -> float:
 
 
 STUDY_NAMES = ("cases", "coarse", "pfem", "detector", "scaling", "scatter", "resolution", "timestep", "tool",
-               "contact", "refupdate", "selfcontact")
+               "contact", "refupdate", "selfcontact", "gain")
 COURANT = 0.15                             # every run at dx <= t_u / 10: half the scene's step (module text)
 COARSE = " n_tu 5"                         # the key suffix of the 'coarse' study: all 18 cases at dx = t_u / 5
 PFEM = " pfem n_tu 5"                      # the key suffix of the 'pfem' study: the 18 cases with the PFEM at t_u / 5
@@ -107,6 +107,8 @@ SELF_KEY = " self contact"                 # the 'selfcontact' study's key part:
 SELF_CONTACT = 0.5                         # (refsph.self_contact: LAMMPS SMD's r_c = dp/2), self_contact_jobs
 SELF_REF_UPDATES = (0.2, 0.1, 0.02)        # ... with these reference updates too (the refupdate study's failures)
 RERUN = " rerun"                           # a run again with today's code, beside its record (its crowding)
+GAIN_KEY = " gain step"                    # the 'gain' study's key part: Numerics.gain_step (the CFL step over the
+                                           # corrected gradient's largest gain, refsph.tlsph.gradient_gain)
 DAMPED_GAMMA = 0.6                         # a PFEM case of the t_u / 10 table that failed with the trapezoidal rule,
 DAMPED = f" n_tu 10 gamma {DAMPED_GAMMA:g}"  # again with Newmark's damped rule, under 'case N pfem' + DAMPED
 BOSSAK_ALPHA = -0.1                        # the Bossak-Newmark rule (second order, damped) beside the damped rule:
@@ -225,6 +227,7 @@ def more_jobs() -> list[tuple[str, str, dict, dict]]:
     pfem = dict(method="pfem")
     out = [("selfcontact", key, options, numerics) for key, (options, numerics) in self_contact_jobs().items()]
     out += [("refupdate", key, options, numerics) for key, (options, numerics) in reference_update_jobs().items()]
+    out += [("gain", key, options, numerics) for key, (options, numerics) in gain_step_jobs().items()]
     out += [("pfem", key, options, pfem) for key, options in time_rule_jobs() + remesh_jobs() + pfem_resolution_jobs()]
     out += [("pfem", f"case {n}{PFEM10}{TO_2MM}", to_2mm(n, n_tu=10.0), pfem) for n in TU_01]
     return out + [("cases", f"case {n}{TO_2MM}", to_2mm(n), sweep_numerics()) for n in TU_01]
@@ -282,6 +285,25 @@ def self_contact_jobs() -> dict:
     out[f"case 10{COARSE}{SELF_KEY} courant {COURANT:g}"] = (converged(10, n_tu=5.0), dict(sc, courant=COURANT))
     # case 1's rerun at the scene's step blew up at 0.77 ms; its record at half the step, again with today's code
     out[f"case 1{COARSE} courant {COURANT:g}{RERUN}"] = (converged(1, n_tu=5.0), dict(courant=COURANT))
+    return out
+
+
+def gain_step_jobs() -> dict:
+    """{key: (options, numerics)} of the 'gain' study: the runs that broke down at the scene's courant 0.3 (a
+    reference update left a hot chip-tip particle with few neighbours on one side, its correction amplified: the
+    history), again at 0.3 with the step divided by the corrected gradient's largest gain (``Numerics.gain_step``):
+    case 1 at t_u/5 (its rerun blew up), case 10 at reference update 0.2, case 1 at 0.02, case 10 with
+    self-contact, case 1 at s/4 and case 10 with the alpha-shape detector; then case 10 at t_u/10 (the sweep's
+    reason for half the step there) and case 1 at t_u/10 at reference update 0.1 (failed at half the step)."""
+    g = dict(gain_step=True)
+    out = {f"case 1{COARSE}{GAIN_KEY}": (converged(1, n_tu=5.0), dict(g)),
+           f"case 10{COARSE}{REF_KEY}0.2{GAIN_KEY}": (converged(10, n_tu=5.0), dict(g, ref_update_strain=0.2)),
+           f"case 1{COARSE}{REF_KEY}0.02{GAIN_KEY}": (converged(1, n_tu=5.0), dict(g, ref_update_strain=0.02)),
+           f"case 10{COARSE}{SELF_KEY}{GAIN_KEY}": (converged(10, n_tu=5.0), dict(g, self_contact=SELF_CONTACT)),
+           f"case 1{COARSE} s/4{GAIN_KEY}": (converged(1, n_tu=5.0, mass_scale=_s(1) / 4), dict(g)),
+           f"case 10{COARSE} alpha detector{GAIN_KEY}": (converged(10, n_tu=5.0, detector="alpha"), dict(g)),
+           f"case 10{GAIN_KEY}": (converged(10), dict(g))}
+    out[f"case 1{REF_KEY}{REF_UPDATE:g}{GAIN_KEY}"] = (converged(1), dict(g, ref_update_strain=REF_UPDATE))
     return out
 
 
@@ -931,6 +953,20 @@ REF_RUNS = tuple(f"case {n}{COARSE}{REF_KEY}{r:g}" if r != SCENE_REF_UPDATE else
     f"case 1{REF_KEY}{REF_UPDATE:g}{RETRY}",) + tuple(
     f"case {n}{COARSE}{REF_KEY}{r:g} courant {COURANT:g}" for n, r in ((10, 0.2), (1, 0.02)))
 HALF_STEP_RUNS = tuple(f"case {n}{COARSE}{HALF_STEP}" for n in range(1, 19))
+# the 'gain' study's table: each run with the step over the gradient's gain beside the same run at the scene's step
+# (courant 0.3) and at half of it
+GAIN_RUNS = (f"case 1{COARSE} rerun", f"case 1{COARSE} courant 0.15 rerun", f"case 1{COARSE}{GAIN_KEY}",
+             f"case 10{COARSE}{REF_KEY}0.2", f"case 10{COARSE}{REF_KEY}0.2 courant 0.15",
+             f"case 10{COARSE}{REF_KEY}0.2{GAIN_KEY}",
+             f"case 1{COARSE}{REF_KEY}0.02", f"case 1{COARSE}{REF_KEY}0.02 courant 0.15",
+             f"case 1{COARSE}{REF_KEY}0.02{GAIN_KEY}",
+             f"case 10{COARSE}{SELF_KEY}", f"case 10{COARSE}{SELF_KEY} courant 0.15", f"case 10{COARSE}{SELF_KEY}{GAIN_KEY}",
+             f"case 1{COARSE} s/4", f"case 1{COARSE} s/4 courant 0.15", f"case 1{COARSE} s/4{GAIN_KEY}",
+             f"case 10{COARSE} alpha detector", f"case 10{COARSE} alpha detector courant 0.15",
+             f"case 10{COARSE} alpha detector{GAIN_KEY}",
+             "case 10 courant 0.3", "case 10", f"case 10{GAIN_KEY}",
+             f"case 1{REF_KEY}{REF_UPDATE:g}", f"case 1{REF_KEY}{REF_UPDATE:g}{RETRY}",
+             f"case 1{REF_KEY}{REF_UPDATE:g}{GAIN_KEY}")
 # the 'selfcontact' study: case 1's scatter with self-contact (t_u/5, the seeds of SCATTER_T5) and the study's table
 SELF_SCATTER = tuple(f"case 1{COARSE}{SELF_KEY}" + k[len("case 1 n_tu 5"):] for k in SCATTER_T5[:3])
 SELF_RUNS = tuple(k for n in (1, 10) for k in (
@@ -1050,6 +1086,11 @@ STUDIES = (
                  ("crowded [%]", "crowded_pct", ".1f"), ("closest pair [dx]", "closest_dp", ".2f")) + BASIC
      + (("max T [K]", "max_temperature_K", ".0f"), ("wall [s]", "wall", ".0f"))),
     ("Run-to-run scatter with self-contact (t_u/5, case 1, the same perturbation as without)", SELF_SCATTER, BASIC),
+    ("The step over the corrected gradient's gain (Numerics.gain_step, refsph.tlsph.gradient_gain; off in the "
+     "scene): each run that broke down at the scene's courant 0.3, the same at half the step, and at 0.3 with the "
+     "step divided by the largest gain (t_u/10: case 10 at 0.3, the sweep's case 10 at 0.15; case 1 at reference "
+     "update 0.1 at 0.15, at 0.075, and at 0.3 with the gain); a failed run shows its status",
+     GAIN_RUNS, BASIC + (("steps", "n_steps", "d"), ("CPU [min]", "cpu_min", ".1f"), ("wall [s]", "wall", ".0f"))),
     ("Contact and heat split (case 1: penalty contact, half the frictional heat into the chip)",
      ("case 1", "case 1 pinball", "case 1 all friction heat to the chip"),
      BASIC + (("friction heat [% of work]", "friction_of_work", ".1f"),

@@ -90,6 +90,11 @@ class ReferenceConfiguration:
             F[g.n_real:] = g.tensors(F[:g.n_real])
         return F
 
+    def rows_gradient(self, body: State, several_bodies: bool) -> np.ndarray:
+        """Eq. (18) on the deformable rows ``body`` (their ghosts left out)."""
+        op = self.operator(body, several_bodies)
+        return self.deformation_gradient(self.extended(body, op), op)[:body.n]
+
     def gradient_for_rates(self, body: State, ext: State, op: ReferenceOperator) -> np.ndarray:
         """F for a rate evaluation: the last one computed (by :meth:`end_step` or by a rate evaluation) if it belongs
         to this operator and these positions, else Eq. (18) anew (then kept for :meth:`end_step`)."""

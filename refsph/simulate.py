@@ -99,6 +99,8 @@ def make_solver(method: str, setup: Setup) -> Solver:
                              "modes are the tensile instability's, see gamma)")
         if nm.max_condition is not None:
             raise ValueError("max_condition limits TLSPH's kernel-gradient correction; ESPH has none to limit")
+        if nm.gain_step:
+            raise ValueError("gain_step divides the step by TLSPH's corrected-gradient gain; ESPH has no correction")
         if nm.self_contact is not None:
             raise ValueError("self_contact is a TLSPH option (ESPH's particles keep apart through the pressure of "
                              "their current neighbours, and its artificial pressure, gamma)")
@@ -458,11 +460,14 @@ def step_or_fail(state: State, parts: RunParts, dt: float, rec: RunRecord) -> St
     return step
 
 
-def _time_step(setup: Setup, dt: float | None, state: State, physics=()) -> float:
-    """The fixed dt, or the CFL step (and no more than each physics' limit, e.g. heat conduction's)."""
+def _time_step(setup: Setup, dt: float | None, state: State, physics=(), solver=None) -> float:
+    """The fixed dt, or the CFL step (over the solver's gain with ``Numerics.gain_step``; and no more than each
+    physics' limit, e.g. heat conduction's)."""
     if dt is not None:
         return dt
     step = cfl_time_step(state, setup.material, setup.h, setup.numerics.courant)
+    if setup.numerics.gain_step and solver is not None:
+        step /= solver.step_gain(state)
     for p in physics:
         step = min(step, p.step_limit(state))
     return step
@@ -633,7 +638,7 @@ def simulate(setup: Setup, method: str | None = None, *, scene: Scene | None = N
 def _one_step(setup: Setup, parts: RunParts, rec: RunRecord, state: State, dt: float | None, hook) -> State:
     """The step size (the CFL step, the physics' limits, the next snapshot time), the mechanical step, each
     physics after it, the hook, then the record and the snapshots that are due."""
-    step_dt = _time_step(setup, dt, state, parts.physics)
+    step_dt = _time_step(setup, dt, state, parts.physics, parts.solver)
     rec.dts.append(step_dt)                                 # the step size chosen (before any cut to land on time)
     step_dt = min(step_dt, rec.next_output_time() - state.t)   # snapshots land on their nominal times
     prev, step = state, step_or_fail(state, parts, step_dt, rec)

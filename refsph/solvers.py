@@ -80,6 +80,10 @@ class SolverBase:
     def reaction_history(self) -> dict:
         return self.constraints.reaction_history()
 
+    def step_gain(self, state: State) -> float:
+        """What the CFL step is divided by under ``Numerics.gain_step`` (1 here; TLSPH: its gradient's gain)."""
+        return 1.0
+
     def checkpoint(self) -> dict:
         """What a restart needs besides the state: the constraints' log and the solver's own counters."""
         ck = {CONSTRAINTS + k: v for k, v in self.constraints.checkpoint().items()}
@@ -262,8 +266,7 @@ class TLSPHSolver(SolverBase):
         body = self._body(state)
         J = np.ones(body.n)                     # the reference configuration itself: J = 1 (by definition)
         if np.any(body.x != body.X):            # a deformed start: the J the operator gives (Eq. (18))
-            op = self.reference.operator(body, self.several_bodies)
-            J = det(self.reference.deformation_gradient(self.reference.extended(body, op), op)[:body.n])
+            J = det(self.reference.rows_gradient(body, self.several_bodies))
         rho = body.m / (J * body.V0)
         if not np.allclose(body.rho, rho, rtol=1e-8, atol=0.0):
             k = int(np.argmax(np.abs(body.rho - rho)))
@@ -330,14 +333,14 @@ class TLSPHSolver(SolverBase):
 
     def deformation_gradient(self, state: State) -> np.ndarray:
         """Eq. (18) for every row (rigid rows: I)."""
-        body = self._body(state)
-        op = self.reference.operator(body, self.several_bodies)
-        F = self.reference.deformation_gradient(self.reference.extended(body, op), op)
-        return with_identity(F[:body.n], state)
+        return with_identity(self.reference.rows_gradient(self._body(state), self.several_bodies), state)
+
+    def step_gain(self, state: State) -> float:
+        """max(1, the corrected gradient's largest gain) (:meth:`~refsph.tlsph.ReferenceOperator.max_gain`)."""
+        return self.reference.operator(self._body(state), self.several_bodies).max_gain()
 
     def after_step(self, state: State) -> State:
-        """rho = m / (J V0) (Eq. (2)); reference update when max |E| > ref_update_strain
-        (:meth:`~refsph.reference.ReferenceConfiguration.end_step`)."""
+        """rho = m / (J V0) (Eq. (2)); reference update when max |E| > ref_update_strain (ReferenceConfiguration)."""
         self._body(state)
         if isinstance(self.coupling, PenaltyCoupling):
             self.coupling.commit()                          # the step's tangential history (stick / slip)

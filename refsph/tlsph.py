@@ -39,6 +39,7 @@ from dataclasses import dataclass
 
 import numpy as np
 import scipy.sparse as sp
+from scipy.integrate import quad
 
 from .esph import artificial_viscosity
 from .kernels import Kernel, correction_matrix
@@ -47,7 +48,8 @@ from .neighbours import PairBlocks, find_pairs, scatter_add
 from .state import Rates, State
 from .tensor import component_major, det, identity, inv, matmul, rowdot, transpose
 
-__all__ = ["TLSPHParams", "ReferenceOperator", "tlsph_rates", "first_piola", "green_lagrange_norm",
+__all__ = ["TLSPHParams", "ReferenceOperator", "tlsph_rates", "first_piola", "green_lagrange_norm", "gradient_gain",
+           "full_support_gain",
            "reference_update", "reference_viscosity", "correction_matrix", "hourglass_acceleration"]
 
 
@@ -144,6 +146,13 @@ class ReferenceOperator:
         self._sm, self._sm_m = None, None
         self._W: tuple | None = None                          # hourglass constants, made on first use
         self.momentum_cache_hits = self.momentum_cache_misses = 0
+        self._max_gain: float | None = None                 # max_gain(), made on first use
+
+    def max_gain(self) -> float:
+        """max(1, max_i a_i) of :func:`gradient_gain`, made once: the CFL step's divisor (``Numerics.gain_step``)."""
+        if self._max_gain is None:
+            self._max_gain = max(1.0, float(np.max(gradient_gain(self), initial=0.0)))
+        return self._max_gain
 
     def hourglass_constants(self) -> tuple[list, np.ndarray]:
         """What :func:`hourglass_acceleration` needs of the reference configuration, made once: X_j - X_i on the
@@ -210,6 +219,31 @@ class ReferenceOperator:
                 js += jside[a * d + k]
             out[a] = iside - js / self.V
         return out.T
+
+
+def full_support_gain(kernel: Kernel, h: float, dim: int) -> float:
+    """int |grad W| dV over the kernel's support [1/m]: what sum_j V_j |grad_i W(X_ij)| tends to for a particle
+    whose support is full (a fine lattice), the reference of :func:`gradient_gain`."""
+    shell = {1: lambda r: 2.0, 2: lambda r: 2.0 * np.pi * r, 3: lambda r: 4.0 * np.pi * r * r}[dim]
+    value, _ = quad(lambda r: shell(r) * abs(float(kernel.dw_dr(r, h, dim))), 0.0, kernel.support * h, limit=200)
+    return float(value)
+
+
+def gradient_gain(op: ReferenceOperator) -> np.ndarray:
+    """The gain of Eq. (18)'s corrected gradient at each real particle, against a full support's (refsph's
+    measure, not the paper's):
+
+        a_i = sum_j V_j |L_i grad_i W(X_ij)| / int |grad W| dV      (about 1 inside a body)
+
+    Eq. (18) gives |F_i - F'_i| <= a_i (int |grad W| dV) max_j |u_ij - u'_ij| for two displacement fields u, u', so
+    a particle's stiffness grows like a_i^2 and its frequency like a_i. Where a reference update leaves a particle
+    with few neighbours on one side (a torn chip tip), L_i = M_i^-T amplifies and a_i reaches 3 (the sweep's
+    blown-up cuts), while the CFL step assumes 1: ``Numerics.gain_step`` divides the step by max(1, max_i a_i).
+    Computed from the operator's matrices G_k (entries V_j (L_i grad_i W_ij)_k), ghost rows left out."""
+    magnitude = sum(Gk.multiply(Gk) for Gk in op.G).sqrt()
+    A = np.asarray(magnitude.sum(axis=1)).ravel()
+    n = op.n if op.ghosts is None else op.ghosts.n_real
+    return A[:n] / full_support_gain(op.kernel, op.h, op.dim)
 
 
 def first_piola(sigma: np.ndarray, J: np.ndarray, Finv: np.ndarray) -> np.ndarray:

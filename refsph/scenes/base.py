@@ -42,8 +42,10 @@ class Numerics:
     heat step (conduction, frictional heat, losses, :class:`refsph.thermal.HeatFlow`) runs once every this many
     mechanical steps, over their summed step with the heat they made (1 = every step; the plastic heat of the return
     map still raises T every step); self_contact: TLSPH particles of one body closer than self_contact dp repel
-    (:mod:`refsph.self_contact`, LAMMPS SMD's self-contact at 0.5; None = off, as in the paper). The numbers of a
-    run do not depend on ``threads``, only its speed does.
+    (:mod:`refsph.self_contact`, LAMMPS SMD's self-contact at 0.5; None = off, as in the paper); gain_step: TLSPH's
+    CFL step divided by the corrected gradient's largest gain, max(1, max_i a_i) (:func:`refsph.tlsph.gradient_gain`:
+    about 1 in a body, up to 3 at a torn chip tip after a reference update; off = the plain CFL step, as in the
+    paper). The numbers of a run do not depend on ``threads``, only its speed does.
     """
 
     h_over_dp: float = 1.5
@@ -69,6 +71,7 @@ class Numerics:
     max_condition: float | None = None
     heat_every: int = 1
     self_contact: float | None = None
+    gain_step: bool = False
 
     def __post_init__(self):
         """Every parameter checked when the Numerics is made (a scene's, or ``--set``'s replacement of it), so that
@@ -103,7 +106,7 @@ class Numerics:
             if getattr(self, name) not in choices:
                 raise ValueError(f"numerical parameter {name} must be one of {', '.join(choices)}, got "
                                  f"{getattr(self, name)!r}")
-        for name in ("corrected", "esph_correction"):
+        for name in ("corrected", "esph_correction", "gain_step"):
             if not isinstance(getattr(self, name), (bool, np.bool_)):
                 raise ValueError(f"numerical parameter {name} must be true or false, got {getattr(self, name)!r}")
 

@@ -11,6 +11,7 @@ from refsph.cli import main
 from refsph.simulate import run
 
 CASES = [("taylor", "tlsph", dict(dim=2, quick=True, t_end=6e-6)),
+         ("taylor", "tlsph", dict(dim=2, quick=True, t_end=6e-6, numerics=dict(gain_step=True))),  # step over gain
          ("pressing", "esph", dict(quick=True, t_end=0.2e-6)),
          ("pressing", "tlsph", dict(quick=True, t_end=0.2e-6)),
          ("pressing", "tlsph", dict(quick=True, t_end=0.2e-6, numerics=dict(integrator="leapfrog"))),  # kept force

@@ -362,8 +362,8 @@ display(Markdown(split_page.split("\n\n", 1)[1]))             # the page without
 #   2.5 → 2.8 over the last five updates, and the run blew up there. A particle's frequency grows like $a_i$, so
 #   `--set gain_step=true` divides the step by $\max(1, \max_i a_i)$ (`refsph.tlsph.gradient_gain`; refsph's
 #   choice, off by default). At 0.3 with it, the six $t_u/5$ runs that broke down at 0.3 ran to the end, in 0.68–1.30
-#   (mean 0.94) of the steps of half the step: not cheaper, but the step shrinks for a measured reason, where and
-#   when the gradient amplifies (the page's gain table; one run each).
+#   (mean 0.94) of the steps of half the step, and so did case 10 at $t_u/10$ (1.15): not cheaper, but the step
+#   shrinks for a measured reason, where and when the gradient amplifies (the page's gain table; one run each).
 #
 # ## Your turn
 #

@@ -351,13 +351,18 @@ display(Markdown(split_page.split("\n\n", 1)[1]))             # the page without
 #   \sqrt{s}$). At $t_u/5$, four runs a side, halving $s$ moves neither force (case 1: $F_c$ −0.5 %) but cools
 #   the rake face by 10 % (Welch's $t = -3.8$). At $s/4$ (one run, Courant 0.15 as its $s$ run) it is 15 % cooler
 #   still, the frictional heat unchanged (1.9 against 1.7 % of the work): a mass-scaling bias of the temperatures.
+#
+# %% [markdown]
 # * **The time step.** At $t_u/10$ the scene's step (Courant 0.3) broke two of three runs: a particle of case 10
 #   inverts at 1.1 ms, and in case 2 two particles of the chip's free surface oscillate against each other until
 #   their artificial viscosity heats the chip past 1500 K. The step $C h/(c_L + |v|_{max})$ leaves out the
 #   viscosity's own signal speed; at 0.15 both run, and the sweep uses 0.15 at $t_u/10$ (the page's time-step
 #   study). A particle above twice the melting temperature stops the run as 'blow-up' (`Setup.T_limit`).
-#   Traced in case 1 at $t_u/5$: each reference update re-forms the neighbourhoods, and one that leaves a chip-tip
-#   particle a few neighbours on one side makes its correction $\mathbf L_i = \mathbf M_i^{-T}$ amplify. Its gain
+#
+# %% [markdown]
+# * **Why the step breaks.** Traced in case 1 at $t_u/5$: each reference update re-forms the neighbourhoods, and
+#   one that leaves a chip-tip particle a few neighbours on one side makes its correction
+#   $\mathbf L_i = \mathbf M_i^{-T}$ amplify. Its gain
 #   $a_i = \sum_j V_j |\mathbf L_i \nabla W_{ij}| / \int |\nabla W|\,dV$ (0.90 inside a body) rose 1.6 → 2.0 → 2.4 →
 #   2.5 → 2.8 over the last five updates, and the run blew up there. A particle's frequency grows like $a_i$, so
 #   `--set gain_step=true` divides the step by $\max(1, \max_i a_i)$ (`refsph.tlsph.gradient_gain`; refsph's

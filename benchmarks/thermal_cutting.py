@@ -102,6 +102,7 @@ REF_KEY = " ref update "                   # the 'refupdate' study's key part: T
 REF_UPDATES = (1.5, 0.2, 0.1, 0.05, 0.02)  # 0.5) at these values at t_u/5 (reference_update_jobs) ...
 REF_UPDATE = 0.1                           # ... and at this one at t_u/10 and for the scatter
 SCENE_REF_UPDATE = 0.5                     # the scene's (refsph.scenes.thermal_cutting; a test holds them equal)
+REF_FAILED = ((10, 0.2), (1, 0.02))        # (case, reference update) of the two t_u/5 runs that failed at courant 0.3
 HALF_STEP = f"{REF_KEY}{REF_UPDATE:g} courant {COURANT:g}"   # the 18 cuts at t_u/5 at REF_UPDATE and half the step
 SELF_KEY = " self contact"                 # the 'selfcontact' study's key part: Numerics.self_contact at SELF_CONTACT
 SELF_CONTACT = 0.5                         # (refsph.self_contact: LAMMPS SMD's r_c = dp/2), self_contact_jobs
@@ -248,7 +249,7 @@ def reference_update_jobs() -> dict:
     for n in range(1, 19):                                   # the 18 cuts at t_u/5 at REF_UPDATE and half the step
         out[f"case {n}{COARSE}{HALF_STEP}"] = (converged(n, n_tu=5.0),
                                                dict(ref_update_strain=REF_UPDATE, courant=COURANT))
-    for n, r in ((10, 0.2), (1, 0.02)):                      # the two that failed at t_u/5, at half the step
+    for n, r in REF_FAILED:                                  # the two that failed at t_u/5, at half the step
         out[f"case {n}{COARSE}{REF_KEY}{r:g} courant {COURANT:g}"] = (converged(n, n_tu=5.0),
                                                                       dict(ref_update_strain=r, courant=COURANT))
     for n in (1, 10):
@@ -295,13 +296,13 @@ def gain_step_jobs() -> dict:
     self-contact, case 1 at s/4 and case 10 with the alpha-shape detector; then case 10 at t_u/10 (the sweep's
     reason for half the step there) and case 1 at t_u/10 at reference update 0.1 (failed at half the step)."""
     g = dict(gain_step=True)
-    out = {f"case 1{COARSE}{GAIN_KEY}": (converged(1, n_tu=5.0), dict(g)),
-           f"case 10{COARSE}{REF_KEY}0.2{GAIN_KEY}": (converged(10, n_tu=5.0), dict(g, ref_update_strain=0.2)),
-           f"case 1{COARSE}{REF_KEY}0.02{GAIN_KEY}": (converged(1, n_tu=5.0), dict(g, ref_update_strain=0.02)),
-           f"case 10{COARSE}{SELF_KEY}{GAIN_KEY}": (converged(10, n_tu=5.0), dict(g, self_contact=SELF_CONTACT)),
+    out = {f"case 1{COARSE}{GAIN_KEY}": (converged(1, n_tu=5.0), dict(g))}
+    out.update({f"case {n}{COARSE}{REF_KEY}{r:g}{GAIN_KEY}": (converged(n, n_tu=5.0), dict(g, ref_update_strain=r))
+                for n, r in REF_FAILED})
+    out.update({f"case 10{COARSE}{SELF_KEY}{GAIN_KEY}": (converged(10, n_tu=5.0), dict(g, self_contact=SELF_CONTACT)),
            f"case 1{COARSE} s/4{GAIN_KEY}": (converged(1, n_tu=5.0, mass_scale=_s(1) / 4), dict(g)),
            f"case 10{COARSE} alpha detector{GAIN_KEY}": (converged(10, n_tu=5.0, detector="alpha"), dict(g)),
-           f"case 10{GAIN_KEY}": (converged(10), dict(g))}
+           f"case 10{GAIN_KEY}": (converged(10), dict(g))})
     out[f"case 1{REF_KEY}{REF_UPDATE:g}{GAIN_KEY}"] = (converged(1), dict(g, ref_update_strain=REF_UPDATE))
     return out
 
@@ -696,6 +697,12 @@ def _pfem_force_line(r: dict, res: dict) -> str:
 DOF_QUANTITIES = (("TRF", "T_RF"), ("TFCS", "T_FCS"), ("ratio", "Fp/Fc"))   # the DOF table's errors, in order
 
 
+def both_ok(rows_a: list, rows_b: list, material: str) -> tuple[list, list]:
+    """The rows of two comparison() tables (the same cases, in order) of ``material`` where both runs are 'ok'."""
+    pairs = [(a, b) for a, b in zip(rows_a, rows_b) if a["material"] == material and a["status"] == b["status"] == "ok"]
+    return [a for a, _ in pairs], [b for _, b in pairs]
+
+
 def dof_rows(res: dict) -> list[dict]:
     """Degrees of freedom against accuracy, per resolution and material, over the cases both methods ran (t_u / 5:
     the 'pfem' and 'coarse' studies; t_u / 10: the PFEM's and the sweep's tables): the mean node and particle
@@ -705,13 +712,11 @@ def dof_rows(res: dict) -> list[dict]:
     for label, sfx_pf, sfx_sph in (("t_u/5", PFEM, COARSE), ("t_u/10", PFEM10, "")):
         pf_rows, sph_rows = comparison(res, sfx_pf), comparison(res, sfx_sph)
         for mat in ("AISI1045", "Ti6Al4V"):
-            both = [(a, b) for a, b in zip(pf_rows, sph_rows)
-                    if a["material"] == mat and a["status"] == b["status"] == "ok"]
-            if not both:
+            pf, sph = both_ok(pf_rows, sph_rows, mat)
+            if not pf:
                 continue
-            pf, sph = [a for a, _ in both], [b for _, b in both]
             n = [round(float(np.mean([res["runs"][r["key"]]["n_particles"] for r in rows]))) for rows in (pf, sph)]
-            row = dict(dx=label, material=mat, cases=len(both), nodes=n[0], dof_pfem=3 * n[0], particles=n[1],
+            row = dict(dx=label, material=mat, cases=len(pf), nodes=n[0], dof_pfem=3 * n[0], particles=n[1],
                        dof_sph=2 * n[1], wall_min_pfem=_mean(pf, "wall_s") / 60, wall_min_sph=_mean(sph, "wall_s") / 60)
             for q, _ in DOF_QUANTITIES:
                 row.update({f"{q}_pfem": _mean(pf, f"{q}_err"), f"{q}_sph": _mean(sph, f"{q}_err"),
@@ -950,23 +955,16 @@ REF_RUNS = tuple(f"case {n}{COARSE}{REF_KEY}{r:g}" if r != SCENE_REF_UPDATE else
                  for n in (1, 10) for r in sorted(REF_UPDATES + (SCENE_REF_UPDATE,), reverse=True)) + tuple(
     k for n in (1, 10) for k in (f"case {n}", f"case {n}{REF_KEY}{REF_UPDATE:g}")) + (
     f"case 1{REF_KEY}{REF_UPDATE:g}{RETRY}",) + tuple(
-    f"case {n}{COARSE}{REF_KEY}{r:g} courant {COURANT:g}" for n, r in ((10, 0.2), (1, 0.02)))
+    f"case {n}{COARSE}{REF_KEY}{r:g} courant {COURANT:g}" for n, r in REF_FAILED)
 HALF_STEP_RUNS = tuple(f"case {n}{COARSE}{HALF_STEP}" for n in range(1, 19))
 # the 'gain' study's table: each run with the step over the gradient's gain beside the same run at the scene's step
 # (courant 0.3) and at half of it
-GAIN_RUNS = (f"case 1{COARSE} rerun", f"case 1{COARSE} courant 0.15 rerun", f"case 1{COARSE}{GAIN_KEY}",
-             f"case 10{COARSE}{REF_KEY}0.2", f"case 10{COARSE}{REF_KEY}0.2 courant 0.15",
-             f"case 10{COARSE}{REF_KEY}0.2{GAIN_KEY}",
-             f"case 1{COARSE}{REF_KEY}0.02", f"case 1{COARSE}{REF_KEY}0.02 courant 0.15",
-             f"case 1{COARSE}{REF_KEY}0.02{GAIN_KEY}",
-             f"case 10{COARSE}{SELF_KEY}", f"case 10{COARSE}{SELF_KEY} courant 0.15",
-             f"case 10{COARSE}{SELF_KEY}{GAIN_KEY}",
-             f"case 1{COARSE} s/4", f"case 1{COARSE} s/4 courant 0.15", f"case 1{COARSE} s/4{GAIN_KEY}",
-             f"case 10{COARSE} alpha detector", f"case 10{COARSE} alpha detector courant 0.15",
-             f"case 10{COARSE} alpha detector{GAIN_KEY}",
-             "case 10 courant 0.3", "case 10", f"case 10{GAIN_KEY}",
-             f"case 1{REF_KEY}{REF_UPDATE:g}", f"case 1{REF_KEY}{REF_UPDATE:g}{RETRY}",
-             f"case 1{REF_KEY}{REF_UPDATE:g}{GAIN_KEY}")
+GAIN_T5 = (*(f"case {n}{COARSE}{REF_KEY}{r:g}" for n, r in REF_FAILED), f"case 10{COARSE}{SELF_KEY}",
+           f"case 1{COARSE} s/4", f"case 10{COARSE} alpha detector")   # failed at 0.3 (case 1's: its rerun)
+GAIN_RUNS = ((f"case 1{COARSE} rerun", f"case 1{COARSE} courant {COURANT:g} rerun", f"case 1{COARSE}{GAIN_KEY}")
+             + tuple(base + sfx for base in GAIN_T5 for sfx in ("", f" courant {COURANT:g}", GAIN_KEY))
+             + ("case 10 courant 0.3", "case 10", f"case 10{GAIN_KEY}", f"case 1{REF_KEY}{REF_UPDATE:g}",
+                f"case 1{REF_KEY}{REF_UPDATE:g}{RETRY}", f"case 1{REF_KEY}{REF_UPDATE:g}{GAIN_KEY}"))
 # the 'selfcontact' study: case 1's scatter with self-contact (t_u/5, the seeds of SCATTER_T5) and the study's table
 SELF_SCATTER = tuple(f"case 1{COARSE}{SELF_KEY}" + k[len("case 1 n_tu 5"):] for k in SCATTER_T5[:3])
 SELF_RUNS = tuple(k for n in (1, 10) for k in (
@@ -1148,13 +1146,11 @@ def _half_step_errors(res: dict) -> str:
     here, coarse = comparison(res, COARSE + HALF_STEP), comparison(res, COARSE)
     parts = []
     for material in ("AISI1045", "Ti6Al4V"):
-        pairs = [(h, c) for h, c in zip(here, coarse)
-                 if h["material"] == material and h["status"] == c["status"] == "ok"]
-        if pairs:
-            h, c = [p[0] for p in pairs], [p[1] for p in pairs]
+        h, c = both_ok(here, coarse, material)
+        if h:
             errs = [f"{name} {_mean(h, q):.1f} % ({'coarse ' if q == 'TRF_err' else ''}{_mean(c, q):.1f} %)"
                     for name, q in (("T_RF", "TRF_err"), ("T_FCS", "TFCS_err"), ("Fp/Fc", "ratio_err"))]
-            parts.append(f"{material} ({len(pairs)} cases): " + ", ".join(errs))
+            parts.append(f"{material} ({len(h)} cases): " + ", ".join(errs))
     return ("Mean |error| against the measurements over the cases recorded here, beside the 'coarse' table's on the "
             "same cases: " + ("; ".join(parts) if parts else "none recorded yet") + ".")
 

@@ -224,7 +224,7 @@ class ReferenceOperator:
 def full_support_gain(kernel: Kernel, h: float, dim: int) -> float:
     """int |grad W| dV over the kernel's support [1/m]: what sum_j V_j |grad_i W(X_ij)| tends to for a particle
     whose support is full (a fine lattice), the reference of :func:`gradient_gain`."""
-    shell = {1: lambda r: 2.0, 2: lambda r: 2.0 * np.pi * r, 3: lambda r: 4.0 * np.pi * r * r}[dim]
+    shell = {2: lambda r: 2.0 * np.pi * r, 3: lambda r: 4.0 * np.pi * r * r}[dim]   # the kernels' 2D and 3D
     value, _ = quad(lambda r: shell(r) * abs(float(kernel.dw_dr(r, h, dim))), 0.0, kernel.support * h, limit=200)
     return float(value)
 

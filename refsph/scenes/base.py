@@ -44,8 +44,8 @@ class Numerics:
     map still raises T every step); self_contact: TLSPH particles of one body closer than self_contact dp repel
     (:mod:`refsph.self_contact`, LAMMPS SMD's self-contact at 0.5; None = off, as in the paper); gain_step: TLSPH's
     CFL step divided by the corrected gradient's largest gain, max(1, max_i a_i) (:func:`refsph.tlsph.gradient_gain`:
-    about 1 in a body, up to 3 at a torn chip tip after a reference update; off = the plain CFL step, as in the
-    paper). The numbers of a run do not depend on ``threads``, only its speed does.
+    0.90 inside a body at h = 1.3 dp (Wendland), 2.8 at a torn chip tip after a reference update in case 1's blow-up;
+    off = the plain CFL step, as in the paper). The numbers of a run do not depend on ``threads``, only its speed does.
     """
 
     h_over_dp: float = 1.5

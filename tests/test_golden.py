@@ -14,6 +14,7 @@ import pytest
 from refsph.cli import main
 from refsph.crosscheck.compare import SCATTER_FILE, compare, format_table
 from refsph.crosscheck.golden import (METRIC_RUNS, SCATTER_K, SCATTER_RULE, case_names, generated_with, metric_rows,
+                                     written_names,
                                       pinned_environment, savez_fixed, spread, write_golden_cases)
 from refsph.neighbours import PairBlocks, check_half_pairs, find_pairs
 from refsph.crosscheck.oracle import rates
@@ -378,3 +379,15 @@ def test_oracle_refuses_a_folder_it_did_not_write_and_names_bad_patterns(tmp_pat
     assert main(["oracle", str(tmp_path / "new"), "--only", "no_such_case"]) == 2
     err = capsys.readouterr().err
     assert "no golden case matches no_such_case" in err and "Traceback" not in err
+
+
+def test_oracle_only_names_what_it_writes(tmp_path, capsys):
+    """`--only` writes a chosen case's group-mates too (computed together): the count and the names printed are those
+    of the folders written (it said "5 golden cases" for nine folders)."""
+    from refsph.cli import main
+    names = written_names(["kernel_*", "esph_pair_terms"])
+    assert set(case_names(["kernel_*", "esph_pair_terms"])) < set(names)
+    assert {n for n in names if n.startswith("esph_rates")} and "pinball" not in names
+    assert main(["oracle", str(tmp_path / "g"), "--only", "kernel_*", "esph_pair_terms"]) == 0
+    assert capsys.readouterr().out.startswith(f"{len(names)} golden cases in")
+    assert sorted(p.name for p in (tmp_path / "g").iterdir() if p.is_dir()) == sorted(names)

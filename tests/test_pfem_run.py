@@ -3,11 +3,13 @@ snapshots of numbers with their units, the triangles, the reaction CSV, the rest
 gives the numbers of an uninterrupted one to the bit; the heat ledger closes; ParaView gets the triangles; the CLI
 refuses what the PFEM cannot take. A short cut: the quick scene with 0.3 t_u of travel (8 steps, ~20 s)."""
 import json
+import shutil
 
 import numpy as np
 import pytest
 
 from refsph.cli import main
+from refsph.crosscheck.compare import compare
 from refsph.io import load_reactions, load_snapshot
 from refsph.pfem_run import restart_pfem, run_pfem
 
@@ -70,6 +72,25 @@ def test_restart_gives_the_uninterrupted_numbers(short_run, tmp_path):
     zb = load_snapshot(part / "snapshots" / second.summary["snapshots"][-1])
     for k in ("x", "T", "eps_p", "triangles", "tool_T"):
         np.testing.assert_array_equal(za[k], zb[k])
+
+
+def test_refsph_compare_takes_pfem_run_folders(short_run, tmp_path):
+    """`refsph compare` on two PFEM run folders: the nodes have no reference positions X, so positions are judged
+    against the largest displacement from REF's first snapshot; a copy passes, a node moved by 1 um fails at its
+    id and time (the CLI said only "'X'" before)."""
+    out, _ = short_run
+    assert main(["compare", str(out), str(out)]) == 0
+    test = tmp_path / "moved"
+    shutil.copytree(out, test)
+    last = sorted((test / "snapshots").glob("snap_*.npz"))[-1]
+    with np.load(last) as f:
+        z = dict(f)
+    z["x"][5, 0] += 1e-6
+    np.savez(last, **z)
+    rows = compare(out, test)
+    bad = [r for r in rows if not r.passed]
+    assert [r.quantity.split()[-1] for r in bad] == ["x"] and bad[0].where.startswith(f"particle id {int(z['id'][5])}")
+    assert main(["compare", str(out), str(test)]) == 1
 
 
 def test_a_timed_checkpoint_changes_nothing_and_is_continued(short_run, tmp_path, monkeypatch):

@@ -13,7 +13,8 @@ Two kinds of folders are compared:
   snapshots matched by time (TEST interpolated linearly in time where its snapshot times differ from REF's).
 
 The error of an array is max |test - ref| / max |ref| (positions: relative to the largest displacement
-max |x_ref - X_ref|, so that a 1 um shift of a 1 mm body counts); of a scalar |test - ref| / |ref|. For run folders
+max |x_ref - X_ref|, so that a 1 um shift of a 1 mm body counts; a PFEM run's nodes have no X: against their
+positions in REF's first snapshot); of a scalar |test - ref| / |ref|. For run folders
 the scale max |ref| is taken over all of REF's snapshots, so that a field passing through zero (a vibrating bar at
 half a period) is not judged against its own near-zero size.
 
@@ -344,6 +345,19 @@ def _rows_of(z: dict, ids: np.ndarray):
     return order[np.searchsorted(z["id"][order], ids)]
 
 
+def _displacement(z: dict, first: dict) -> np.ndarray:
+    """x - X of snapshot ``z``; where it has no reference positions X (a PFEM run's nodes), x against the same
+    particle's x in REF's ``first`` snapshot (particles matched by id; those not in it count as not moved)."""
+    if "X" in z:
+        return z["x"] - z["X"]
+    if "id" not in z or "id" not in first:
+        return z["x"] - first["x"] if len(z["x"]) == len(first["x"]) else np.zeros_like(z["x"])
+    _, here, there = np.intersect1d(z["id"], first["id"], return_indices=True)
+    out = np.zeros_like(z["x"])
+    out[here] = z["x"][here] - first["x"][there]
+    return out
+
+
 def _absent_ids(z: dict, ids: np.ndarray) -> np.ndarray:
     """The particles ``ids`` that snapshot ``z`` does not hold (none where z has no ids and as many rows)."""
     if "id" not in z:
@@ -384,7 +398,7 @@ def compare_runs(ref: Path, test: Path, tolerances: dict | None = None) -> Rows:
     rows = Rows(_metric_rows(s_ref.get("metrics", {}), s_test.get("metrics", {}), tol), _run_notes(s_ref, s_test))
     test_snaps = [_load_snapshot(p) for p in p_test]
     ref_snaps = [_load_snapshot(p) for p in p_ref]
-    scale = {f: max(float(np.max(np.abs(z["x"] - z["X"] if f == "x" else z[f]))) for z in ref_snaps)
+    scale = {f: max(float(np.max(np.abs(_displacement(z, ref_snaps[0]) if f == "x" else z[f]))) for z in ref_snaps)
              for f in FIELDS if all(f in z for z in ref_snaps)}
     for p, z in zip(p_ref, ref_snaps):
         ids = z.get("id", np.arange(len(z["x"])))

@@ -110,8 +110,9 @@ from ..thermal import conduction_rate, laplacian
 from ..tlsph import ReferenceOperator, TLSPHParams, tlsph_rates
 from .compare import SCATTER_FILE, Row, compare_case
 
-__all__ = ["write_golden_cases", "case_names", "pinned_environment", "generated_with", "metric_rows", "METRIC_RUNS",
-           "FORMAT_VERSION", "FORMAT_CHANGES", "COMMON_CONVENTIONS", "ESPH_CONVENTIONS", "plain_array", "savez_fixed"]
+__all__ = ["write_golden_cases", "case_names", "written_names", "pinned_environment", "generated_with", "metric_rows",
+           "METRIC_RUNS", "FORMAT_VERSION", "FORMAT_CHANGES", "COMMON_CONVENTIONS", "ESPH_CONVENTIONS", "plain_array",
+           "savez_fixed"]
 
 FORMAT_VERSION = 2
 FORMAT_CHANGES = {
@@ -1238,22 +1239,33 @@ def _write_cases(root: Path, only=None) -> list[str]:
     for name in chosen:
         _clear_case(root / name)
     root.mkdir(parents=True, exist_ok=True)
+    done = set()
     for group, write in _registry():
-        if chosen & set(group):
+        if chosen & set(group):                             # a group's cases are computed together, all written
             written = write(root)
             written = [written] if isinstance(written, str) else written
             assert list(written) == list(group), (written, group)
+            done.update(written)
     index = dict(format_version=FORMAT_VERSION, format="golden/FORMAT.md", format_changes=FORMAT_CHANGES,
                  refsph_version=__version__, cases=case_names(), generated_with=generated_with(),
                  conventions=COMMON_CONVENTIONS,
                  compare="refsph compare DIR YOUR_DIR: every output array within its case's tolerance, relative to "
                          "the largest value of the reference array")
     (root / "index.json").write_text(json.dumps(index, indent=1) + "\n")
-    return case_names(only)
+    assert done == set(written_names(only)), (done, only)
+    return written_names(only)
+
+
+def written_names(only=None) -> list[str]:
+    """The cases that writing ``only`` writes: those chosen and their group-mates (computed together), in order."""
+    chosen = set(case_names(only))
+    done = {n for group, _ in _registry() if chosen & set(group) for n in group}
+    return [n for n in case_names() if n in done]
 
 
 def write_golden_cases(directory, only=None) -> list[str]:
-    """Write the golden cases into ``directory`` and an ``index.json`` (of every case); returns the names written.
+    """Write the golden cases into ``directory`` and an ``index.json`` (of every case); returns the names written
+    (with ``only``, a chosen case's group-mates too: cases computed together are written together).
     Without ``only`` the cases there are deleted first (a FORMAT.md or other notes stay) and every case written
     (the ``metrics_*`` cases run whole scenes: minutes); ``only``: the cases matching these patterns, the others
     kept. The cases are computed in a child process with :func:`pinned_environment` (module text: the bytes do
@@ -1267,7 +1279,7 @@ def write_golden_cases(directory, only=None) -> list[str]:
     if child.returncode != 0:
         last = (child.stderr.strip().splitlines() or ["(no message)"])[-1]
         raise RuntimeError(f"writing the golden cases into {directory} failed in the pinned child process: {last}")
-    return case_names(only)
+    return written_names(only)
 
 
 def main(argv=None) -> int:

@@ -91,7 +91,7 @@ def _s(case: int) -> float:
 
 
 STUDY_NAMES = ("cases", "coarse", "pfem", "detector", "scaling", "scatter", "resolution", "timestep", "tool",
-               "contact", "refupdate", "selfcontact", "gain")
+               "contact", "refupdate", "selfcontact", "gain", "frequency")
 COURANT = 0.15                             # every run at dx <= t_u / 10: half the scene's step (module text)
 COARSE = " n_tu 5"                         # the key suffix of the 'coarse' study: all 18 cases at dx = t_u / 5
 PFEM = " pfem n_tu 5"                      # the key suffix of the 'pfem' study: the 18 cases with the PFEM at t_u / 5
@@ -110,6 +110,8 @@ SELF_REF_UPDATES = (0.2, 0.1, 0.02)        # ... with these reference updates to
 RERUN = " rerun"                           # a run again with today's code, beside its record (its crowding)
 GAIN_KEY = " gain step"                    # the 'gain' study's key part: Numerics.gain_step (the CFL step over the
                                            # corrected gradient's largest gain, refsph.tlsph.gradient_gain)
+FREQUENCY_STEP = 0.5                       # the 'frequency' study: Numerics.frequency_step (the step under this
+FREQ_KEY = f" frequency step {FREQUENCY_STEP:g}"   # fraction of 2 / w_max, refsph.tlsph.largest_frequency)
 DAMPED_GAMMA = 0.6                         # a PFEM case of the t_u / 10 table that failed with the trapezoidal rule,
 DAMPED = f" n_tu 10 gamma {DAMPED_GAMMA:g}"  # again with Newmark's damped rule, under 'case N pfem' + DAMPED
 BOSSAK_ALPHA = -0.1                        # the Bossak-Newmark rule (second order, damped) beside the damped rule:
@@ -224,6 +226,9 @@ def more_jobs() -> list[tuple[str, str, dict, dict]]:
     out = [("selfcontact", key, options, numerics) for key, (options, numerics) in self_contact_jobs().items()]
     out += [("refupdate", key, options, numerics) for key, (options, numerics) in reference_update_jobs().items()]
     out += [("gain", key, options, numerics) for key, (options, numerics) in gain_step_jobs().items()]
+    out += [("frequency", key.replace(GAIN_KEY, FREQ_KEY), options,
+             dict({k: v for k, v in numerics.items() if k != "gain_step"}, frequency_step=FREQUENCY_STEP))
+            for key, (options, numerics) in gain_step_jobs().items()]
     # case 10 at s/2 moved Fc by -21 %, T_RF by -12 %, one run against case 10's scatter of three: its scatter at s/2
     # too (the same two seeds), so that the forces' dependence on s is read between two groups of three
     out += [("scaling", f"case 10 s/2 jitter {seed}", converged(10, mass_scale=_s(10) / 2, jitter=0.01, seed=seed),
@@ -961,10 +966,12 @@ HALF_STEP_RUNS = tuple(f"case {n}{COARSE}{HALF_STEP}" for n in range(1, 19))
 # (courant 0.3) and at half of it
 GAIN_T5 = (*(f"case {n}{COARSE}{REF_KEY}{r:g}" for n, r in REF_FAILED), f"case 10{COARSE}{SELF_KEY}",
            f"case 1{COARSE} s/4", f"case 10{COARSE} alpha detector")   # failed at 0.3 (case 1's: its rerun)
-GAIN_RUNS = ((f"case 1{COARSE} rerun", f"case 1{COARSE} courant {COURANT:g} rerun", f"case 1{COARSE}{GAIN_KEY}")
-             + tuple(base + sfx for base in GAIN_T5 for sfx in ("", f" courant {COURANT:g}", GAIN_KEY))
-             + ("case 10 courant 0.3", "case 10", f"case 10{GAIN_KEY}", f"case 1{REF_KEY}{REF_UPDATE:g}",
-                f"case 1{REF_KEY}{REF_UPDATE:g}{RETRY}", f"case 1{REF_KEY}{REF_UPDATE:g}{GAIN_KEY}"))
+GAIN_RUNS = ((f"case 1{COARSE} rerun", f"case 1{COARSE} courant {COURANT:g} rerun", f"case 1{COARSE}{GAIN_KEY}",
+              f"case 1{COARSE}{FREQ_KEY}")
+             + tuple(base + sfx for base in GAIN_T5 for sfx in ("", f" courant {COURANT:g}", GAIN_KEY, FREQ_KEY))
+             + ("case 10 courant 0.3", "case 10", f"case 10{GAIN_KEY}", f"case 10{FREQ_KEY}",
+                f"case 1{REF_KEY}{REF_UPDATE:g}", f"case 1{REF_KEY}{REF_UPDATE:g}{RETRY}",
+                f"case 1{REF_KEY}{REF_UPDATE:g}{GAIN_KEY}", f"case 1{REF_KEY}{REF_UPDATE:g}{FREQ_KEY}"))
 # the 'selfcontact' study: case 1's scatter with self-contact (t_u/5, the seeds of SCATTER_T5) and the study's table
 SELF_SCATTER = tuple(f"case 1{COARSE}{SELF_KEY}" + k[len("case 1 n_tu 5"):] for k in SCATTER_T5[:3])
 SELF_RUNS = tuple(k for n in (1, 10) for k in (
@@ -1084,10 +1091,11 @@ STUDIES = (
                  ("crowded [%]", "crowded_pct", ".1f"), ("closest pair [dx]", "closest_dp", ".2f")) + BASIC
      + (("max T [K]", "max_temperature_K", ".0f"), ("wall [s]", "wall", ".0f"))),
     ("Run-to-run scatter with self-contact (t_u/5, case 1, the same perturbation as without)", SELF_SCATTER, BASIC),
-    ("The step over the corrected gradient's gain (Numerics.gain_step, refsph.tlsph.gradient_gain; off in the "
-     "scene): each run that broke down at the scene's courant 0.3, the same at half the step, and at 0.3 with the "
-     "step divided by the largest gain (t_u/10: case 10 at 0.3, the sweep's case 10 at 0.15; case 1 at reference "
-     "update 0.1 at 0.15, at 0.075, and at 0.3 with the gain); a failed run shows its status",
+    ("The step over the corrected gradient's gain (Numerics.gain_step, refsph.tlsph.gradient_gain) and under half "
+     "the critical step (Numerics.frequency_step 0.5, refsph.tlsph.largest_frequency; both off in the scene): each "
+     "run that broke down at the scene's courant 0.3, the same at half the step, and at 0.3 with the step divided "
+     "by the largest gain, or held under half of 2 / w_max (t_u/10: case 10 at 0.3, the sweep's case 10 at 0.15; "
+     "case 1 at reference update 0.1 at 0.15, at 0.075, and at 0.3 with either); a failed run shows its status",
      GAIN_RUNS, BASIC + (("steps", "n_steps", "d"), ("CPU [min]", "cpu_min", ".1f"), ("wall [s]", "wall", ".0f"))),
     ("Contact and heat split (case 1: penalty contact, half the frictional heat into the chip)",
      ("case 1", "case 1 pinball", "case 1 all friction heat to the chip"),

@@ -99,8 +99,9 @@ def make_solver(method: str, setup: Setup) -> Solver:
                              "modes are the tensile instability's, see gamma)")
         if nm.max_condition is not None:
             raise ValueError("max_condition limits TLSPH's kernel-gradient correction; ESPH has none to limit")
-        if nm.gain_step:
-            raise ValueError("gain_step divides the step by TLSPH's corrected-gradient gain; ESPH has no correction")
+        if nm.gain_step or nm.frequency_step:
+            raise ValueError("gain_step and frequency_step limit the step by TLSPH's fixed operator (its corrected "
+                             "gradient's gain, its largest frequency); ESPH's neighbours change every step")
         if nm.self_contact is not None:
             raise ValueError("self_contact is a TLSPH option (ESPH's particles keep apart through the pressure of "
                              "their current neighbours, and its artificial pressure, gamma)")
@@ -112,6 +113,9 @@ def make_solver(method: str, setup: Setup) -> Solver:
     if method == "tlsph":
         if nm.esph_correction:
             raise ValueError("esph_correction is an ESPH option; TLSPH's kernel-gradient correction is 'corrected'")
+        if nm.frequency_step and setup.mirror is not None:
+            raise ValueError("frequency_step needs the largest frequency of a body without mirror ghosts; this setup "
+                             "has symmetry planes (model the whole body, or use gain_step)")
         prm = TLSPHParams(h=h, beta1=nm.beta1, beta2=nm.beta2, eps=nm.eps, kernel=kernel,
                           corrected=nm.corrected, ref_update_strain=nm.ref_update_strain,
                           hourglass=float(nm.hourglass), viscous_heat=bool(setup.dissipation_heat),
@@ -461,13 +465,16 @@ def step_or_fail(state: State, parts: RunParts, dt: float, rec: RunRecord) -> St
 
 
 def _time_step(setup: Setup, dt: float | None, state: State, physics=(), solver=None) -> float:
-    """The fixed dt, or the CFL step (over the solver's gain with ``Numerics.gain_step``; and no more than each
-    physics' limit, e.g. heat conduction's)."""
+    """The fixed dt, or the CFL step (over the solver's gain with ``Numerics.gain_step``; no more than
+    ``Numerics.frequency_step`` of the solver's critical step; and no more than each physics' limit, e.g. heat
+    conduction's)."""
     if dt is not None:
         return dt
     step = cfl_time_step(state, setup.material, setup.h, setup.numerics.courant)
     if setup.numerics.gain_step and solver is not None:
         step /= solver.step_gain(state)
+    if setup.numerics.frequency_step and solver is not None:
+        step = min(step, setup.numerics.frequency_step * solver.critical_step(state))
     for p in physics:
         step = min(step, p.step_limit(state))
     return step

@@ -84,6 +84,10 @@ class SolverBase:
         """What the CFL step is divided by under ``Numerics.gain_step`` (1 here; TLSPH: its gradient's gain)."""
         return 1.0
 
+    def critical_step(self, state: State) -> float:
+        """The step ``Numerics.frequency_step`` is a fraction of (no limit here; TLSPH: 2 / w_max)."""
+        return float("inf")
+
     def checkpoint(self) -> dict:
         """What a restart needs besides the state: the constraints' log and the solver's own counters."""
         ck = {CONSTRAINTS + k: v for k, v in self.constraints.checkpoint().items()}
@@ -294,42 +298,8 @@ class TLSPHSolver(SolverBase):
         if part != "deformation" and self.self_contact is not None:
             r.v = r.v + self_contact_acceleration(body, self.self_contact, self.material, self.several_bodies)
         if body is not state:
-            r = self._with_rigid(state, r, dt, contact=part != "deformation")
+            r = _with_rigid(self, state, r, dt, contact=part != "deformation")
         return self.constraints.constrain(state, r, record=part != "deformation")
-
-    def _with_rigid(self, state: State, r: Rates, dt: float, contact: bool = True) -> Rates:
-        """Rates of all rows: the deformable ones plus the pinball contact (``contact``), the rigid ones carrying
-        the reaction (dv/dt = contact force / m, turned into the recorded force and then zeroed by the
-        constraints), the contact's friction power on both sides (``Rates.friction_power``) and, where the rates
-        carry the viscous heat, the contact's damping power added to it (``Rates.heat_power``; that part alone in
-        ``Rates.damping_power``)."""
-        n, N, d = self.constraints.n_deformable, state.n, state.dim
-        v = np.zeros((N, d))
-        v[:n] = r.v
-        power = heat = damping = None
-        if r.heat_power is not None:
-            heat = np.zeros(N)
-            heat[:n] = r.heat_power
-        if contact:
-            c = self.coupling.with_tools(state, n, dt)
-            v[:n] += c.a
-            v[n:] = c.force_on_b / state.m[n:, None]
-            if c.friction_power_a is not None:
-                power = np.concatenate([c.friction_power_a, c.friction_power_b])
-            if heat is not None and c.heat_power_a is not None:
-                heat[:n] += c.heat_power_a
-                damping = np.zeros(N)
-                damping[:n] = c.heat_power_a
-        S = np.zeros((N, d, d))
-        S[:n] = r.S
-        S_zz = np.zeros(N)
-        S_zz[:n] = r.S_zz
-        l = None
-        if r.l is not None:
-            l = np.zeros((N, d, d))
-            l[:n] = r.l
-        return Rates(x=state.v.copy(), v=v, rho=None, S=S, S_zz=S_zz, l=l, friction_power=power, heat_power=heat,
-                     damping_power=damping)
 
     def deformation_gradient(self, state: State) -> np.ndarray:
         """Eq. (18) for every row (rigid rows: I)."""
@@ -338,6 +308,11 @@ class TLSPHSolver(SolverBase):
     def step_gain(self, state: State) -> float:
         """max(1, the corrected gradient's largest gain) (:meth:`~refsph.tlsph.ReferenceOperator.max_gain`)."""
         return self.reference.operator(self._body(state), self.several_bodies).max_gain()
+
+    def critical_step(self, state: State) -> float:
+        """2 / w_max of the reference configuration (:meth:`~refsph.tlsph.ReferenceOperator.critical_step`)."""
+        body = self._body(state)
+        return self.reference.operator(body, self.several_bodies).critical_step(body, self.material, self.params)
 
     def after_step(self, state: State) -> State:
         """rho = m / (J V0) (Eq. (2)); reference update when max |E| > ref_update_strain (ReferenceConfiguration)."""
@@ -363,3 +338,38 @@ class TLSPHSolver(SolverBase):
         if self.coupling is not None:
             out.update(self.coupling.diagnostics(self.several_bodies))
         return out
+
+
+def _with_rigid(solver: TLSPHSolver, state: State, r: Rates, dt: float, contact: bool = True) -> Rates:
+    """Rates of all rows: the deformable ones plus the pinball contact (``contact``), the rigid ones carrying
+    the reaction (dv/dt = contact force / m, turned into the recorded force and then zeroed by the
+    constraints), the contact's friction power on both sides (``Rates.friction_power``) and, where the rates
+    carry the viscous heat, the contact's damping power added to it (``Rates.heat_power``; that part alone in
+    ``Rates.damping_power``)."""
+    n, N, d = solver.constraints.n_deformable, state.n, state.dim
+    v = np.zeros((N, d))
+    v[:n] = r.v
+    power = heat = damping = None
+    if r.heat_power is not None:
+        heat = np.zeros(N)
+        heat[:n] = r.heat_power
+    if contact:
+        c = solver.coupling.with_tools(state, n, dt)
+        v[:n] += c.a
+        v[n:] = c.force_on_b / state.m[n:, None]
+        if c.friction_power_a is not None:
+            power = np.concatenate([c.friction_power_a, c.friction_power_b])
+        if heat is not None and c.heat_power_a is not None:
+            heat[:n] += c.heat_power_a
+            damping = np.zeros(N)
+            damping[:n] = c.heat_power_a
+    S = np.zeros((N, d, d))
+    S[:n] = r.S
+    S_zz = np.zeros(N)
+    S_zz[:n] = r.S_zz
+    l = None
+    if r.l is not None:
+        l = np.zeros((N, d, d))
+        l[:n] = r.l
+    return Rates(x=state.v.copy(), v=v, rho=None, S=S, S_zz=S_zz, l=l, friction_power=power, heat_power=heat,
+                 damping_power=damping)

@@ -35,6 +35,7 @@ antisymmetric); pi_ij is Eq. (12)-(13) evaluated with the current x_ij, v_ij.
 """
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
@@ -49,7 +50,7 @@ from .state import Rates, State
 from .tensor import component_major, det, identity, inv, matmul, rowdot, transpose
 
 __all__ = ["TLSPHParams", "ReferenceOperator", "tlsph_rates", "first_piola", "green_lagrange_norm", "gradient_gain",
-           "full_support_gain",
+           "full_support_gain", "largest_frequency",
            "reference_update", "reference_viscosity", "correction_matrix", "hourglass_acceleration"]
 
 
@@ -86,8 +87,6 @@ class ReferenceOperator:
     so that  sum_j V_j f_j (x) grad~_i W_ij = (G[k] @ f)_i  and  sum_j V_j grad~_i W_ij = G[k] @ 1.
     ``GT[k]`` is its transpose (CSR), used for the j-side term of the momentum sum (Eq. (17)).
     The kernel-gradient correction L is baked into the entries, so F needs no per-step matrix product.
-    Products are taken one column at a time: SciPy's single-vector CSR product is its fastest sparse
-    kernel (about 0.5 ns per stored entry), faster than its multi-vector one.
 
     ``pairs`` is a :class:`~refsph.neighbours.PairBlocks` of the half pairs (``block_size`` pairs per block,
     None = ``PAIR_BLOCK``), used by the artificial viscosity; its ``threads`` also run the independent sparse
@@ -146,13 +145,22 @@ class ReferenceOperator:
         self._sm, self._sm_m = None, None
         self._W: tuple | None = None                          # hourglass constants, made on first use
         self.momentum_cache_hits = self.momentum_cache_misses = 0
-        self._max_gain: float | None = None                 # max_gain(), made on first use
+        self._max_gain = self._critical_step = None         # max_gain(), critical_step(): made on first use
 
     def max_gain(self) -> float:
         """max(1, max_i a_i) of :func:`gradient_gain`, made once: the CFL step's divisor (``Numerics.gain_step``)."""
         if self._max_gain is None:
             self._max_gain = max(1.0, float(np.max(gradient_gain(self), initial=0.0)))
         return self._max_gain
+
+    def critical_step(self, state: State, mat: ElasticMaterial, prm: TLSPHParams) -> float:
+        """2 / w_max [s] of :func:`largest_frequency` about x = X at rest without stress (so a restart finds it
+        again), made once: ``Numerics.frequency_step``'s limit. ``state``: the operator's rows (for the masses)."""
+        if self._critical_step is None:
+            rest = dataclasses.replace(state, x=self.X[:state.n].copy(), v=np.zeros_like(state.v),
+                                       S=np.zeros_like(state.S), S_zz=np.zeros_like(state.S_zz))
+            self._critical_step = 2.0 / largest_frequency(rest, mat, prm, self)[0]
+        return self._critical_step
 
     def hourglass_constants(self) -> tuple[list, np.ndarray]:
         """What :func:`hourglass_acceleration` needs of the reference configuration, made once: X_j - X_i on the
@@ -244,6 +252,46 @@ def gradient_gain(op: ReferenceOperator) -> np.ndarray:
     A = np.asarray(magnitude.sum(axis=1)).ravel()
     n = op.n if op.ghosts is None else op.ghosts.n_real
     return A[:n] / full_support_gain(op.kernel, op.h, op.dim)
+
+
+def largest_frequency(state: State, mat: ElasticMaterial, prm: TLSPHParams, op: ReferenceOperator, *,
+                      tol: float = 1e-3, seed: int = 0) -> tuple[float, np.ndarray]:
+    """The largest angular frequency w_max [rad/s] of the elastic TLSPH equations linearised about ``state`` on
+    ``op`` (refsph's diagnostic; the paper gives only the CFL step), and the mode's amplitude per particle (N,).
+
+    A displacement u moves x by eps u and, through Eqs. (19) and (20) with u for v, the deviatoric stress by
+    eps dS/dt; Eqs. (24) and (17) (artificial viscosity off: it damps, it does not stiffen; hourglass control as
+    ``prm`` says) then change the acceleration by -eps K u. The leapfrog on u'' = -K u is stable if and only if
+
+        dt w_max < 2,   w_max^2 = the largest |eigenvalue| of K       (Hairer, Lubich & Wanner 2006, Sec. I.5)
+
+    for the linear elastic body exactly, and to first order about any state (plastic flow only softens). So
+    2 / (w_max h / (c_L + |v|max)) is the largest Courant number the state allows, against the CFL step's. K is
+    applied matrix-free (three rate evaluations) and its largest eigenvalue found by ARPACK (SciPy's ``eigs``,
+    relative ``tol``). ``state``: the operator's rows (a body without ghosts: mirror planes are refused)."""
+    from scipy.sparse.linalg import LinearOperator, eigs
+    if op.ghosts is not None:
+        raise ValueError("largest_frequency takes a body without mirror ghosts")
+    n, d = state.x.shape
+    if n != op.n:
+        raise ValueError(f"the state has {n} rows, the operator {op.n}")
+    prm = dataclasses.replace(prm, beta1=0.0, beta2=0.0)
+    a0 = tlsph_rates(state, mat, prm, op, part="forces").v
+    size = float(np.sqrt(np.median(op.V)))                  # a particle spacing [m]
+
+    def K(u):
+        u = u.reshape(n, d)
+        eps = 1e-6 * size / max(float(np.max(np.abs(u))), 1e-300)
+        rate = tlsph_rates(dataclasses.replace(state, v=u), mat, prm, op, part="deformation")
+        moved = dataclasses.replace(state, x=state.x + eps * u, S=state.S + eps * rate.S,
+                                    S_zz=state.S_zz + eps * rate.S_zz)
+        return (a0 - tlsph_rates(moved, mat, prm, op, part="forces").v).ravel() / eps
+
+    start = np.random.default_rng(seed).standard_normal(n * d)
+    w, vec = eigs(LinearOperator((n * d, n * d), matvec=K, dtype=float), k=1, which="LM", v0=start, tol=tol,
+                  ncv=min(n * d - 1, 30), maxiter=5000)
+    mode = np.sqrt(np.sum(np.abs(vec[:, 0].reshape(n, d)) ** 2, axis=1))
+    return float(np.sqrt(abs(w[0]))), mode / mode.max()
 
 
 def first_piola(sigma: np.ndarray, J: np.ndarray, Finv: np.ndarray) -> np.ndarray:

@@ -79,5 +79,5 @@ def test_numerics_checks_and_esph_refuses():
     from refsph.simulate import make_solver
     setup = get_scene("taylor").setup(2, None, True)
     setup.numerics = dataclasses.replace(setup.numerics, gain_step=True)
-    with pytest.raises(ValueError, match="gain_step divides"):
+    with pytest.raises(ValueError, match="gain_step and frequency_step limit"):
         make_solver("esph", setup)

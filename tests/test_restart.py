@@ -20,6 +20,9 @@ CASES = [("taylor", "tlsph", dict(dim=2, quick=True, t_end=6e-6)),
                                            options=dict(case=1, length=0.5e-3, travel=1.0))),
          ("thermal_cutting", "tlsph", dict(quick=True, t_end=2e-5, numerics=dict(threads=1, contact="penalty"),
                                            options=dict(case=1, length=0.5e-3, travel=1.0))),   # friction history
+         ("thermal_cutting", "tlsph", dict(quick=True, t_end=2e-5,                # the step under 2 / w_max
+                                           numerics=dict(threads=1, contact="penalty", frequency_step=0.2),
+                                           options=dict(case=1, length=0.5e-3, travel=1.0))),
          ("thermal_cutting", "tlsph", dict(quick=True, t_end=2e-5,                # heat kept between heat steps
                                            numerics=dict(threads=1, contact="penalty", heat_every=7),
                                            options=dict(case=1, length=0.5e-3, travel=1.0)))]

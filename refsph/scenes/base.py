@@ -45,7 +45,10 @@ class Numerics:
     (:mod:`refsph.self_contact`, LAMMPS SMD's self-contact at 0.5; None = off, as in the paper); gain_step: TLSPH's
     CFL step divided by the corrected gradient's largest gain, max(1, max_i a_i) (:func:`refsph.tlsph.gradient_gain`:
     0.90 inside a body at h = 1.3 dp (Wendland), 2.8 at a torn chip tip after a reference update in case 1's blow-up;
-    off = the plain CFL step, as in the paper). The numbers of a run do not depend on ``threads``, only its speed does.
+    off = the plain CFL step, as in the paper); frequency_step: TLSPH's step no longer than this fraction of the
+    critical step 2 / w_max of each reference configuration (:meth:`refsph.tlsph.ReferenceOperator.critical_step`;
+    0 = off, as in the paper; the leapfrog fails above 1). The numbers of a run do not depend on ``threads``, only
+    its speed does.
     """
 
     h_over_dp: float = 1.5
@@ -72,6 +75,7 @@ class Numerics:
     heat_every: int = 1
     self_contact: float | None = None
     gain_step: bool = False
+    frequency_step: float = 0.0
 
     def __post_init__(self):
         """Every parameter checked when the Numerics is made (a scene's, or ``--set``'s replacement of it), so that
@@ -98,6 +102,7 @@ class Numerics:
         real("penalty_alpha", 0.0, 4.0, lo_open=True)
         real("max_condition", 1.0, lo_open=True, optional=True)
         real("self_contact", 0.0, 1.0, lo_open=True, optional=True)
+        real("frequency_step", 0.0, 1.0)
         if not (isinstance(self.threads, int) and not isinstance(self.threads, bool) and self.threads >= 0):
             raise ValueError(f"numerical parameter threads must be a whole number >= 0, got {self.threads!r}")
         if not (isinstance(self.heat_every, int) and not isinstance(self.heat_every, bool) and self.heat_every >= 1):

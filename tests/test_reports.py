@@ -19,7 +19,7 @@ def _script(name):
     return mod
 
 
-@pytest.mark.parametrize("name", ["taylor", "pressing", "cutting"])
+@pytest.mark.parametrize("name", ["taylor", "pressing", "cutting", "stable_step"])
 def test_report_is_generated_from_the_json(name):
     records = json.loads((ROOT / "benchmarks" / f"{name}.json").read_text())
     assert _script(name).report(records) == (ROOT / "benchmarks" / f"{name}_report.md").read_text()

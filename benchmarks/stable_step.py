@@ -83,12 +83,17 @@ def measure(numerics: dict) -> dict:
     return dict(updates=rows, end=end, cpu_min=(time.process_time() - start) / 60.0)
 
 
+def ordered(data: dict) -> dict:
+    """The recorded runs in the order of RUNS."""
+    return {k: data[k] for k in RUNS if k in data}
+
+
 def figure(data: dict) -> None:
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     fig, (ax, bx) = plt.subplots(1, 2, figsize=(10, 3.8), constrained_layout=True)
-    for (label, run), color in zip(data.items(), ("C3", "C0", "C2")):
+    for (label, run), color in zip(ordered(data).items(), ("C3", "C0", "C2")):
         t = [r["t_ms"] for r in run["updates"]]
         ax.plot(t, [r["C_crit"] for r in run["updates"]], "o-", color=color, ms=3, label=f"C_crit, {label}")
         ax.plot(t, [r["courant_used"] for r in run["updates"]], "--", color=color, label=f"in use, {label}")
@@ -109,7 +114,7 @@ def report(data: dict) -> str:
              "elastic TLSPH equations (`refsph.tlsph.largest_frequency`); a state is stable with the leapfrog below "
              "C_crit. The gain is the corrected gradient's (`refsph.tlsph.gradient_gain`).\n\n"
              "![C_crit](../figures/11_stable_step.png)\n"]
-    for label, run in data.items():
+    for label, run in ordered(data).items():
         rows = run["updates"]
         table = [[r["update"], f(r["t_ms"], ".4f"), f(r["C_crit"], ".3f"), f(r["courant_used"], ".3f"),
                   f(r["gain_max"], ".2f"), f(r["C_crit"] * r["gain_max"], ".2f"), r["mode_particle"],
@@ -134,7 +139,6 @@ def main(argv=None) -> int:
                 data[label] = measure(numerics)
                 study.write_json(OUT_JSON, data)                 # each run kept as soon as it is done
                 print(f"{label}: {data[label]['end']['status']}, {len(data[label]['updates'])} updates", flush=True)
-    data = {k: data[k] for k in RUNS if k in data}
     figure(data)
     study.write_if_changed(OUT_MD, report(data))
     print(report(data))

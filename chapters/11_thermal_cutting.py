@@ -370,6 +370,18 @@ display(Markdown(split_page.split("\n\n", 1)[1]))             # the page without
 #   (mean 0.94) of the steps of half the step, and so did case 10 at $t_u/10$ (1.15): not cheaper, but the step
 #   shrinks for a measured reason, where and when the gradient amplifies (the page's gain table; one run each).
 #
+# %% [markdown]
+# * **The stable step, measured.** The leapfrog on the linearised equations $\ddot{\mathbf u} = -\mathbf K
+#   \mathbf u$ is stable if and only if $\Delta t\,\omega_{max} < 2$. `refsph.tlsph.largest_frequency` finds
+#   $\omega_{max}$ ($\mathbf K$ applied matrix-free, ARPACK; 0.1 s at $t_u/10$), so a state allows any Courant
+#   number below $C_{crit} = 2 (c_L + |v|_{max}) / (\omega_{max} h)$: 1.04 for a fresh lattice, and refsph's leapfrog
+#   is stable at 0.97 of the critical step and fails at 1.03 (tested). Before case 1's blow-up $C_{crit}$ fell
+#   0.55 → 0.39 → 0.32 → 0.30 → 0.255 over the last five updates, below the run's 0.3, and the particle that blew
+#   up is where the mode was largest (`benchmarks/stable_step_report.md`). $C_{crit}$ times the largest gain stays
+#   at 0.72–1.06, so the gain tracks the stable step, and at 0.3 the gain step keeps a margin of 2.6 or more.
+#   `--set frequency_step=0.5` holds the step under half of each reference configuration's $2/\omega_{max}$
+#   instead: case 1 then took 0.87 of the gain step's steps and 0.78 of half the step's (one run each).
+#
 # ## Your turn
 #
 # Predict first, run, then open *What you should see*. The last exercise asks for code, graded against the package.

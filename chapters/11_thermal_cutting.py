@@ -380,7 +380,8 @@ display(Markdown(split_page.split("\n\n", 1)[1]))             # the page without
 #   up is where the mode was largest (`benchmarks/stable_step_report.md`). $C_{crit}$ times the largest gain stays
 #   at 0.72–1.06, so the gain tracks the stable step, and at 0.3 the gain step keeps a margin of 2.6 or more.
 #   `--set frequency_step=0.5` holds the step under half of each reference configuration's $2/\omega_{max}$
-#   instead: case 1 then took 0.87 of the gain step's steps and 0.78 of half the step's (one run each).
+#   instead: the six $t_u/5$ runs that broke down at 0.3 ran to the end in 0.54–1.25 (mean 0.70) of the steps of
+#   half the step, 0.66 of its CPU, and 0.75 of the gain step's steps (the page's gain table; one run each).
 #
 # ## Your turn
 #

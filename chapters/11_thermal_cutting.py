@@ -377,11 +377,14 @@ display(Markdown(split_page.split("\n\n", 1)[1]))             # the page without
 #   number below $C_{crit} = 2 (c_L + |v|_{max}) / (\omega_{max} h)$: 1.04 for a fresh lattice, and refsph's leapfrog
 #   is stable at 0.97 of the critical step and fails at 1.03 (tested). Before case 1's blow-up $C_{crit}$ fell
 #   0.55 → 0.39 → 0.32 → 0.30 → 0.255 over the last five updates, below the run's 0.3, and the particle that blew
-#   up is where the mode was largest (`benchmarks/stable_step_report.md`). $C_{crit}$ times the largest gain stays
-#   at 0.72–1.06, so the gain tracks the stable step, and at 0.3 the gain step keeps a margin of 2.6 or more.
-#   `--set frequency_step=0.5` holds the step under half of each reference configuration's $2/\omega_{max}$
-#   instead: the six $t_u/5$ runs that broke down at 0.3 ran to the end in 0.54–1.25 (mean 0.70) of the steps of
-#   half the step, 0.66 of its CPU, and 0.75 of the gain step's steps (the page's gain table; one run each).
+#   up is where the mode was largest (`benchmarks/stable_step_report.md`).
+#
+# %% [markdown]
+# * **Two steps that follow it.** $C_{crit}$ times the largest gain stays at 0.72–1.06, so the gain tracks the
+#   stable step, and at 0.3 the gain step keeps a margin of 2.6 or more. `--set frequency_step=0.5` holds the
+#   step under half of each reference configuration's $2/\omega_{max}$ instead: the six $t_u/5$ runs that broke
+#   down at 0.3 ran to the end in 0.54–1.25 (mean 0.70) of the steps of half the step, 0.66 of its CPU, and 0.75
+#   of the gain step's steps (the page's gain table; one run each).
 #
 # ## Your turn
 #

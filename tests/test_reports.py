@@ -502,6 +502,20 @@ def test_thermal_cutting_reference_update_study_runs_what_its_keys_say():
     assert "| case 1 n_tu 5 | 0.50 |" in page and "| case 1 n_tu 5 ref update 0.1 | 0.10 |" in page
 
 
+def test_thermal_cutting_frequency_study_is_the_gain_study_with_the_frequency_step():
+    """The 'frequency' study: each gain-study run again with frequency_step instead of gain_step (nothing else
+    changed), under the same key with FREQ_KEY for GAIN_KEY, and each in the gain table beside its gain run."""
+    mod = _script("thermal_cutting")
+    todo = {key: (options, numerics) for study, key, options, numerics in mod.more_jobs() if study == "frequency"}
+    gain = mod.gain_step_jobs()
+    assert len(todo) == len(gain) == 8
+    for key, (options, numerics) in gain.items():
+        f_options, f_numerics = todo[key.replace(mod.GAIN_KEY, mod.FREQ_KEY)]
+        assert f_options == options and numerics.pop("gain_step") is True
+        assert f_numerics == dict(numerics, frequency_step=mod.FREQUENCY_STEP)
+        assert key in mod.GAIN_RUNS and key.replace(mod.GAIN_KEY, mod.FREQ_KEY) in mod.GAIN_RUNS
+
+
 def test_thermal_cutting_refuses_to_skip_a_record_made_with_other_numerics(tmp_path):
     """_sweep_round: a key recorded with other scene options or other numerics than its job now asks for is not
     skipped as done, and not run over either: the sweep stops and names it (--redo runs it again)."""

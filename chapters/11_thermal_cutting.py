@@ -385,8 +385,8 @@ display(Markdown(split_page.split("\n\n", 1)[1]))             # the page without
 #   step under half of each reference configuration's $2/\omega_{max}$ instead: the six $t_u/5$ runs that broke
 #   down at 0.3 ran to the end in 0.54–1.25 (mean 0.70) of the steps of half the step, 0.66 of its CPU, and 0.75
 #   of the gain step's steps. At $t_u/10$ case 10 ran too, but in 1.10 of the steps of half the step: by its step
-#   count $C_{crit}$ averaged about 0.27 there, so half the step was already about half the critical one (the
-#   page's gain table; one run each).
+#   count $C_{crit}$ averaged about 0.27 there, so half the step was already about half the critical one. Case 1
+#   at reference update 0.1 took 0.59 of the steps of the sweep's case 1 (the page's gain table; one run each).
 #
 # ## Your turn
 #

@@ -140,8 +140,9 @@ def main(argv=None) -> int:
                 study.write_json(OUT_JSON, data)                 # each run kept as soon as it is done
                 print(f"{label}: {data[label]['end']['status']}, {len(data[label]['updates'])} updates", flush=True)
     figure(data)
-    study.write_if_changed(OUT_MD, report(data))
-    print(report(data))
+    page = report(data)
+    study.write_if_changed(OUT_MD, page)
+    print(page)
     return 0
 
 

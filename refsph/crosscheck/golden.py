@@ -1239,20 +1239,17 @@ def _write_cases(root: Path, only=None) -> list[str]:
     for name in chosen:
         _clear_case(root / name)
     root.mkdir(parents=True, exist_ok=True)
-    done = set()
     for group, write in _registry():
         if chosen & set(group):                             # a group's cases are computed together, all written
             written = write(root)
             written = [written] if isinstance(written, str) else written
             assert list(written) == list(group), (written, group)
-            done.update(written)
     index = dict(format_version=FORMAT_VERSION, format="golden/FORMAT.md", format_changes=FORMAT_CHANGES,
                  refsph_version=__version__, cases=case_names(), generated_with=generated_with(),
                  conventions=COMMON_CONVENTIONS,
                  compare="refsph compare DIR YOUR_DIR: every output array within its case's tolerance, relative to "
                          "the largest value of the reference array")
     (root / "index.json").write_text(json.dumps(index, indent=1) + "\n")
-    assert done == set(written_names(only)), (done, only)
     return written_names(only)
 
 

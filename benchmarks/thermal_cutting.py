@@ -91,7 +91,7 @@ def _s(case: int) -> float:
 
 
 STUDY_NAMES = ("cases", "coarse", "pfem", "detector", "scaling", "scatter", "resolution", "timestep", "tool",
-               "contact", "refupdate", "selfcontact", "gain", "frequency")
+               "contact", "refupdate", "selfcontact", "gain", "frequency", "refined")
 COURANT = 0.15                             # every run at dx <= t_u / 10: half the scene's step (module text)
 COARSE = " n_tu 5"                         # the key suffix of the 'coarse' study: all 18 cases at dx = t_u / 5
 PFEM = " pfem n_tu 5"                      # the key suffix of the 'pfem' study: the 18 cases with the PFEM at t_u / 5
@@ -112,6 +112,9 @@ GAIN_KEY = " gain step"                    # the 'gain' study's key part: Numeri
                                            # corrected gradient's largest gain, refsph.tlsph.gradient_gain)
 FREQUENCY_STEP = 0.5                       # the 'frequency' study: Numerics.frequency_step (the step under this
 FREQ_KEY = f" frequency step {FREQUENCY_STEP:g}"   # fraction of 2 / w_max, refsph.tlsph.largest_frequency)
+REFINED = f"{REF_KEY}{REF_UPDATE:g}{FREQ_KEY}"   # the 'refined' study: the 18 cuts at t_u/10 at REF_UPDATE (the
+                                           # t_u/5 study: 0.5 is not converged, 0.1 is within the scatter of 0.05) at
+                                           # the scene's courant 0.3 under FREQUENCY_STEP (case 1: the 'frequency' run)
 DAMPED_GAMMA = 0.6                         # a PFEM case of the t_u / 10 table that failed with the trapezoidal rule,
 DAMPED = f" n_tu 10 gamma {DAMPED_GAMMA:g}"  # again with Newmark's damped rule, under 'case N pfem' + DAMPED
 BOSSAK_ALPHA = -0.1                        # the Bossak-Newmark rule (second order, damped) beside the damped rule:
@@ -229,6 +232,8 @@ def more_jobs() -> list[tuple[str, str, dict, dict]]:
     out += [("frequency", key.replace(GAIN_KEY, FREQ_KEY), options,
              dict({k: v for k, v in numerics.items() if k != "gain_step"}, frequency_step=FREQUENCY_STEP))
             for key, (options, numerics) in gain_step_jobs().items()]
+    out += [("refined", f"case {n}{REFINED}", converged(n), dict(ref_update_strain=REF_UPDATE,
+                                                                 frequency_step=FREQUENCY_STEP)) for n in range(1, 19)]
     # case 10 at s/2 moved Fc by -21 %, T_RF by -12 %, one run against case 10's scatter of three: its scatter at s/2
     # too (the same two seeds), so that the forces' dependence on s is read between two groups of three
     out += [("scaling", f"case 10 s/2 jitter {seed}", converged(10, mass_scale=_s(10) / 2, jitter=0.01, seed=seed),
@@ -962,6 +967,7 @@ REF_RUNS = tuple(f"case {n}{COARSE}{REF_KEY}{r:g}" if r != SCENE_REF_UPDATE else
     f"case 1{REF_KEY}{REF_UPDATE:g}{RETRY}",) + tuple(
     f"case {n}{COARSE}{REF_KEY}{r:g} courant {COURANT:g}" for n, r in REF_FAILED)
 HALF_STEP_RUNS = tuple(f"case {n}{COARSE}{HALF_STEP}" for n in range(1, 19))
+REFINED_RUNS = tuple(f"case {n}{REFINED}" for n in range(1, 19))
 # the 'gain' study's table: each run with the step over the gradient's gain beside the same run at the scene's step
 # (courant 0.3) and at half of it
 GAIN_T5 = (*(f"case {n}{COARSE}{REF_KEY}{r:g}" for n, r in REF_FAILED), f"case 10{COARSE}{SELF_KEY}",
@@ -1081,6 +1087,11 @@ STUDIES = (
      "scene's 0.5 and 0.3): at 0.3 the SPH cuts' blow-ups come by chance at every threshold, at 0.15 none of the "
      "four tried failed (the self-contact tables below)",
      HALF_STEP_RUNS, BASIC + (("max T [K]", "max_temperature_K", ".0f"), ("wall [s]", "wall", ".0f"))),
+    (f"The 18 cuts at t_u/10 at ref update {REF_UPDATE:g} (the t_u/10 table's: the scene's 0.5, which the t_u/5 study "
+     f"finds unconverged) at the scene's courant 0.3 with the step under {FREQUENCY_STEP:g} of 2 / w_max "
+     f"(Numerics.frequency_step; case 1 at {REF_UPDATE:g} went NaN at courant 0.15 without it)",
+     REFINED_RUNS, BASIC + (("max T [K]", "max_temperature_K", ".0f"), ("steps", "n_steps", "d"),
+                            ("CPU [min]", "cpu_min", ".1f"))),
     (f"Run-to-run scatter at ref update {REF_UPDATE:g} (t_u/5, case 1, the same perturbation as at the scene's 0.5)",
      REF_SCATTER, BASIC),
     ("Self-contact (Numerics.self_contact = 0.5: particles of the workpiece closer than dx/2 repel, "
@@ -1144,23 +1155,27 @@ def _study_lines(res: dict) -> list[str]:
             lines += [_single_run_line(res, k, group) for group, singles in REF_SINGLES for k in singles]
         if keys == HALF_STEP_RUNS:
             lines += ["", _half_step_errors(res)]
+        if keys == REFINED_RUNS:
+            lines += ["", _half_step_errors(res, REFINED, "", "the t_u/10")]
     return lines
 
 
-def _half_step_errors(res: dict) -> str:
-    """Mean |error| against the measurements of T_RF, T_FCS and Fp/Fc per material over the cases the half-step
-    group has recorded 'ok', beside the 'coarse' table's (0.5, Courant 0.3) over the same cases (both from
+def _half_step_errors(res: dict, suffix: str = COARSE + HALF_STEP, base: str = COARSE,
+                      name: str = "the 'coarse'") -> str:
+    """Mean |error| against the measurements of T_RF, T_FCS and Fp/Fc per material over the cases the group of key
+    suffix ``suffix`` (default: the half-step group) has recorded 'ok', beside the group ``base``'s (default the
+    'coarse' table's: 0.5, Courant 0.3; its ``name`` in the line) over the same cases (both from
     :func:`comparison`)."""
-    here, coarse = comparison(res, COARSE + HALF_STEP), comparison(res, COARSE)
+    here, coarse = comparison(res, suffix), comparison(res, base)
     parts = []
     for material in ("AISI1045", "Ti6Al4V"):
         h, c = both_ok(here, coarse, material)
         if h:
-            errs = [f"{name} {_mean(h, q):.1f} % ({'coarse ' if q == 'TRF_err' else ''}{_mean(c, q):.1f} %)"
-                    for name, q in (("T_RF", "TRF_err"), ("T_FCS", "TFCS_err"), ("Fp/Fc", "ratio_err"))]
+            errs = [f"{qn} {_mean(h, q):.1f} % ({'before ' if q == 'TRF_err' else ''}{_mean(c, q):.1f} %)"
+                    for qn, q in (("T_RF", "TRF_err"), ("T_FCS", "TFCS_err"), ("Fp/Fc", "ratio_err"))]
             parts.append(f"{material} ({len(h)} cases): " + ", ".join(errs))
-    return ("Mean |error| against the measurements over the cases recorded here, beside the 'coarse' table's on the "
-            "same cases: " + ("; ".join(parts) if parts else "none recorded yet") + ".")
+    return ("Mean |error| against the measurements over the cases recorded here, beside " + name + " table's on the "
+            "same cases ('before'): " + ("; ".join(parts) if parts else "none recorded yet") + ".")
 
 
 def resolution_convergence(res: dict) -> list[dict]:

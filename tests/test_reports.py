@@ -516,6 +516,21 @@ def test_thermal_cutting_frequency_study_is_the_gain_study_with_the_frequency_st
         assert key in mod.GAIN_RUNS and key.replace(mod.GAIN_KEY, mod.FREQ_KEY) in mod.GAIN_RUNS
 
 
+def test_thermal_cutting_refined_study_is_the_sweep_at_the_tighter_reference_update():
+    """The 'refined' study: the 18 cuts of the t_u/10 table with the same scene options, at reference update
+    REF_UPDATE under the frequency step (the scene's courant), case 1's the very run of the 'frequency' study; its
+    table lists them in case order."""
+    mod = _script("thermal_cutting")
+    todo = mod.jobs(studies=("refined",))
+    assert list(todo) == list(mod.REFINED_RUNS) and len(todo) == 18
+    sweep = mod.jobs(studies=("cases",))
+    for n, key in enumerate(mod.REFINED_RUNS, start=1):
+        options, numerics = todo[key]
+        assert options == sweep[f"case {n}"][0]
+        assert numerics == dict(ref_update_strain=mod.REF_UPDATE, frequency_step=mod.FREQUENCY_STEP)
+    assert todo["case 1" + mod.REFINED] == mod.jobs(studies=("frequency",))["case 1" + mod.REFINED]
+
+
 def test_thermal_cutting_refuses_to_skip_a_record_made_with_other_numerics(tmp_path):
     """_sweep_round: a key recorded with other scene options or other numerics than its job now asks for is not
     skipped as done, and not run over either: the sweep stops and names it (--redo runs it again)."""

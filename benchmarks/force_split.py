@@ -124,15 +124,16 @@ def continue_run(folder: Path, travel: float, scratch: Path, numerics: dict | No
     import dataclasses
 
     import refsph.coupling as coupling
-    from refsph.simulate import _prepare, simulate
+    from refsph.simulate import build, simulate
 
     summary = json.loads((folder / "summary.json").read_text())
     args = summary["run_args"]
     work = scratch_copy(folder, scratch)
     shutil.copytree(folder, work)
-    setup, scene, metrics, _ = _prepare(args["scene_name"], args["method"], args["dim"], args["dp"], args["t_end"],
-                                        args["quick"], args["dt"], dict(args["numerics"] or {}, **(numerics or {})),
-                                        args["options"], args.get("particles"))
+    setup, scene, metrics = build(args["scene_name"], args["method"], dim=args["dim"], dp=args["dp"],
+                                  t_end=args["t_end"], quick=args["quick"], dt=args["dt"],
+                                  numerics=dict(args["numerics"] or {}, **(numerics or {})), options=args["options"],
+                                  particles=args.get("particles"))
     rebuilt = dataclasses.asdict(setup.numerics)
     differ = {k: (v, rebuilt[k]) for k, v in summary["numerics"].items()
               if k in rebuilt and rebuilt[k] != v and k not in (numerics or {})}

@@ -50,10 +50,10 @@ def measure(numerics: dict) -> dict:
     """Case 1 at t_u/5 at the scene's Courant number (with ``numerics``: the gain step, the frequency step), C_crit
     at every reference update (module text)."""
     import thermal_cutting as tc
-    from refsph.simulate import SimulationError, _prepare, _time_step, simulate
+    from refsph.simulate import SimulationError, build, simulate, time_step
     from refsph.tlsph import gradient_gain, largest_frequency
-    setup, scene, metrics, _ = _prepare("thermal_cutting", "tlsph", None, None, None, False, None,
-                                        dict(numerics, threads=1), tc.converged(1, n_tu=5.0), None)
+    setup, scene, metrics = build("thermal_cutting", "tlsph", numerics=dict(numerics, threads=1),
+                                  options=tc.converged(1, n_tu=5.0))
     h, c = setup.h, setup.material.c_longitudinal
     rows, seen = [], set()
 
@@ -70,7 +70,7 @@ def measure(numerics: dict) -> dict:
         peak = int(np.argmax(mode))
         rows.append(dict(t_ms=1e3 * float(state.t), update=int(solver.reference.n_updates),
                          C_crit=2.0 * (c + vmax) / (omega * h), gain_max=float(gain.max()),
-                         courant_used=_time_step(setup, None, state, (), solver) * (c + vmax) / h,
+                         courant_used=time_step(setup, None, state, (), solver) * (c + vmax) / h,
                          mode_particle=peak, mode_gain=float(gain[peak]), gain_particle=int(np.argmax(gain))))
 
     start = time.process_time()

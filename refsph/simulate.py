@@ -33,7 +33,7 @@ import warnings
 import zipfile
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Callable
+from typing import Callable, NamedTuple
 
 import numpy as np
 
@@ -55,8 +55,9 @@ from .solvers import ESPHSolver, TLSPHSolver
 from .state import State
 from .tlsph import TLSPHParams
 
-__all__ = ["SimulationError", "RunResult", "RunRecord", "make_solver", "step_physics", "run", "check_run", "simulate",
-           "snapshot_times", "step_or_fail", "provenance", "run_commits", "earlier_commits", "restart_run", "METHODS"]
+__all__ = ["SimulationError", "RunResult", "RunRecord", "Built", "make_solver", "step_physics", "run", "build",
+           "check_run", "simulate", "time_step", "snapshot_times", "step_or_fail", "provenance", "run_commits",
+           "earlier_commits", "restart_run", "METHODS"]
 
 METHODS = ("esph", "tlsph")
 CHECKPOINT = "restart.npz"          # snapshots/restart.npz: how to continue from the last checkpoint (see simulate)
@@ -464,10 +465,10 @@ def step_or_fail(state: State, parts: RunParts, dt: float, rec: RunRecord) -> St
     return step
 
 
-def _time_step(setup: Setup, dt: float | None, state: State, physics=(), solver=None) -> float:
-    """The fixed dt, or the CFL step (over the solver's gain with ``Numerics.gain_step``; no more than
-    ``Numerics.frequency_step`` of the solver's critical step; and no more than each physics' limit, e.g. heat
-    conduction's)."""
+def time_step(setup: Setup, dt: float | None, state: State, physics=(), solver=None) -> float:
+    """The step the run loop takes from ``state``: the fixed dt, or the CFL step (over the solver's gain with
+    ``Numerics.gain_step``; no more than ``Numerics.frequency_step`` of the solver's critical step; and no more
+    than each physics' limit, e.g. heat conduction's)."""
     if dt is not None:
         return dt
     step = cfl_time_step(state, setup.material, setup.h, setup.numerics.courant)
@@ -556,7 +557,7 @@ def _begin(setup: Setup, parts: RunParts, out, dt, name: str, record, record_eve
     parts.bind(state)
     rec = RunRecord(setup, parts, out, dt, name, record, snapshot_times(setup), overwrite=overwrite,
                     checkpoint_every=checkpoint_every)
-    rec.record_every = record_every or max(1, int(setup.t_end / _time_step(setup, dt, state, parts.physics) / 400))
+    rec.record_every = record_every or max(1, int(setup.t_end / time_step(setup, dt, state, parts.physics) / 400))
     _warn_fixed_dt(setup, dt, state)
     rec.record(state)
     rec.snapshot_if_due(state)
@@ -645,7 +646,7 @@ def simulate(setup: Setup, method: str | None = None, *, scene: Scene | None = N
 def _one_step(setup: Setup, parts: RunParts, rec: RunRecord, state: State, dt: float | None, hook) -> State:
     """The step size (the CFL step, the physics' limits, the next snapshot time), the mechanical step, each
     physics after it, the hook, then the record and the snapshots that are due."""
-    step_dt = _time_step(setup, dt, state, parts.physics, parts.solver)
+    step_dt = time_step(setup, dt, state, parts.physics, parts.solver)
     rec.dts.append(step_dt)                                 # the step size chosen (before any cut to land on time)
     step_dt = min(step_dt, rec.next_output_time() - state.t)   # snapshots land on their nominal times
     prev, step = state, step_or_fail(state, parts, step_dt, rec)
@@ -691,6 +692,24 @@ def run(scene_name: str, method: str, *, dim: int | None = None, dp: float | Non
         _check_same_run(Path(out), args)
     return simulate(setup, method, scene=scene, out=out, dt=dt, progress=progress, restart=restart,
                     meta=dict(run_args=args), metrics=metrics, overwrite=overwrite, checkpoint_every=checkpoint_every)
+
+
+class Built(NamedTuple):
+    """What :func:`build` returns: the run's ``setup``, its ``scene`` and the ``metrics`` callback to pass on."""
+    setup: Setup
+    scene: Scene
+    metrics: Callable
+
+
+def build(scene_name: str, method: str, *, dim: int | None = None, dp: float | None = None,
+          t_end: float | None = None, quick: bool = False, dt: float | None = None, numerics: dict | None = None,
+          options: dict | None = None, particles=None) -> Built:
+    """What :func:`run` would simulate, built and not run (the same arguments, checked the same way): the Setup
+    of scene ``scene_name`` with ``numerics`` and ``options`` applied, its Scene and metrics. Change the setup, then
+    ``simulate(b.setup, method, scene=b.scene, metrics=b.metrics, hook=...)``: a registered scene with a hook of
+    one's own, a record, another solver (README, "Your own scene")."""
+    setup, scene, metrics, _ = _prepare(scene_name, method, dim, dp, t_end, quick, dt, numerics, options, particles)
+    return Built(setup, scene, metrics)
 
 
 def _check_same_run(out: Path, args: dict) -> None:

@@ -1,5 +1,6 @@
 """The public path for a scene of one's own: the README's script, a solver of one's own, a per-step hook, rigid
 bodies that turn, an initial stress, the heating switch, clean summaries."""
+import json
 import re
 import runpy
 from pathlib import Path
@@ -10,7 +11,7 @@ import pytest
 from refsph.boundaries import RigidBody
 from refsph.integrate import Solver
 from refsph.scenes import Numerics, Setup, aisi4340_material, lattice
-from refsph.simulate import make_solver, run, simulate
+from refsph.simulate import build, make_solver, run, simulate
 from refsph.state import concatenate_states, make_state
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -150,6 +151,27 @@ def test_own_solver_and_hook(integrator):
     P = np.sum(res.state.m[:, None] * res.state.v, axis=0)
     assert P[1] == pytest.approx(-1e6 * res.state.t * res.state.m.sum(), rel=1e-9)
     assert len(calls) == res.summary["n_steps"] and res.summary["method"] == "tlsph"
+
+
+def test_build_is_what_run_simulates(tmp_path):
+    """build: a registered scene's setup with run's numerics and options applied and checked, not run; simulated
+    with its scene and metrics (and a hook of one's own) it gives run's numbers, bit for bit. Unknown numerics and
+    options are refused as run refuses them."""
+    kw = dict(quick=True, t_end=2e-6, numerics=dict(courant=0.2), options=dict(symmetry=False))
+    b = build("taylor", "tlsph", **kw)
+    assert b.setup.numerics.courant == 0.2 and b.setup.t_end == 2e-6 and b.scene.name == "taylor"
+    steps = []
+    mine = simulate(b.setup, "tlsph", scene=b.scene, metrics=b.metrics, hook=lambda s, sv: steps.append(s.t),
+                    out=tmp_path / "mine", progress=False)
+    ref = run("taylor", "tlsph", out=tmp_path / "run", progress=False, **kw)
+    assert np.array_equal(mine.state.x, ref.state.x)
+    assert (json.loads((tmp_path / "mine" / "summary.json").read_text())["metrics"]
+            == json.loads((tmp_path / "run" / "summary.json").read_text())["metrics"])
+    assert len(steps) == ref.summary["n_steps"] > 0
+    with pytest.raises(ValueError, match="unknown numerical parameter"):
+        build("taylor", "tlsph", quick=True, numerics=dict(courrant=0.2))
+    with pytest.raises((ValueError, TypeError), match="symetry"):
+        build("taylor", "tlsph", quick=True, options=dict(symetry=False))
 
 
 def test_a_wrapper_without_part_is_refused_before_the_first_step():

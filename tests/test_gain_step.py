@@ -56,7 +56,7 @@ def _setup(x, gain_step):
 
 
 def test_the_step_is_divided_by_the_gain_and_a_healthy_body_is_unchanged():
-    from refsph.simulate import _time_step, make_solver, simulate
+    from refsph.simulate import time_step, make_solver, simulate
     X, _, _ = block_lattice(12, 12, DX, DX)
     runs = {g: simulate(_setup(X, g), "tlsph", progress=False) for g in (False, True)}
     assert runs[True].summary["n_steps"] == runs[False].summary["n_steps"]      # gain 1: the same run, bit for bit
@@ -64,10 +64,10 @@ def test_the_step_is_divided_by_the_gain_and_a_healthy_body_is_unchanged():
     X2 = np.vstack([X, X[-1] + [2.2 * DX, 0.3 * DX]])
     setup = _setup(X2, True)
     solver = make_solver("tlsph", setup)
-    plain = _time_step(setup, None, setup.state)
+    plain = time_step(setup, None, setup.state)
     assert solver.step_gain(setup.state) > 1.15
-    assert _time_step(setup, None, setup.state, (), solver) == pytest.approx(plain / solver.step_gain(setup.state))
-    assert _time_step(dataclasses.replace(setup, numerics=dataclasses.replace(setup.numerics, gain_step=False)),
+    assert time_step(setup, None, setup.state, (), solver) == pytest.approx(plain / solver.step_gain(setup.state))
+    assert time_step(dataclasses.replace(setup, numerics=dataclasses.replace(setup.numerics, gain_step=False)),
                       None, setup.state, (), solver) == plain
 
 

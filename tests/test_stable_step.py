@@ -104,7 +104,7 @@ def test_frequency_step_holds_the_step_under_the_critical_one():
     """A healthy lattice at Courant 0.3 with frequency_step 0.5: the CFL step is the smaller (C_crit 1.04), the run
     bit for bit the plain one. The torn tip at Courant 1.0, above its C_crit (0.82): the plain run fails, with
     frequency_step 0.9 the step is 0.9 of 2 / w_max and the run lasts."""
-    from refsph.simulate import _time_step
+    from refsph.simulate import time_step
     X = _lattice()
 
     def numerics(setup, **kw):
@@ -121,7 +121,7 @@ def test_frequency_step_holds_the_step_under_the_critical_one():
         simulate(tip, "tlsph", progress=False)
     tip = numerics(tip, frequency_step=0.9)
     solver = make_solver("tlsph", tip)
-    assert _time_step(tip, None, tip.state, (), solver) == pytest.approx(0.9 * 2.0 / omega, rel=1e-3)
+    assert time_step(tip, None, tip.state, (), solver) == pytest.approx(0.9 * 2.0 / omega, rel=1e-3)
     res = simulate(tip, "tlsph", progress=False)
     assert res.summary["status"] == "ok" and np.abs(res.state.v).max() < 1e-2
 

@@ -15,9 +15,8 @@ Runs (2D plane strain, the scene `refsph.scenes.cutting`, 1 mm of cut = 20 us un
   coarse-...           the same at dp = 0.025 mm and 0.0167 mm (feed 0.3 mm), for the work-precision plot
   noupdate-tlsph       TLSPH without reference-configuration updates, dp = 0.025 mm, feed 0.3 mm, 0.5 mm of
                        cut (reduced size), against the same run with updates (coarse-tlsph-f0.3-25um)
-  penalty-tlsph-fFEED  the TLSPH paper runs with the penalty tool contact (Numerics.contact = 'penalty') in
-                       place of the paper's pinballs; ESPH has no tool contact of that kind (its tool acts
-                       through the SPH sums)
+  penalty-METHOD-fFEED the paper runs with the penalty tool contact (Numerics.contact = 'penalty'): TLSPH's in
+                       place of the paper's pinballs, ESPH's in place of the tool's particles in the SPH sums
 Each run is one process; its folder runs/benchmarks/cutting/NAME keeps summary.json, reaction_forces.csv and all
 snapshots (every 1/8 of the cut). BLAS/OpenMP pools are pinned to one thread; refsph's pair sums run on the run's
 share of the cores (Numerics.threads: all of them with --jobs 1, one each with --jobs 2). Wall times are what the
@@ -78,14 +77,16 @@ def job_list():
     for m in METHODS:
         jobs.append(dict(name=f"coarse-{m}-f0.3-{dp_tag(1e-3 / 60)}", method=m, dp=1e-3 / 60, feed=0.3e-3,
                          travel=1e-3, numerics=None))
-    for f in FEEDS:                     # the paper runs with the penalty tool contact (TLSPH only: ESPH has none)
-        jobs.append(dict(name=f"penalty-tlsph-f{f * 1e3:g}", method="tlsph", dp=DP_PAPER, feed=f, travel=1e-3,
-                         numerics=dict(contact="penalty")))
+    for m in ("tlsph", "esph"):         # the paper runs with the penalty tool contact (ESPH: the tool out of the sums)
+        for f in FEEDS:
+            jobs.append(dict(name=f"penalty-{m}-f{f * 1e3:g}", method=m, dp=DP_PAPER, feed=f, travel=1e-3,
+                             numerics=dict(contact="penalty")))
     return jobs
 
 
 def is_penalty(r) -> bool:
-    """A run (job or record) with the penalty tool contact; the other TLSPH runs have the paper's pinballs."""
+    """A run (job or record) with the penalty tool contact; the other runs have the paper's (TLSPH: pinballs; ESPH:
+    the tool's particles in the SPH sums)."""
     return r["name"].startswith("penalty-")
 
 
@@ -135,7 +136,8 @@ def record(job, runs=None):
                threads=s.get("threads", s["numerics"].get("threads", 1)), status=s["status"], error=s.get("error"),
                t_final_us=1e6 * s["t_final"], cut_length_mm=50.0 * s["t_final"] * 1e3,
                ref_update_strain=s["numerics"]["ref_update_strain"],
-               contact=s["numerics"].get("contact", "pinball") if s["method"] == "tlsph" else None,
+               contact=(s["numerics"].get("contact", "pinball") if s["method"] == "tlsph"
+                        else "penalty" if s["numerics"].get("contact") == "penalty" else None),
                reference_updates=diag.get("reference_updates"),
                max_pinball_penetration_over_dp=(diag["max_pinball_penetration_m"] / s["dp"]
                                                 if "max_pinball_penetration_m" in diag else None),
@@ -499,11 +501,11 @@ def reference_updates_figure(by):
         study.save_figure(fig, FIG / "08_cutting_reference_updates.png", dpi=120)
 
 
-def _contact_pairs(records):
-    """(paper-tlsph run, penalty-tlsph run) of each feed both have, the pinball run first."""
+def _contact_pairs(records, method: str = "tlsph"):
+    """(paper-METHOD run, penalty-METHOD run) of each feed both have, the paper's contact first."""
     by = {r["name"]: r for r in records}
     return [(by[r["name"].replace("penalty-", "paper-")], r) for r in records
-            if is_penalty(r) and r["name"].replace("penalty-", "paper-") in by]
+            if is_penalty(r) and r["method"] == method and r["name"].replace("penalty-", "paper-") in by]
 
 
 def contact_figure(records):
@@ -577,10 +579,11 @@ def _pair(a, b, key, spec, scale=1.0) -> str:
 
 
 def _report_contact(P, records) -> list[str]:
-    """TLSPH's tool contact: the paper runs (pinballs) against the same runs with the penalty contact."""
+    """TLSPH's tool contact: the paper runs (pinballs) against the same runs with the penalty contact; then ESPH's
+    (:func:`_report_contact_esph`)."""
     pairs = _contact_pairs(records)
     if not pairs:
-        return []
+        return _report_contact_esph(P, records)
     rel = lambda a, b: None if _ratio(b, a) is None else _ratio(b, a) - 1  # noqa: E731
     rows = [[_v(b["feed_mm"], "g"), f"{a['status']} / {b['status']}", _pair(a, b, "cut_length_mm", ".2f"),
              _pair(a, b, "cutting_force_mean_MN_per_m", ".3f"),
@@ -595,7 +598,7 @@ def _report_contact(P, records) -> list[str]:
          "eps_p max", "eps_p p99", "flank gap / dp", "steps", "threads", "wall [min]", "CPU [min]"], rows)]
     good = [(a, b) for a, b in pairs if a["status"] == "ok" and b["status"] == "ok"]
     if not good:
-        return out + ["", P("contact_failed"), ""]
+        return out + ["", P("contact_failed"), ""] + _report_contact_esph(P, records)
     fc = [b["cutting_force_mean_MN_per_m"] / a["cutting_force_mean_MN_per_m"] - 1 for a, b in good]
     ft = [b["thrust_force_mean_MN_per_m"] / a["thrust_force_mean_MN_per_m"] - 1 for a, b in good]
     ch = [b["chip_thickness_mm"] / a["chip_thickness_mm"] - 1 for a, b in good]
@@ -608,7 +611,38 @@ def _report_contact(P, records) -> list[str]:
                         eps_max=each("max_plastic_strain", ".1f"), p99=each("plastic_strain_p99", ".2f"),
                         cpu=", ".join(_v(c, ".2f") for c in cpu),
                         figure=_fig("08_cutting_contact_forces.png", "forces, pinball against penalty contact")),
-                  ""]
+                  ""] + _report_contact_esph(P, records)
+
+
+def _report_contact_esph(P, records) -> list[str]:
+    """ESPH's tool: the paper runs (the tool's particles in the SPH sums) against the same runs with the penalty
+    contact, and the two methods' penalty runs side by side."""
+    pairs = _contact_pairs(records, "esph")
+    if not pairs:
+        return []
+    rows = [[_v(b["feed_mm"], "g"), f"{a['status']} / {b['status']}", _pair(a, b, "cut_length_mm", ".2f"),
+             _pair(a, b, "cutting_force_mean_MN_per_m", ".3f"), _pair(a, b, "thrust_force_mean_MN_per_m", ".3f"),
+             _pair(a, b, "chip_thickness_mm", ".3f"), _pair(a, b, "n_shear_bands", "d"),
+             _pair(a, b, "max_plastic_strain", ".1f"), _pair(a, b, "plastic_strain_p99", ".2f"),
+             _pair(a, b, "flank_gap_over_dp", ".2f"), _pair(a, b, "n_steps", "d"),
+             _pair(a, b, "cpu_time_s", ".1f", 1 / 60)] for a, b in pairs]
+    out = [P("contact_esph"), "", _md_table(
+        ["feed [mm]", "status", "cut [mm]", "Fc", "Ft", "chip [mm]", "bands", "eps_p max", "eps_p p99",
+         "flank gap / dp", "steps", "CPU [min]"], rows)]
+    tl = {r["feed_mm"]: r for _, r in _contact_pairs(records) if r["status"] == "ok"}
+    good = [(a, b) for a, b in pairs if a["status"] == "ok" and b["status"] == "ok"]
+    if not good:
+        return out + ["", P("contact_failed"), ""]
+    each = lambda key, spec: ", ".join(f"{_v(a.get(key), spec)} -> {_v(b.get(key), spec)}"  # noqa: E731
+                                       for a, b in good)
+    def side(b, key):                                          # ESPH's value 'against' TLSPH's, same feed
+        return f"{_v(b[key], '.3f')} against {_v(tl[b['feed_mm']][key], '.3f')}"
+    methods = "; ".join(f"feed {_v(b['feed_mm'], 'g')} mm: Fc {side(b, 'cutting_force_mean_MN_per_m')} MN/m, chip "
+                        f"{side(b, 'chip_thickness_mm')} mm" for _, b in good if b["feed_mm"] in tl) or "-"
+    return out + ["", P("contact_esph_end", fc=each("cutting_force_mean_MN_per_m", ".3f"),
+                        ft=each("thrust_force_mean_MN_per_m", ".3f"), chip=each("chip_thickness_mm", ".3f"),
+                        bands=each("n_shear_bands", "d"), eps_max=each("max_plastic_strain", ".1f"),
+                        methods=methods), ""]
 
 
 def _report_runs(P, records, ok, paper) -> list[str]:

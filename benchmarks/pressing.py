@@ -11,8 +11,8 @@ Runs (2D plane strain, the scene `refsph.scenes.pressing`, tool travel 0.2 mm = 
   conv       dp = 0.0167, 0.0133, 0.01, 0.00667 mm (the paper's Fig. 10; h/dp = 1.5), CFL step (Courant 0.3)
   dt1e-10    dp = 0.01 mm with the paper's fixed dt = 1e-10 s (Table 4)
   kp10/kp200 TLSPH at dp = 0.01 mm with the pinball scaling factor K_p = 10 and 200 (default 50)
-  penalty    TLSPH at the four spacings with the penalty tool contact (Numerics.contact = 'penalty') in place of
-             the paper's pinballs (ESPH has no such contact: its tool acts through the SPH sums)
+  penalty    both methods at the four spacings with the penalty tool contact (Numerics.contact = 'penalty'): TLSPH's
+             in place of the paper's pinballs, ESPH's in place of the paper's tool in the SPH sums
 Each run is one process; its run folder runs/benchmarks/pressing/NAME keeps summary.json, reaction_forces.csv
 and the final snapshot (the others are deleted). Writes benchmarks/pressing.json, one record per run (a line
 each): method, spacing, particle count, steps, wall time, the scalar metrics of the scene, the binned tool
@@ -23,6 +23,7 @@ Figures:
   figures/07_pressing_resolution.png       final plastic strain at the four spacings, both methods (Fig. 10)
   figures/07_pressing_force.png            tool force against time at the four spacings
   figures/07_pressing_contact_force.png    TLSPH's tool force, pinball against penalty contact, finest spacing
+                                           (ESPH's pair: in the report's table)
 Report: `--report` reads only benchmarks/pressing.json (it runs nothing and rewrites neither the JSON nor a
 figure) and writes benchmarks/pressing_report.md: what was run, the result tables, the sensitivity to the time
 step and to K_p, the cost, and the figures above (chapter 07 teaches the lesson and links the report).
@@ -85,14 +86,16 @@ def job_list():
     for kp in (10.0, 200.0):
         jobs.append(dict(name=f"kp{kp:g}-tlsph-{dp_tag(DP_SENS)}", method="tlsph", dp=DP_SENS, dt=None,
                          numerics=dict(contact_Kp=kp)))
-    for dp in resolutions():            # the penalty tool contact (TLSPH only: ESPH's tool has no contact law)
-        jobs.append(dict(name=f"penalty-tlsph-{dp_tag(dp)}", method="tlsph", dp=dp, dt=None,
-                         numerics=dict(contact="penalty")))
+    for m in ("tlsph", "esph"):         # the penalty tool contact (ESPH: the tool out of the SPH sums)
+        for dp in resolutions():
+            jobs.append(dict(name=f"penalty-{m}-{dp_tag(dp)}", method=m, dp=dp, dt=None,
+                             numerics=dict(contact="penalty")))
     return jobs
 
 
 def is_penalty(r) -> bool:
-    """A run (job or record) with the penalty tool contact; the other TLSPH runs have the paper's pinballs."""
+    """A run (job or record) with the penalty tool contact; the other runs have the paper's tool contact (TLSPH:
+    the pinballs; ESPH: the tool's particles in the SPH sums)."""
     return r["name"].startswith("penalty-")
 
 
@@ -129,7 +132,8 @@ def record(job):
     fh = np.asarray(m["tool_force_history"])
     line = np.asarray(m["plastic_strain_line"])
     imp = s["diagnostics"]["reaction_impulse"]
-    contact = nm.get("contact", "pinball") if s["method"] == "tlsph" else None
+    contact = (nm.get("contact", "pinball") if s["method"] == "tlsph"
+               else "penalty" if nm.get("contact") == "penalty" else None)   # ESPH's own: the tool in the sums
     pen = s["diagnostics"].get("max_penalty_penetration_m")
     return dict(
         name=name, method=s["method"], dp_nominal_mm=1e3 * job["dp"], dp_mm=1e3 * s["dp"], h_mm=1e3 * s["h"],
@@ -193,13 +197,14 @@ def differences(r, ref) -> dict:
 
 def add_differences(records):
     """vs_finest: against the finest conv run of the method; vs_base: against the conv run of the method at
-    the same nominal spacing (for the dt and K_p runs). The penalty runs: vs_finest against the finest penalty run,
-    vs_base against the (pinball) conv run at the same spacing."""
+    the same nominal spacing (for the dt and K_p runs). The penalty runs: vs_finest against the finest penalty run
+    of the method, vs_base against the method's conv run (the paper's contact) at the same spacing."""
     conv = {(r["method"], r["dp_nominal_mm"]): r for r in records if r["name"].startswith("conv-")}
     penalty = [r for r in records if is_penalty(r)]
     for r in records:
         if is_penalty(r):           # vs_finest: the finest penalty run; vs_base: the pinball run at the same dp
-            r["vs_finest"] = differences(r, min(penalty, key=lambda c: c["dp_nominal_mm"]))
+            r["vs_finest"] = differences(r, min([c for c in penalty if c["method"] == r["method"]],
+                                                key=lambda c: c["dp_nominal_mm"]))
             if (r["method"], r["dp_nominal_mm"]) in conv:
                 r["vs_base"] = differences(r, conv[(r["method"], r["dp_nominal_mm"])])
             continue
@@ -379,11 +384,12 @@ def _plot_force(conv):
     study.save_figure(fig, FIG / "07_pressing_force.png", dpi=120)
 
 
-def _contact_pairs(records):
-    """(pinball conv-tlsph run, penalty run) at each spacing both have, coarsest first."""
-    pin = {r["dp_nominal_mm"]: r for r in records if r["name"].startswith("conv-tlsph-")}
-    return [(pin[r["dp_nominal_mm"]], r) for r in sorted([r for r in records if is_penalty(r)],
-                                                        key=lambda r: -r["dp_nominal_mm"]) if r["dp_nominal_mm"] in pin]
+def _contact_pairs(records, method: str = "tlsph"):
+    """(the paper's contact: conv-METHOD run, penalty run of the method) at each spacing both have, coarsest
+    first."""
+    pin = {r["dp_nominal_mm"]: r for r in records if r["name"].startswith(f"conv-{method}-")}
+    pen = sorted([r for r in records if is_penalty(r) and r["method"] == method], key=lambda r: -r["dp_nominal_mm"])
+    return [(pin[r["dp_nominal_mm"]], r) for r in pen if r["dp_nominal_mm"] in pin]
 
 
 def _plot_contact(records):
@@ -558,12 +564,14 @@ def _orders(pairs, k) -> str:
     return "; ".join(out)
 
 
-def _report_contact(P, records) -> list[str]:
-    """TLSPH's tool contact: the paper's pinballs (conv-tlsph) against the penalty contact, spacing by spacing."""
-    pairs = _contact_pairs(records)
-    if not pairs:
-        return []
-    rows = [[_um(b), _pair_cell(a, b, "tool_force_mean_MN_per_m", ".3f"),
+CONTACT_COLUMNS = ["dp [um]", "F mean", "penalty / paper's - 1", "F peak", "clamp", "line peak", "at x [mm]",
+                   "width [mm]", "eps p99", "eps max", "T max [K]", "gap/dp", "penetration/dp", "steps", "wall [s]",
+                   "CPU [s]"]
+
+
+def _contact_rows(pairs) -> list[list[str]]:
+    """A row per (paper's contact, penalty) pair: the columns CONTACT_COLUMNS, each cell 'paper's / penalty'."""
+    return [[_um(b), _pair_cell(a, b, "tool_force_mean_MN_per_m", ".3f"),
              _pct(b["tool_force_mean_MN_per_m"] / a["tool_force_mean_MN_per_m"] - 1),
              _pair_cell(a, b, "tool_force_peak_MN_per_m", ".2f"),
              _pair_cell(a, b, "clamp_force_mean_MN_per_m", ".3f", -1),
@@ -575,25 +583,61 @@ def _report_contact(P, records) -> list[str]:
              f"{study.fmt(b.get('max_penalty_penetration_over_dp'), '.3f')}",
              _pair_cell(a, b, "n_steps", "d"), _pair_cell(a, b, "wall_time_s", ".1f"),
              _pair_cell(a, b, "cpu_time_s", ".1f")] for a, b in pairs]
-    L = [P("contact"), "", _aligned(["dp [um]", "F mean", "penalty / pinball - 1", "F peak", "clamp", "line peak",
-                                     "at x [mm]", "width [mm]", "eps p99", "eps max", "T max [K]", "gap/dp",
-                                     "penetration/dp", "steps", "wall [s]", "CPU [s]"], rows), ""]
+
+
+def _span(pairs, k, key, spec) -> str:
+    """The first (coarsest) and last (finest) value of ``key`` of contact k (0 the paper's, 1 penalty)."""
+    return f"{format(pairs[0][k][key], spec)} to {format(pairs[-1][k][key], spec)}"
+
+
+def _report_contact(P, records) -> list[str]:
+    """The tool contact: TLSPH's pinballs (conv-tlsph) against the penalty contact, spacing by spacing; then ESPH's
+    tool in the SPH sums against the penalty contact (:func:`_report_contact_esph`)."""
+    pairs = _contact_pairs(records)
+    if not pairs:
+        return _report_contact_esph(P, records)
+    L = [P("contact"), "", _aligned(CONTACT_COLUMNS, _contact_rows(pairs)), ""]
     diff = [b["tool_force_mean_MN_per_m"] / a["tool_force_mean_MN_per_m"] - 1 for a, b in pairs]
     cost = [b["cpu_time_s"] / a["wall_time_s"] for a, b in pairs if b.get("cpu_time_s")]
-
-    def span(k, key, spec):            # the first (coarsest) and last (finest) value of contact k
-        return f"{format(pairs[0][k][key], spec)} to {format(pairs[-1][k][key], spec)}"
     a, b = pairs[-1]
     L += [P("contact_end", dp_fine=_um(b), f_pin=f"{a['tool_force_mean_MN_per_m']:.3f}",
             f_pen=f"{b['tool_force_mean_MN_per_m']:.3f}", diff_min=_pct(min(diff)), diff_max=_pct(max(diff)),
-            peak_pin=span(0, "tool_force_peak_MN_per_m", ".2f"), peak_pen=span(1, "tool_force_peak_MN_per_m", ".2f"),
-            max_pin=span(0, "max_plastic_strain", ".2f"), max_pen=span(1, "max_plastic_strain", ".2f"),
+            peak_pin=_span(pairs, 0, "tool_force_peak_MN_per_m", ".2f"),
+            peak_pen=_span(pairs, 1, "tool_force_peak_MN_per_m", ".2f"),
+            max_pin=_span(pairs, 0, "max_plastic_strain", ".2f"), max_pen=_span(pairs, 1, "max_plastic_strain", ".2f"),
             x_pin=f"{a['line_peak_x_mm']:.2f}", x_pen=f"{b['line_peak_x_mm']:.2f}",
             line_l2=_pct(b["vs_base"]["line_L2_rel"], False) if b.get("vs_base") else "-",
             cost=f"{min(cost):.1f} to {max(cost):.1f}" if cost else "-",
             figure=_fig("07_pressing_contact_force.png", "tool force, pinball against penalty contact")), ""]
     if len(pairs) >= 3:
         L += [P("contact_order", order_pen=_orders(pairs, 1), order_pin=_orders(pairs, 0)), ""]
+    return L + _report_contact_esph(P, records)
+
+
+def _report_contact_esph(P, records) -> list[str]:
+    """ESPH's tool: the paper's (its particles in the SPH sums, conv-esph) against the penalty contact, spacing by
+    spacing, and the two methods' penalty runs against each other at the finest spacing both have."""
+    pairs = _contact_pairs(records, "esph")
+    if not pairs:
+        return []
+    L = [P("contact_esph"), "", _aligned(CONTACT_COLUMNS, _contact_rows(pairs)), ""]
+    diff = [b["tool_force_mean_MN_per_m"] / a["tool_force_mean_MN_per_m"] - 1 for a, b in pairs]
+    pen_t = {r["dp_nominal_mm"]: r for _, r in _contact_pairs(records)}
+    both = [(pen_t[b["dp_nominal_mm"]], b) for _, b in pairs if b["dp_nominal_mm"] in pen_t]
+    methods = "-"
+    if both:
+        t, e = both[-1]
+        each = ", ".join(_pct(e2["tool_force_mean_MN_per_m"] / t2["tool_force_mean_MN_per_m"] - 1) for t2, e2 in both)
+        methods = (f"{e['tool_force_mean_MN_per_m']:.3f} against TLSPH's {t['tool_force_mean_MN_per_m']:.3f} MN/m "
+                   f"({_pct(e['tool_force_mean_MN_per_m'] / t['tool_force_mean_MN_per_m'] - 1)}) at {_um(e)} um, "
+                   f"over the spacings {each}")
+    L += [P("contact_esph_end", diffs=", ".join(_pct(d) for d in diff),
+            peak_sums=_span(pairs, 0, "tool_force_peak_MN_per_m", ".2f"),
+            peak_pen=_span(pairs, 1, "tool_force_peak_MN_per_m", ".2f"),
+            max_sums=_span(pairs, 0, "max_plastic_strain", ".2f"), max_pen=_span(pairs, 1, "max_plastic_strain", ".2f"),
+            methods=methods), ""]
+    if len(pairs) >= 3:
+        L += [P("contact_order_esph", order_pen=_orders(pairs, 1), order_sums=_orders(pairs, 0)), ""]
     return L
 
 

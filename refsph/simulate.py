@@ -86,15 +86,19 @@ def make_solver(method: str, setup: Setup) -> Solver:
     h = setup.h
     common = dict(strength=setup.strength, mirror=setup.mirror, walls=setup.walls, rigid=setup.rigid,
                   clamps=setup.clamps, threads=threads)
+    if nm.contact not in ("pinball", "penalty"):
+        raise ValueError(f"Numerics.contact must be 'pinball' or 'penalty', got {nm.contact!r}")
+    penalty = None
+    if nm.contact == "penalty" and setup.rigid:
+        penalty = PenaltyContact(alpha=nm.penalty_alpha, damping=nm.penalty_damping, offset=0.5 * setup.dp,
+                                 time_scale=nm.courant * h / setup.material.c_longitudinal, friction=setup.friction)
     if method == "esph":
-        if setup.friction is not None:
-            raise ValueError("friction is a law of the TLSPH pinball contact; ESPH tools act through the SPH "
-                             "sums and have no friction model (run TLSPH, or set friction=None)")
+        if setup.friction is not None and penalty is None:
+            raise ValueError("friction acts in the penalty contact with rigid bodies; ESPH's tools otherwise act "
+                             "through the SPH sums and have no friction model (set contact='penalty' with a tool "
+                             "that has a shape, run TLSPH, or set friction=None)")
         if setup.dissipation_heat:
             raise ValueError("dissipation_heat is a TLSPH option (ESPH's artificial viscosity heat is not computed)")
-        if nm.contact != "pinball" and setup.rigid:
-            raise ValueError(f"contact={nm.contact!r} is a TLSPH contact; ESPH's tools act on the workpiece through "
-                             "the SPH sums (run TLSPH, or leave contact at its default)")
         if nm.hourglass:
             raise ValueError("hourglass control is a TLSPH option (ESPH's neighbours change every step, its zig-zag "
                              "modes are the tensile instability's, see gamma)")
@@ -108,9 +112,7 @@ def make_solver(method: str, setup: Setup) -> Solver:
                              "their current neighbours, and its artificial pressure, gamma)")
         prm = ESPHParams(h=h, dp=setup.dp, beta1=nm.beta1, beta2=nm.beta2, gamma=nm.gamma, n_ap=nm.n_ap,
                          eps=nm.eps, kernel=kernel, correction=bool(nm.esph_correction))
-        return ESPHSolver(setup.material, prm, skin_factor=nm.skin_factor, **common)
-    if nm.contact not in ("pinball", "penalty"):
-        raise ValueError(f"Numerics.contact must be 'pinball' or 'penalty', got {nm.contact!r}")
+        return ESPHSolver(setup.material, prm, skin_factor=nm.skin_factor, contact=penalty, **common)
     if method == "tlsph":
         if nm.esph_correction:
             raise ValueError("esph_correction is an ESPH option; TLSPH's kernel-gradient correction is 'corrected'")
@@ -121,14 +123,10 @@ def make_solver(method: str, setup: Setup) -> Solver:
                           corrected=nm.corrected, ref_update_strain=nm.ref_update_strain,
                           hourglass=float(nm.hourglass), viscous_heat=bool(setup.dissipation_heat),
                           max_condition=nm.max_condition)
-        contact = None
+        contact = penalty
         if setup.friction is not None and not setup.rigid:
             raise ValueError("friction acts in the contact with rigid bodies, and this setup has none")
-        if nm.contact == "penalty" and setup.rigid:
-            contact = PenaltyContact(alpha=nm.penalty_alpha, damping=nm.penalty_damping, offset=0.5 * setup.dp,
-                                     time_scale=nm.courant * h / setup.material.c_longitudinal,
-                                     friction=setup.friction)
-        elif setup.rigid or len(_deformable_bodies(setup)) > 1:
+        if penalty is None and (setup.rigid or len(_deformable_bodies(setup)) > 1):
             k = nm.contact_k if nm.contact_k is not None else setup.dp / (2.0 * h)
             contact = PinballContact(k=k, K_p=nm.contact_Kp, friction=setup.friction)
         r_c = None if nm.self_contact is None else nm.self_contact * setup.dp

@@ -18,6 +18,7 @@ checkpoint's layout (the constraints' arrays under ``constraints/``).
 """
 from __future__ import annotations
 
+import dataclasses
 import warnings
 
 import numpy as np
@@ -122,15 +123,23 @@ class ESPHSolver(SolverBase):
     """ESPH rates with a Verlet pair list (cutoff 2h, skin ``skin_factor * h``; the scenes' value is
     ``Numerics.skin_factor``). With symmetry planes (``mirror``) the ghosts are chosen when the list is built
     (every particle within 2h + skin of a plane) and move with their sources until the next build. Rigid bodies
-    are ordinary SPH neighbours (velocity V, density by Eq. (10) floored at rho0, stress -p I with p >= 0)."""
+    are ordinary SPH neighbours (velocity V, density by Eq. (10) floored at rho0, stress -p I with p >= 0), the
+    paper's way; with ``contact`` a :class:`~refsph.penalty.PenaltyContact` they are not: the SPH sums cover the
+    deformable rows only, and the tools act through the penalty contact on their exact outline (Coulomb friction
+    mu(T) included: :class:`~refsph.coupling.PenaltyCoupling`, as TLSPH's; not in the paper)."""
 
     method = "esph"
     evolved = ("x", "v", "rho", "S", "S_zz")
 
     def __init__(self, material: ElasticMaterial, params: ESPHParams, skin_factor: float, *,
                  strength: StrengthModel | None = None, mirror: MirrorPlanes | None = None, walls=(), rigid=(),
-                 clamps=(), threads: int = 1):
+                 clamps=(), threads: int = 1, contact: PenaltyContact | None = None):
         super().__init__(material, params, strength, mirror, Constraints(walls, rigid, clamps, mirror), threads)
+        if contact is not None and not isinstance(contact, PenaltyContact):
+            raise TypeError("ESPH's tool contact is the penalty contact (refsph.penalty.PenaltyContact) or none (the "
+                            f"tools in the SPH sums); got {type(contact).__name__}")
+        self.contact = contact
+        self.coupling = None if contact is None else PenaltyCoupling(contact, self.constraints.rigid)
         self.pairs = VerletList(params.kernel.support * params.h, skin_factor * params.h)
         self.pair_sum: PairBlocks | None = None            # blocks and sparse patterns of the current pair list
         self.pair_sum_build = -1
@@ -141,6 +150,8 @@ class ESPHSolver(SolverBase):
         """The state fits the solver (ValueError naming what does not). Several deformable bodies are accepted
         with a warning: ESPH has no contact law between them, they are one continuum to the SPH sums."""
         self.check_common(state)
+        if self.contact is not None and self.contact.friction is not None and state.T is None:
+            raise ValueError("friction with mu(T) needs a state with temperatures (make_state(..., T0=...))")
         if len(self.constraints.deformable_bodies) > 1:
             warnings.warn(f"ESPH has no contact between deformable bodies {self.constraints.deformable_bodies}: "
                           "within 2h they are one continuum to the SPH sums (pressure pushes them apart, tension "
@@ -169,25 +180,40 @@ class ESPHSolver(SolverBase):
             self._build_with_ghosts(state.x, state)
         return (self.pairs.I, self.pairs.J), self.ghosts.extend_state(state, self.ghost_constant)
 
-    def rates(self, state: State, dt: float | None = None, part: str = "all", out: dict | None = None) -> Rates:
-        """Eqs. (10)-(14), (23) over all particles, rigid ones included; constrained (``dt`` is not used).
-        ``part``: 'all', 'deformation' or 'forces' (:func:`~refsph.esph.esph_rates`; the leapfrog's halves).
-        ``out``: a dict that receives the pair list (I, J) and the pressure p (Eq. (24)) of ``state``'s rows."""
+    def _body(self, state: State) -> State:
+        """The rows in the SPH sums: every row, or with the penalty contact the deformable rows [0, n) (views)."""
         if self.constraints.dim is None:
             self.constraints.bind(state)
-        (I, J), ext = self._pairs_and_state(state)
+        n = self.constraints.n_deformable
+        if self.coupling is None or n == state.n:
+            return state
+        return dataclasses.replace(state, **{f.name: getattr(state, f.name)[:n] for f in dataclasses.fields(state)
+                                            if f.name != "t" and getattr(state, f.name) is not None})
+
+    def rates(self, state: State, dt: float | None = None, part: str = "all", out: dict | None = None) -> Rates:
+        """Eqs. (10)-(14), (23) over all particles, rigid ones included (``dt`` is not used); with the penalty
+        contact over the deformable rows, then the contact for a step of size ``dt``; constrained. ``part``: 'all',
+        'deformation' or 'forces' (:func:`~refsph.esph.esph_rates`; the leapfrog's halves). ``out``: a dict that
+        receives the pair list (I, J) and the pressure p (Eq. (24)) of ``state``'s rows."""
+        body = self._body(state)
+        (I, J), ext = self._pairs_and_state(body)
         if self.pair_sum_build != self.pairs.n_builds:
             if self.pair_sum is not None:
                 self.pair_sum.close()
             self.pair_sum = PairBlocks(I, J, ext.n, threads=self.threads)
             self.pair_sum_build = self.pairs.n_builds
         r = esph_rates(ext, self.material, self.params, I, J, pairs=self.pair_sum, part=part)
-        r = r if ext is state else r.rows(state.n)
+        r = r if ext is body else r.rows(body.n)
         if out is not None:
             out.update(pair_i=I, pair_j=J, p=eos_pressure(state.rho, self.material.rho0, self.material.K))
+        if body is not state:
+            r = _with_rigid(self, state, r, dt, contact=part != "deformation")
         return self.constraints.constrain(state, r, record=part != "deformation")
 
     def after_step(self, state: State) -> State:
+        """The penalty contact's tangential history of the step committed (stick / slip); nothing else."""
+        if self.coupling is not None:
+            self.coupling.commit()
         return state
 
     def deformation_gradient(self, state: State) -> None:
@@ -199,6 +225,8 @@ class ESPHSolver(SolverBase):
         ck = dict(n_builds=np.int64(self.pairs.n_builds))
         if self.pairs.x_build is not None:
             ck["x_build"] = self.pairs.x_build
+        if self.coupling is not None:
+            ck.update(self.coupling.checkpoint())
         return ck
 
     def own_restore(self, ck: dict, state: State) -> None:
@@ -207,14 +235,18 @@ class ESPHSolver(SolverBase):
             if self.mirror is None:
                 self.pairs.build(x_build)
             else:
-                self._build_with_ghosts(x_build, state)
+                self._build_with_ghosts(x_build, self._body(state))
         self.pairs.n_builds = int(ck["n_builds"])
         self.pair_sum_build = -1
+        if self.coupling is not None:
+            self.coupling.restore(ck)
 
     def own_diagnostics(self) -> dict:
         out = {"neighbour_list_builds": self.pairs.n_builds, "n_pairs": int(len(self.pairs.I))}
         if self.ghosts is not None:
             out["n_ghosts"] = int(self.ghosts.n)
+        if self.coupling is not None:
+            out.update(self.coupling.diagnostics(False))
         return out
 
 
@@ -340,8 +372,8 @@ class TLSPHSolver(SolverBase):
         return out
 
 
-def _with_rigid(solver: TLSPHSolver, state: State, r: Rates, dt: float, contact: bool = True) -> Rates:
-    """Rates of all rows: the deformable ones plus the pinball contact (``contact``), the rigid ones carrying
+def _with_rigid(solver: SolverBase, state: State, r: Rates, dt: float, contact: bool = True) -> Rates:
+    """Rates of all rows: the deformable ones plus the tool contact (``contact``), the rigid ones carrying
     the reaction (dv/dt = contact force / m, turned into the recorded force and then zeroed by the
     constraints), the contact's friction power on both sides (``Rates.friction_power``) and, where the rates
     carry the viscous heat, the contact's damping power added to it (``Rates.heat_power``; that part alone in
@@ -371,5 +403,9 @@ def _with_rigid(solver: TLSPHSolver, state: State, r: Rates, dt: float, contact:
     if r.l is not None:
         l = np.zeros((N, d, d))
         l[:n] = r.l
-    return Rates(x=state.v.copy(), v=v, rho=None, S=S, S_zz=S_zz, l=l, friction_power=power, heat_power=heat,
+    rho = None
+    if r.rho is not None:                                   # ESPH integrates rho; a tool's stays where it is
+        rho = np.zeros(N)
+        rho[:n] = r.rho
+    return Rates(x=state.v.copy(), v=v, rho=rho, S=S, S_zz=S_zz, l=l, friction_power=power, heat_power=heat,
                  damping_power=damping)

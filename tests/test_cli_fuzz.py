@@ -63,7 +63,7 @@ CASES = [
     ["run", "thermal_cutting", "--case", "19"], ["run", "thermal_cutting", "--jitter", "0.5"],
     ["run", "thermal_cutting", "--dim", "3"], ["run", "thermal_cutting", "--method", "esph"],
     ["run", "cutting", "--method", "both", "--set", "esph_correction=true"],
-    ["run", "pressing", "--set", "contact=penalty", "--method", "esph"],
+    ["run", "thermal_cutting", "--set", "contact=penalty", "--method", "esph"],
     # run: files
     ["run", "bar", "--from", "{d}/missing.npz"], ["run", "bar", "--from", "{d}/garbage.npz"],
     ["run", "bar", "--from", "{d}/trunc.npz"], ["run", "bar", "--from", "{d}/no_v.npz"],

@@ -25,7 +25,8 @@ CASES = [("taylor", "tlsph", dict(dim=2, quick=True, t_end=6e-6)),
                                            options=dict(case=1, length=0.5e-3, travel=1.0))),
          ("thermal_cutting", "tlsph", dict(quick=True, t_end=2e-5,                # heat kept between heat steps
                                            numerics=dict(threads=1, contact="penalty", heat_every=7),
-                                           options=dict(case=1, length=0.5e-3, travel=1.0)))]
+                                           options=dict(case=1, length=0.5e-3, travel=1.0))),
+         ("pressing", "esph", dict(quick=True, t_end=0.2e-6, numerics=dict(contact="penalty")))]   # ESPH's tool out
 
 
 def _killed(monkeypatch, scene, method, out, kw):

@@ -33,10 +33,11 @@ class Numerics:
     spacing); contact_Kp: the pinball scaling factor K_p (Eq. (33)); threads: threads that share the pair sums
     (0 = one per available core); integrator: the time stepper (:data:`refsph.integrate.STEPPERS`); esph_correction:
     ESPH's normalised velocity gradient (:mod:`refsph.esph`; off: Eq. (23) as printed); hourglass: TLSPH hourglass
-    control coefficient (Ganzenmueller 2015, :mod:`refsph.tlsph`; 0 = off, as in the paper); contact: the TLSPH
-    contact with rigid tools, 'pinball' (Eqs. (32)-(36), the paper's) or 'penalty' (:mod:`refsph.penalty`, on the
-    tools' exact geometry, ``RigidBody.shape``); penalty_alpha: the penalty stiffness alpha m / dt^2 (the fraction of
-    the penetration removed per step); penalty_damping: the damping ratio of the penalty's normal spring;
+    control coefficient (Ganzenmueller 2015, :mod:`refsph.tlsph`; 0 = off, as in the paper); contact: the
+    contact with rigid tools, 'pinball' (TLSPH: Eqs. (32)-(36), the paper's; ESPH: the tools in the SPH sums, the
+    paper's) or 'penalty' (either method: :mod:`refsph.penalty`, on the tools' exact geometry,
+    ``RigidBody.shape``); penalty_alpha: the penalty stiffness alpha m / dt^2 (the fraction of the penetration
+    removed per step); penalty_damping: the damping ratio of the penalty's normal spring;
     max_condition: TLSPH's kernel-gradient correction inverts a moment matrix whose condition number exceeds it
     only up to it (:func:`refsph.kernels.correction_matrix`; None = no limit, as in the paper); heat_every: the
     heat step (conduction, frictional heat, losses, :class:`refsph.thermal.HeatFlow`) runs once every this many

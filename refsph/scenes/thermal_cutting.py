@@ -3,7 +3,8 @@ their Appendix B (AISI 1045 at 60/120/180 m/min, Ti6Al4V at 20/40/60 m/min; uncu
 2D plane strain, TLSPH. (ESPH takes the penalty contact and its friction too, but computes no heat of its
 artificial viscosity, ``dissipation_heat``; with ``--option dissipation_heat=false`` its quick cut of case 1 fails
 at 0.33 ms of 0.8: the tool particle at the edge's lowest corner, which takes the frictional heat of the contacts
-nearest to it and conducts poorly, passes T_limit. Not pursued: the paper's cuts are run with TLSPH.)
+nearest to it and conducts poorly, passes T_limit; with all of that heat in the chip, ``--option chip_fraction=1``,
+the paper's code's choice, it runs. Not pursued here: the paper's cuts are run with TLSPH.)
 
 The model, as in their Sections 2.1-2.4 and Tables 1-2, A1-A3 (``refsph.paper_data``), and what refsph chooses:
 

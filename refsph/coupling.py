@@ -1,6 +1,6 @@
-"""How the bodies of a TLSPH run meet: the pinball contact (Eqs. (32)-(36), :mod:`refsph.contact`) between the
-deformable rows and the rigid tools, and between every two deformable bodies (:class:`PinballCoupling`); or the
-penalty contact on the tools' exact geometry (:mod:`refsph.penalty`, :class:`PenaltyCoupling`).
+"""How the bodies of a run meet: TLSPH's pinball contact (Eqs. (32)-(36), :mod:`refsph.contact`) between the
+deformable rows and the rigid tools, and between every two deformable bodies (:class:`PinballCoupling`); or, for
+either method, the penalty contact on the tools' exact geometry (:mod:`refsph.penalty`, :class:`PenaltyCoupling`).
 
 :class:`PinballCoupling` is the part of the TLSPH solver (:mod:`refsph.solvers`) that knows which rows meet which:
 the deformable rows [0, n) against the rigid rows [n, N) (a rigid partner: m_b = mu_b = inf), and each pair of
@@ -25,7 +25,8 @@ __all__ = ["PinballCoupling", "PenaltyCoupling"]
 
 def _check_dt(dt) -> None:
     if not (dt is not None and dt > 0):
-        raise ValueError(f"the pinball contact needs the step size dt > 0 (Eq. (34)), got {dt!r}")
+        raise ValueError(f"the tool contact needs the step size dt > 0 (the pinball's Eq. (34), the penalty's "
+                         f"tangential history), got {dt!r}")
 
 
 class PinballCoupling:

@@ -88,6 +88,8 @@ def make_solver(method: str, setup: Setup) -> Solver:
                   clamps=setup.clamps, threads=threads)
     if nm.contact not in ("pinball", "penalty"):
         raise ValueError(f"Numerics.contact must be 'pinball' or 'penalty', got {nm.contact!r}")
+    if setup.friction is not None and not setup.rigid:
+        raise ValueError("friction acts in the contact with rigid bodies, and this setup has none")
     penalty = None
     if nm.contact == "penalty" and setup.rigid:
         penalty = PenaltyContact(alpha=nm.penalty_alpha, damping=nm.penalty_damping, offset=0.5 * setup.dp,
@@ -124,8 +126,6 @@ def make_solver(method: str, setup: Setup) -> Solver:
                           hourglass=float(nm.hourglass), viscous_heat=bool(setup.dissipation_heat),
                           max_condition=nm.max_condition)
         contact = penalty
-        if setup.friction is not None and not setup.rigid:
-            raise ValueError("friction acts in the contact with rigid bodies, and this setup has none")
         if penalty is None and (setup.rigid or len(_deformable_bodies(setup)) > 1):
             k = nm.contact_k if nm.contact_k is not None else setup.dp / (2.0 * h)
             contact = PinballContact(k=k, K_p=nm.contact_Kp, friction=setup.friction)

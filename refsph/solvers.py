@@ -5,7 +5,8 @@ fixes and material models apart:
 
 * the rates of its formulation (:func:`refsph.esph.esph_rates`, :func:`refsph.tlsph.tlsph_rates`; for TLSPH the
   reference configuration, :class:`refsph.reference.ReferenceConfiguration`, and the pinball contact of its bodies,
-  :class:`refsph.coupling.PinballCoupling`);
+  :class:`refsph.coupling.PinballCoupling`; for either, the penalty tool contact,
+  :class:`refsph.coupling.PenaltyCoupling`);
 * a :class:`~refsph.boundaries.Constraints` (rigid walls, rigid bodies, clamps and the reaction log) and, for
   symmetry, :class:`~refsph.boundaries.MirrorPlanes`;
 * a strength model (:mod:`refsph.strength`: elastic, Johnson-Cook, modified Johnson-Cook, or a user's law; whether
@@ -135,6 +136,9 @@ class ESPHSolver(SolverBase):
                  strength: StrengthModel | None = None, mirror: MirrorPlanes | None = None, walls=(), rigid=(),
                  clamps=(), threads: int = 1, contact: PenaltyContact | None = None):
         super().__init__(material, params, strength, mirror, Constraints(walls, rigid, clamps, mirror), threads)
+        if contact is not None and not self.constraints.rigid:
+            raise ValueError("the penalty contact acts between the deformable rows and rigid bodies, and this setup "
+                             "has none (give rigid=..., or contact=None)")
         if contact is not None and not isinstance(contact, PenaltyContact):
             raise TypeError("ESPH's tool contact is the penalty contact (refsph.penalty.PenaltyContact) or none (the "
                             f"tools in the SPH sums); got {type(contact).__name__}")

@@ -134,8 +134,9 @@ class Setup:
     ``walls``: rigid walls (:class:`~refsph.boundaries.RigidWall`); ``rigid``: tools
     (:class:`~refsph.boundaries.RigidBody`, their particles the last rows of ``state``); ``clamps``: held
     particles (:class:`~refsph.boundaries.Clamp`); ``friction``: a :class:`~refsph.contact.CoulombFriction` for
-    the TLSPH pinball contact (None: frictionless, as in the paper); ``info``: numbers that describe the scene
-    (written to ``summary.json`` as ``scene_info``: JSON scalars, strings and short lists only); ``arrays``:
+    the tool contact (TLSPH's pinball, or either method's penalty; None: frictionless, as in the paper);
+    ``info``: numbers that describe the scene (written to ``summary.json`` as ``scene_info``: JSON scalars, strings
+    and short lists only); ``arrays``:
     per-particle arrays the scene's measurements need (index sets; not written to the summary); ``thermal``: heat
     conduction during the run (a :class:`refsph.thermal.Conduction`; None: none, the paper's adiabatic model);
     ``friction_heat``: the frictional heat of the contact (a :class:`refsph.thermal.FrictionHeat`; None: friction

@@ -234,6 +234,9 @@ def more_jobs() -> list[tuple[str, str, dict, dict]]:
             for key, (options, numerics) in gain_step_jobs().items()]
     out += [("refined", f"case {n}{REFINED}", converged(n), dict(ref_update_strain=REF_UPDATE,
                                                                  frequency_step=FREQUENCY_STEP)) for n in range(1, 19)]
+    # the resolution check at REF_UPDATE (the 'resolution' study's runs are at the scene's 0.5): t_u/15 of cases 1, 10
+    out += [("refined", f"case {n} n_tu 15{REFINED}", converged(n, n_tu=15.0),
+             dict(ref_update_strain=REF_UPDATE, frequency_step=FREQUENCY_STEP)) for n in (1, 10)]
     # case 10 at s/2 moved Fc by -21 %, T_RF by -12 %, one run against case 10's scatter of three: its scatter at s/2
     # too (the same two seeds), so that the forces' dependence on s is read between two groups of three
     out += [("scaling", f"case 10 s/2 jitter {seed}", converged(10, mass_scale=_s(10) / 2, jitter=0.01, seed=seed),
@@ -968,6 +971,9 @@ REF_RUNS = tuple(f"case {n}{COARSE}{REF_KEY}{r:g}" if r != SCENE_REF_UPDATE else
     f"case {n}{COARSE}{REF_KEY}{r:g} courant {COURANT:g}" for n, r in REF_FAILED)
 HALF_STEP_RUNS = tuple(f"case {n}{COARSE}{HALF_STEP}" for n in range(1, 19))
 REFINED_RUNS = tuple(f"case {n}{REFINED}" for n in range(1, 19))
+# the resolution check at REF_UPDATE: each case at t_u/5 (the 'refupdate' study's run, courant 0.3), t_u/10 and t_u/15
+REFINED_RESOLUTION = tuple(k for n in (1, 10) for k in (f"case {n}{COARSE}{REF_KEY}{REF_UPDATE:g}",
+                                                          f"case {n}{REFINED}", f"case {n} n_tu 15{REFINED}"))
 # the 'gain' study's table: each run with the step over the gradient's gain beside the same run at the scene's step
 # (courant 0.3) and at half of it
 GAIN_T5 = (*(f"case {n}{COARSE}{REF_KEY}{r:g}" for n, r in REF_FAILED), f"case 10{COARSE}{SELF_KEY}",
@@ -1092,6 +1098,11 @@ STUDIES = (
      f"(Numerics.frequency_step; case 1 at {REF_UPDATE:g} went NaN at courant 0.15 without it)",
      REFINED_RUNS, BASIC + (("max T [K]", "max_temperature_K", ".0f"), ("steps", "n_steps", "d"),
                             ("CPU [min]", "cpu_min", ".1f"))),
+    (f"Resolution at ref update {REF_UPDATE:g} (the 'resolution' study's runs are at the scene's 0.5): cases 1 and 10 "
+     f"at t_u/5 (courant 0.3), t_u/10 and t_u/15 (courant 0.3 under {FREQUENCY_STEP:g} of 2 / w_max); read with "
+     "the scatter at ref update 0.1 below (t_u/5) and the scatter tables at 0.5",
+     REFINED_RESOLUTION, (("across t_u", "across", ".0f"), ("particles", "n_particles", "d")) + BASIC
+     + (("steps", "n_steps", "d"), ("CPU [min]", "cpu_min", ".1f"))),
     (f"Run-to-run scatter at ref update {REF_UPDATE:g} (t_u/5, case 1, the same perturbation as at the scene's 0.5)",
      REF_SCATTER, BASIC),
     ("Self-contact (Numerics.self_contact = 0.5: particles of the workpiece closer than dx/2 repel, "

@@ -522,7 +522,12 @@ def test_thermal_cutting_refined_study_is_the_sweep_at_the_tighter_reference_upd
     table lists them in case order."""
     mod = _script("thermal_cutting")
     todo = mod.jobs(studies=("refined",))
-    assert list(todo) == list(mod.REFINED_RUNS) and len(todo) == 18
+    assert list(todo)[:18] == list(mod.REFINED_RUNS) and len(todo) == 20
+    for n in (1, 10):                                 # the resolution check: the same at t_u/15
+        options, numerics = todo[f"case {n} n_tu 15{mod.REFINED}"]
+        base_options, base_numerics = todo[f"case {n}{mod.REFINED}"]
+        assert options == dict(base_options, n_tu=15.0) and numerics == base_numerics
+    assert all(k in mod.REFINED_RESOLUTION for k in (f"case 1 n_tu 5{mod.REF_KEY}0.1", f"case 10 n_tu 15{mod.REFINED}"))
     sweep = mod.jobs(studies=("cases",))
     for n, key in enumerate(mod.REFINED_RUNS, start=1):
         options, numerics = todo[key]

@@ -1221,15 +1221,20 @@ def resolution_convergence(res: dict) -> list[dict]:
 
 def _verdict(f: list, sd5: float, sd10: float, z1: float, z2: float) -> str:
     """What three resolutions can say: 'order' only where all three runs and both scatters are there and both
-    changes exceed twice their standard deviation with the same sign."""
+    changes exceed twice their standard deviation with the same sign; else which change does ('only ...'), or
+    neither."""
     if math.isnan(f[0]) or math.isnan(f[1]):
         return "t_u/5 or t_u/10 not recorded"
     if math.isnan(f[2]):
         return "t_u/15 to run"
     if math.isnan(sd5) or math.isnan(sd10):
         return "scatter not measured"
-    if math.isnan(z1) or math.isnan(z2) or min(abs(z1), abs(z2)) <= 2.0:
+    if math.isnan(z1) or math.isnan(z2):
         return "a change inside the scatter"
+    if max(abs(z1), abs(z2)) <= 2.0:
+        return "both changes inside the scatter"
+    if min(abs(z1), abs(z2)) <= 2.0:                      # one beyond twice its deviation, the other not: no order
+        return "only t_u/10 -> 15 beyond the scatter" if abs(z2) > 2.0 else "only t_u/5 -> 10 beyond the scatter"
     return "order" if z1 * z2 > 0 else "not monotone"
 
 

@@ -390,8 +390,9 @@ def test_thermal_cutting_means_at_the_paper_length_of_cut():
 
 def test_thermal_cutting_resolution_order_is_read_only_where_the_changes_beat_the_scatter():
     """resolution_convergence: Fc = 300 + C dx^2 through t_u/5, /10, /15 with a scatter of 1 N/mm gives the order 2
-    and the limit 300; the same runs with a scatter of 100 N/mm give no order (a change inside the scatter); a
-    missing t_u/15 run says so. study.observed_order and study.richardson on an exact power law."""
+    and the limit 300; the same runs with a scatter of 100 N/mm give no order (both changes inside the scatter), and
+    one change beyond twice its deviation names it; a missing t_u/15 run says so. study.observed_order and
+    study.richardson on an exact power law."""
     import math
     mod = _script("thermal_cutting")
     st = mod.study
@@ -426,7 +427,10 @@ def test_thermal_cutting_resolution_order_is_read_only_where_the_changes_beat_th
         assert 1.5 < lo < 2.0 < hi < 2.5 and mod._order_cell(fc) == f"2.0 ({lo:.1f}-{hi:.1f})"
         assert rows["T_RF [K]"]["p"] is None and mod._order_cell(rows["T_RF [K]"]) == "a change inside the scatter"
     noisy = {r["name"]: r for r in mod.resolution_convergence(records(100.0)) if r["case"] == 1}["Fc [N/mm]"]
-    assert noisy["verdict"] == "a change inside the scatter" and noisy["p"] is None and math.isfinite(noisy["z2"])
+    assert noisy["verdict"] == "both changes inside the scatter" and noisy["p"] is None and math.isfinite(noisy["z2"])
+    one = dict(noisy, z1=-1.5, z2=5.2)                          # one change beyond twice its deviation: no order
+    assert mod._verdict(one["f"], *one["sd"], one["z1"], one["z2"]) == "only t_u/10 -> 15 beyond the scatter"
+    assert mod._verdict(one["f"], *one["sd"], 3.0, 0.5) == "only t_u/5 -> 10 beyond the scatter"
     missing = [r for r in mod.resolution_convergence(records(1.0, with_fine=False)) if r["name"] == "Fc [N/mm]"]
     assert all(mod._order_cell(r) == "t_u/15 to run" for r in missing)
     assert "| 1 | Fc [N/mm] | 700.0 | 400.0 | 344.4 |" in "\n".join(mod._resolution_lines(records(1.0)))

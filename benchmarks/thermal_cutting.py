@@ -122,7 +122,8 @@ BOSSAK = f" bossak {BOSSAK_ALPHA:g}"         # its key suffix (gamma 0.6 too, be
 # the tables that take such a run for a failed case's row, the first recorded 'ok' of each tuple: for the PFEM the
 # Bossak-Newmark run before the damped one, for its order (second; on the whole cuts of cases 1 and 8 at t_u/5 the
 # two damped rules move Fp by 5-30 % from the trapezoidal rule's, each the more on one case: the time-rule table)
-RETRIES = {"": (RETRY,), PFEM10: (f" n_tu 10{BOSSAK}", DAMPED)}
+REFINED_RETRY = f" courant {COURANT:g}"      # a 'refined' case that failed: again at half the CFL part of its step
+RETRIES = {"": (RETRY,), PFEM10: (f" n_tu 10{BOSSAK}", DAMPED), REFINED: (REFINED_RETRY,)}
 PFEM_OPTIONS = ("case", "n_tu", "travel", "length", "gamma", "remesh_when_needed", "bossak")   # what the PFEM takes
 REMESH = " remesh when needed"              # the key suffix of a PFEM cut that remeshes only where the quality asks
 PAPER_CUT = (1.5e-3, 2.0e-3)   # m of tool travel: the last quarter of the paper's PFEM cut, 2/3 of its 3 mm workpiece
@@ -333,8 +334,9 @@ def bossak_cut(n: int, n_tu: float) -> dict:
 def retry_jobs(records: dict, studies=STUDY_NAMES) -> dict:
     """The retries (RETRIES) of the t_u/10 tables' cases whose record failed and whose retry is not in jobs(): an
     SPH case 'case N' again at RETRY_COURANT, a PFEM case 'case N pfem' with the Bossak-Newmark rule (key + the
-    first of RETRIES[PFEM10]), a PFEM cut to 2 mm 'case N pfem 2 mm' with it too (key + BOSSAK); the sweep adds
-    them, so that a failed case is taken again without a new line in jobs()."""
+    first of RETRIES[PFEM10]), a PFEM cut to 2 mm 'case N pfem 2 mm' with it too (key + BOSSAK), a 'refined' case
+    at courant COURANT under the same frequency step (key + REFINED_RETRY); the sweep adds them, so that a failed
+    case is taken again without a new line in jobs()."""
     out = {}
     for n in TU_01:
         key = f"case {n}{PFEM10}{TO_2MM}"
@@ -346,6 +348,9 @@ def retry_jobs(records: dict, studies=STUDY_NAMES) -> dict:
             out[sph + RETRY] = (converged(n), sweep_numerics(courant=RETRY_COURANT))
         if "pfem" in studies and records.get(pfem, {}).get("status", "ok") != "ok":
             out[pfem + RETRIES[PFEM10][0]] = (bossak_cut(n, 10.0), dict(method="pfem"))
+        if "refined" in studies and records.get(f"case {n}{REFINED}", {}).get("status", "ok") != "ok":
+            out[f"case {n}{REFINED}{REFINED_RETRY}"] = (converged(n), dict(
+                ref_update_strain=REF_UPDATE, frequency_step=FREQUENCY_STEP, courant=COURANT))
     return out
 
 
@@ -1142,7 +1147,9 @@ def _study_lines(res: dict) -> list[str]:
     for title, keys, columns in STUDIES:
         lines += ["", f"## {title}", "", "| run | " + " | ".join(c[0] for c in columns) + " |",
                   "|---" * (len(columns) + 1) + "|"]
-        for k in keys:
+        shown = keys if keys != REFINED_RUNS else tuple(      # a failed refined case: its retry below it, if recorded
+            x for k in keys for x in (k, k + REFINED_RETRY) if x == k or x in runs)
+        for k in shown:
             r = runs.get(k)
             if r is None or r.get("status") != "ok":
                 lines.append(f"| {k} | " + " | ".join(["-"] * (len(columns) - 1)

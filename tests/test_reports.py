@@ -332,6 +332,13 @@ def test_thermal_cutting_queues_the_retry_of_a_failed_case():
     assert numerics == dict(method="pfem")
     assert out["case 3" + mod.RETRY][1]["courant"] == mod.RETRY_COURANT
     assert set(mod.retry_jobs(recs, studies=("pfem",))) == {bossak}
+    refined = "case 3" + mod.REFINED                                  # a refined case: at half the CFL step
+    out = mod.retry_jobs({refined: dict(status="blow-up")}, studies=("refined",))
+    assert list(out) == [refined + mod.REFINED_RETRY] and out[refined + mod.REFINED_RETRY][1] == dict(
+        ref_update_strain=mod.REF_UPDATE, frequency_step=mod.FREQUENCY_STEP, courant=mod.COURANT)
+    ok = json.loads((ROOT / "benchmarks" / "thermal_cutting.json").read_text())["runs"]["case 3"]
+    page = "\n".join(mod._study_lines(dict(runs={refined: dict(status="blow-up"), refined + mod.REFINED_RETRY: ok})))
+    assert f"| {refined} |" in page and f"| {refined + mod.REFINED_RETRY} |" in page
     two = "case 4" + mod.PFEM10 + mod.TO_2MM                         # a PFEM cut to 2 mm: its Bossak retry
     out = mod.retry_jobs(dict(recs, **{two: dict(status="failed")}), studies=("pfem",))
     assert set(out) == {bossak, two + mod.BOSSAK}

@@ -265,7 +265,9 @@ def largest_frequency(state: State, mat: ElasticMaterial, prm: TLSPHParams, op: 
 
         dt w_max < 2,   w_max^2 = the largest |eigenvalue| of K       (Hairer, Lubich & Wanner 2006, Sec. I.5)
 
-    for the linear elastic body exactly, and to first order about any state (plastic flow only softens). So
+    for the linear elastic body exactly, and to first order about any state (plastic flow only softens; a tool's
+    penalty spring alpha m / tau^2, :mod:`refsph.penalty`, adds a frequency sqrt(alpha) / tau with tau the CFL step at
+    the run's Courant number, so dt sqrt(alpha) / tau <= sqrt(alpha), 0.32 at the scenes' alpha = 0.1: left out). So
     2 / (w_max h / (c_L + |v|max)) is the largest Courant number the state allows, against the CFL step's. K is
     applied matrix-free (three rate evaluations) and its largest eigenvalue found by ARPACK (SciPy's ``eigs``,
     relative ``tol``). ``state``: the operator's rows (a body without ghosts: mirror planes are refused)."""

@@ -391,12 +391,12 @@ display(Markdown(split_page.split("\n\n", 1)[1]))             # the page without
 # %% [markdown]
 # * **The cuts again at reference update 0.1** (the page's 'refined' table: $t_u/10$, Courant 0.3 under the
 #   frequency step; the sweep continues over sessions). With the reference updated before $\lVert\mathbf E\rVert_F$
-#   passes 0.1, the frequency step keeps more of the Courant number: cases 1, 4, 10 and 16 took 0.51–0.80 of the
-#   sweep's steps (11–36 min of CPU each). Between $t_u/5$ and $t_u/10$ case 1 now moves by $F_c$ −8 % and $T_{RF}$
-#   +3 % (at 0.5: −15 % and −10 %; one run each). But the numbers move away from the measurements where the sweep's were close:
-#   $F_c$ falls by 15–34 %, and every rake face is hotter, steel's now 17–20 % above the measured (it was 14 % below),
-#   Ti6Al4V's 40–49 % above (19–26 %); $F_p/F_c$ moves by −15 to +1 %. At the converged reference update the model's rake
-#   faces are too hot for both materials: the sweep's smaller steel errors were partly the unconverged update's.
+#   passes 0.1, the frequency step keeps more of the Courant number: five cases took 0.51–0.83 of the sweep's
+#   steps (11–39 min of CPU each). Between $t_u/5$ and $t_u/10$ case 1 now moves by $F_c$ −8 % and $T_{RF}$ +3 %
+#   (at 0.5: −15 % and −10 %; one run each). $F_c$ falls by 15–34 % against the sweep, $F_p/F_c$ moves by −15 to
+#   +1 %, and every rake face is hotter: steel's now 7–20 % above the measured (it was 14–22 % below), Ti6Al4V's
+#   40–49 % above (19–26 %). At the converged reference update steel's errors change sign more than size, and
+#   Ti6Al4V's rake face is far too hot: part of the sweep's agreement was the unconverged update's.
 #
 # ## Your turn
 #

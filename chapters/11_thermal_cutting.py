@@ -391,11 +391,11 @@ display(Markdown(split_page.split("\n\n", 1)[1]))             # the page without
 # %% [markdown]
 # * **The cuts again at reference update 0.1** (the page's 'refined' table: $t_u/10$, Courant 0.3 under the
 #   frequency step; the sweep continues over sessions). With the reference updated before $\lVert\mathbf E\rVert_F$
-#   passes 0.1, the frequency step keeps more of the Courant number: seven cases took 0.51–0.94 of the sweep's
+#   passes 0.1, the frequency step keeps more of the Courant number: eight cases took 0.51–0.94 of the sweep's
 #   steps (11–39 min of CPU each). Between $t_u/5$ and $t_u/10$ case 1 now moves by $F_c$ −8 % and $T_{RF}$ +3 %
-#   (at 0.5: −15 % and −10 %; one run each). $F_c$ falls by 15–34 % against the sweep, $F_p/F_c$ moves by −15 to
+#   (at 0.5: −15 % and −10 %; one run each). $F_c$ falls by 13–34 % against the sweep, $F_p/F_c$ moves by −15 to
 #   +1 %, and every rake face is hotter: steel's now 7–27 % above the measured (it was 7–22 % below), Ti6Al4V's
-#   40–53 % above (19–38 %). At the converged reference update steel's errors change sign and grow a little, and
+#   40–58 % above (19–38 %). At the converged reference update steel's errors change sign and grow a little, and
 #   Ti6Al4V's rake face is far too hot: part of the sweep's agreement was the unconverged update's.
 #
 # ## Your turn

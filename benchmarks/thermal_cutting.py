@@ -122,6 +122,7 @@ BOSSAK = f" bossak {BOSSAK_ALPHA:g}"         # its key suffix (gamma 0.6 too, be
 # the tables that take such a run for a failed case's row, the first recorded 'ok' of each tuple: for the PFEM the
 # Bossak-Newmark run before the damped one, for its order (second; on the whole cuts of cases 1 and 8 at t_u/5 the
 # two damped rules move Fp by 5-30 % from the trapezoidal rule's, each the more on one case: the time-rule table)
+REFINED_NUMERICS = dict(ref_update_strain=REF_UPDATE, frequency_step=FREQUENCY_STEP)   # what 'refined' sets
 REFINED_RETRY = f" courant {COURANT:g}"      # a 'refined' case that failed: again at half the CFL part of its step
 RETRIES = {"": (RETRY,), PFEM10: (f" n_tu 10{BOSSAK}", DAMPED), REFINED: (REFINED_RETRY,)}
 PFEM_OPTIONS = ("case", "n_tu", "travel", "length", "gamma", "remesh_when_needed", "bossak")   # what the PFEM takes
@@ -233,11 +234,10 @@ def more_jobs() -> list[tuple[str, str, dict, dict]]:
     out += [("frequency", key.replace(GAIN_KEY, FREQ_KEY), options,
              dict({k: v for k, v in numerics.items() if k != "gain_step"}, frequency_step=FREQUENCY_STEP))
             for key, (options, numerics) in gain_step_jobs().items()]
-    out += [("refined", f"case {n}{REFINED}", converged(n), dict(ref_update_strain=REF_UPDATE,
-                                                                 frequency_step=FREQUENCY_STEP)) for n in range(1, 19)]
+    out += [("refined", f"case {n}{REFINED}", converged(n), dict(REFINED_NUMERICS)) for n in range(1, 19)]
     # the resolution check at REF_UPDATE (the 'resolution' study's runs are at the scene's 0.5): t_u/15 of cases 1, 10
-    out += [("refined", f"case {n} n_tu 15{REFINED}", converged(n, n_tu=15.0),
-             dict(ref_update_strain=REF_UPDATE, frequency_step=FREQUENCY_STEP)) for n in (1, 10)]
+    out += [("refined", f"case {n} n_tu 15{REFINED}", converged(n, n_tu=15.0), dict(REFINED_NUMERICS))
+            for n in (1, 10)]
     # case 10 at s/2 moved Fc by -21 %, T_RF by -12 %, one run against case 10's scatter of three: its scatter at s/2
     # too (the same two seeds), so that the forces' dependence on s is read between two groups of three
     out += [("scaling", f"case 10 s/2 jitter {seed}", converged(10, mass_scale=_s(10) / 2, jitter=0.01, seed=seed),
@@ -349,8 +349,7 @@ def retry_jobs(records: dict, studies=STUDY_NAMES) -> dict:
         if "pfem" in studies and records.get(pfem, {}).get("status", "ok") != "ok":
             out[pfem + RETRIES[PFEM10][0]] = (bossak_cut(n, 10.0), dict(method="pfem"))
         if "refined" in studies and records.get(f"case {n}{REFINED}", {}).get("status", "ok") != "ok":
-            out[f"case {n}{REFINED}{REFINED_RETRY}"] = (converged(n), dict(
-                ref_update_strain=REF_UPDATE, frequency_step=FREQUENCY_STEP, courant=COURANT))
+            out[f"case {n}{REFINED}{REFINED_RETRY}"] = (converged(n), dict(REFINED_NUMERICS, courant=COURANT))
     return out
 
 
@@ -1172,13 +1171,13 @@ def _study_lines(res: dict) -> list[str]:
         if keys == REF_RUNS:
             lines += [_single_run_line(res, k, group) for group, singles in REF_SINGLES for k in singles]
         if keys == HALF_STEP_RUNS:
-            lines += ["", _half_step_errors(res)]
+            lines += ["", _group_errors(res)]
         if keys == REFINED_RUNS:
-            lines += ["", _half_step_errors(res, REFINED, "", "the t_u/10")]
+            lines += ["", _group_errors(res, REFINED, "", "the t_u/10")]
     return lines
 
 
-def _half_step_errors(res: dict, suffix: str = COARSE + HALF_STEP, base: str = COARSE,
+def _group_errors(res: dict, suffix: str = COARSE + HALF_STEP, base: str = COARSE,
                       name: str = "the 'coarse'") -> str:
     """Mean |error| against the measurements of T_RF, T_FCS and Fp/Fc per material over the cases the group of key
     suffix ``suffix`` (default: the half-step group) has recorded 'ok', beside the group ``base``'s (default the

@@ -21,9 +21,6 @@ from .tlsph import ReferenceOperator, TLSPHParams, green_lagrange_norm, referenc
 
 __all__ = ["ReferenceConfiguration", "with_identity"]
 
-ROW_FIELDS = ("x", "v", "rho", "S", "S_zz", "eps_p", "eps_dot_p", "W_p", "T", "body")
-
-
 def with_identity(F: np.ndarray, state: State) -> np.ndarray:
     """F of the deformable rows extended to every row of ``state`` (rigid rows: F = I)."""
     if len(F) == state.n:
@@ -57,8 +54,7 @@ class ReferenceConfiguration:
         if self.constant is None or any(a is not b for a, b in zip(whole, self.constant[0])):
             self.constant = (whole, tuple(a[:n] for a in whole))
         m, X, V0 = self.constant[1]
-        part = {name: (None if getattr(state, name) is None else getattr(state, name)[:n]) for name in ROW_FIELDS}
-        return State(m=m, X=X, V0=V0, t=state.t, **part)
+        return state.rows(n, m=m, X=X, V0=V0)
 
     def operator(self, body: State, several_bodies: bool) -> ReferenceOperator:
         """The sparse operator of the current reference configuration of the deformable rows ``body``

@@ -19,7 +19,6 @@ checkpoint's layout (the constraints' arrays under ``constraints/``).
 """
 from __future__ import annotations
 
-import dataclasses
 import warnings
 
 import numpy as np
@@ -50,6 +49,7 @@ class SolverBase:
 
     method: str
     evolved: tuple
+    contact = None                                        # the tool contact, where the method has one
 
     def __init__(self, material: ElasticMaterial, params, strength: StrengthModel | None,
                  mirror: MirrorPlanes | None, constraints: Constraints, threads: int):
@@ -63,11 +63,14 @@ class SolverBase:
         return self.params.h
 
     def check_common(self, state: State) -> None:
-        """The strength model's fields, the symmetry planes and the constraints against ``state``."""
+        """The strength model's fields, the symmetry planes and the constraints against ``state``; a tool contact
+        with friction mu(T) needs the state's temperatures."""
         check_strength_fields(self.strength, state)
         if self.mirror is not None:
             self.mirror.check(state.dim)
         self.constraints.bind(state)
+        if self.contact is not None and self.contact.friction is not None and state.T is None:
+            raise ValueError("friction with mu(T) needs a state with temperatures (make_state(..., T0=...))")
 
     def stage_density(self, old: State, new: State) -> np.ndarray:
         """The density the return map of a stage uses (TLSPH: the start of the step's, Eq. (2))."""
@@ -154,8 +157,6 @@ class ESPHSolver(SolverBase):
         """The state fits the solver (ValueError naming what does not). Several deformable bodies are accepted
         with a warning: ESPH has no contact law between them, they are one continuum to the SPH sums."""
         self.check_common(state)
-        if self.contact is not None and self.contact.friction is not None and state.T is None:
-            raise ValueError("friction with mu(T) needs a state with temperatures (make_state(..., T0=...))")
         if len(self.constraints.deformable_bodies) > 1:
             warnings.warn(f"ESPH has no contact between deformable bodies {self.constraints.deformable_bodies}: "
                           "within 2h they are one continuum to the SPH sums (pressure pushes them apart, tension "
@@ -189,10 +190,7 @@ class ESPHSolver(SolverBase):
         if self.constraints.dim is None:
             self.constraints.bind(state)
         n = self.constraints.n_deformable
-        if self.coupling is None or n == state.n:
-            return state
-        return dataclasses.replace(state, **{f.name: getattr(state, f.name)[:n] for f in dataclasses.fields(state)
-                                            if f.name != "t" and getattr(state, f.name) is not None})
+        return state if self.coupling is None or n == state.n else state.rows(n)
 
     def rates(self, state: State, dt: float | None = None, part: str = "all", out: dict | None = None) -> Rates:
         """Eqs. (10)-(14), (23) over all particles, rigid ones included (``dt`` is not used); with the penalty
@@ -301,8 +299,6 @@ class TLSPHSolver(SolverBase):
         if self.several_bodies and not isinstance(self.contact, PinballContact):
             raise ValueError(f"deformable bodies {self.constraints.deformable_bodies} meet only through the pinball "
                              "contact: give the solver a PinballContact (refsph.simulate.make_solver does)")
-        if self.contact is not None and self.contact.friction is not None and state.T is None:
-            raise ValueError("friction with mu(T) needs a state with temperatures (make_state(..., T0=...))")
         body = self._body(state)
         J = np.ones(body.n)                     # the reference configuration itself: J = 1 (by definition)
         if np.any(body.x != body.X):            # a deformed start: the J the operator gives (Eq. (18))

@@ -93,6 +93,13 @@ class State:
     def dim(self) -> int:
         return self.x.shape[1]
 
+    def rows(self, n: int, **given) -> "State":
+        """The first n rows as a state of views (the time kept; ``given``: fields to take as they are, e.g. views
+        made once that a cache keys on)."""
+        part = {f.name: getattr(self, f.name)[:n] for f in fields(self)
+                if f.name != "t" and f.name not in given and getattr(self, f.name) is not None}
+        return replace(self, **part, **given)
+
     def copy(self) -> "State":
         return replace(self, **{f.name: np.array(getattr(self, f.name), copy=True)
                                 for f in fields(self) if f.name != "t" and getattr(self, f.name) is not None})

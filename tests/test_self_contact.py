@@ -142,7 +142,7 @@ def test_the_sweeps_failure_site(tmp_path):
 
 
 def test_the_half_step_groups_mean_errors():
-    """_half_step_errors: mean |error| against the measurements (refsph.paper_data, through ``comparison``) of the
+    """_group_errors: mean |error| against the measurements (refsph.paper_data, through ``comparison``) of the
     cases recorded 'ok' in both the half-step group and the 'coarse' table, per material; a case recorded in only one
     of them is left out."""
     from refsph.paper_data import rla_cutting_case
@@ -157,10 +157,10 @@ def test_the_half_step_groups_mean_errors():
                                                 passive_force_N_per_m=2e5 * ratio))
     runs = {"case 1 n_tu 5": rec(1.1), f"case 1 n_tu 5{mod.HALF_STEP}": rec(0.9),
             "case 2 n_tu 5": rec(1.5), f"case 2 n_tu 5{mod.HALF_STEP}": rec(1.5, status="blow-up")}
-    line = mod._half_step_errors(dict(runs=runs))
+    line = mod._group_errors(dict(runs=runs))
     assert "AISI1045 (1 cases): T_RF 10.0 % (before 10.0 %), T_FCS 10.0 % (10.0 %), Fp/Fc 50.0 % (50.0 %)" in line
     assert "Ti6Al4V" not in line and "the 'coarse' table's" in line
     # the 'refined' group (t_u/10 at reference update 0.1) against the t_u/10 table, the same way
-    line = mod._half_step_errors(dict(runs={"case 1": rec(1.1), f"case 1{mod.REFINED}": rec(0.8)}), mod.REFINED, "",
+    line = mod._group_errors(dict(runs={"case 1": rec(1.1), f"case 1{mod.REFINED}": rec(0.8)}), mod.REFINED, "",
                                  "the t_u/10")
     assert "AISI1045 (1 cases): T_RF 20.0 % (before 10.0 %)" in line and "the t_u/10 table's" in line

@@ -1173,8 +1173,32 @@ def _study_lines(res: dict) -> list[str]:
         if keys == HALF_STEP_RUNS:
             lines += ["", _group_errors(res)]
         if keys == REFINED_RUNS:
-            lines += ["", _group_errors(res, REFINED, "", "the t_u/10")]
+            lines += ["", _group_errors(res, REFINED, "", "the t_u/10"), "", _ledger_line(res, REFINED, "")]
     return lines
+
+
+LEDGER_SHARES = (("plastic", "plastic_of_work"), ("friction", "friction_of_work"),
+                 ("viscosity + contact damping", "dissipation_of_work"))
+
+
+def _ledger_line(res: dict, suffix: str, base: str) -> str:
+    """Where the tool's work goes in the group of key suffix ``suffix`` beside the group ``base``, per material over
+    the cases both have recorded 'ok' (the mean over those cases of each heat source in percent of the tool's work,
+    :func:`_values`), and the tool's work of the group over the base's (the mean of the per-case ratios)."""
+    parts = []
+    for material in ("AISI1045", "Ti6Al4V"):
+        here, other = both_ok(comparison(res, suffix), comparison(res, base), material)
+        if not here:
+            continue
+        a = [_values(res["runs"][r["key"]]) for r in here]
+        b = [_values(res["runs"][r["key"]]) for r in other]
+        shares = ", ".join(f"{name} {np.mean([v[k] for v in a]):.1f} % ({np.mean([v[k] for v in b]):.1f} %)"
+                           for name, k in LEDGER_SHARES)
+        work = np.mean([x["tool_work_J_per_m"] / y["tool_work_J_per_m"] for x, y in zip(a, b)])
+        parts.append(f"{material} ({len(here)} cases): {shares}; the tool's work {work:.2f} of the other's")
+    return ("Where the tool's work goes (the heat made, percent of the tool's work, mean over the cases recorded "
+            "here), beside the t_u/10 table's on the same cases in brackets: "
+            + ("; ".join(parts) if parts else "none recorded yet") + ".")
 
 
 def _group_errors(res: dict, suffix: str = COARSE + HALF_STEP, base: str = COARSE,

@@ -547,6 +547,24 @@ def test_thermal_cutting_refined_study_is_the_sweep_at_the_tighter_reference_upd
     assert todo["case 1" + mod.REFINED] == mod.jobs(studies=("frequency",))["case 1" + mod.REFINED]
 
 
+def test_thermal_cutting_ledger_line_compares_where_the_work_goes():
+    """_ledger_line: per material, the mean share of each heat source in the tool's work over the cases both groups
+    have recorded ok, and the ratio of the tool's work; a case recorded in one group only is left out."""
+    mod = _script("thermal_cutting")
+    ok = json.loads((ROOT / "benchmarks" / "thermal_cutting.json").read_text())["runs"]["case 3"]
+
+    def rec(work, plastic, friction, diss):
+        return dict(ok, metrics=dict(ok["metrics"], tool_work_J_per_m=work),
+                    heat_balance=dict(ok["heat_balance"], plastic_J=plastic, friction_J=friction, dissipation_J=diss))
+    runs = {"case 3": rec(100.0, 70.0, 2.0, 20.0), "case 3" + mod.REFINED: rec(80.0, 64.0, 8.0, 4.0),
+            "case 4": rec(100.0, 10.0, 10.0, 10.0)}         # not in the refined group: left out
+    line = mod._ledger_line(dict(runs=runs), mod.REFINED, "")
+    assert "AISI1045 (1 cases): plastic 80.0 % (70.0 %), friction 10.0 % (2.0 %)" in line
+    assert "viscosity + contact damping 5.0 % (20.0 %); the tool's work 0.80 of the other's" in line
+    assert "Ti6Al4V" not in line
+    assert "none recorded yet" in mod._ledger_line(dict(runs={"case 4": runs["case 4"]}), mod.REFINED, "")
+
+
 def test_thermal_cutting_refuses_to_skip_a_record_made_with_other_numerics(tmp_path):
     """_sweep_round: a key recorded with other scene options or other numerics than its job now asks for is not
     skipped as done, and not run over either: the sweep stops and names it (--redo runs it again)."""

@@ -975,6 +975,8 @@ REF_RUNS = tuple(f"case {n}{COARSE}{REF_KEY}{r:g}" if r != SCENE_REF_UPDATE else
     f"case {n}{COARSE}{REF_KEY}{r:g} courant {COURANT:g}" for n, r in REF_FAILED)
 HALF_STEP_RUNS = tuple(f"case {n}{COARSE}{HALF_STEP}" for n in range(1, 19))
 REFINED_RUNS = tuple(f"case {n}{REFINED}" for n in range(1, 19))
+REFINED_SERIES = (("refsph SPH, t_u/10,\nref update 0.5", "", "D", "C1"),     # the figure's series (measured_cuts)
+                  (f"refsph SPH, t_u/10,\nref update {REF_UPDATE:g}", REFINED, "o", "C3"))
 # the resolution check at REF_UPDATE: each case at t_u/5 (the 'refupdate' study's run, courant 0.3), t_u/10 and t_u/15
 REFINED_RESOLUTION = tuple(k for n in (1, 10) for k in (f"case {n}{COARSE}{REF_KEY}{REF_UPDATE:g}",
                                                           f"case {n}{REFINED}", f"case {n} n_tu 15{REFINED}"))
@@ -1173,7 +1175,9 @@ def _study_lines(res: dict) -> list[str]:
         if keys == HALF_STEP_RUNS:
             lines += ["", _group_errors(res)]
         if keys == REFINED_RUNS:
-            lines += ["", _group_errors(res, REFINED, "", "the t_u/10"), "", _ledger_line(res, REFINED, "")]
+            lines += ["", _group_errors(res, REFINED, "", "the t_u/10"), "", _ledger_line(res, REFINED, ""), "",
+                      "![The cuts at reference update 0.1 beside the t_u/10 table's, case by case, against the "
+                      "measurements and the paper's SPH and PFEM](../figures/11_thermal_cutting_refined.png)"]
     return lines
 
 
@@ -1391,6 +1395,11 @@ def figures(res: dict) -> None:
         fig.legend(loc="outside right upper")
         fig.savefig(FIG / "11_thermal_cutting_vs_measured.png", dpi=100)
     plt.close(fig)
+    with plt.rc_context(slide_style()):                     # the 'refined' study beside the t_u/10 table
+        fig, axes = plt.subplots(3, 1, figsize=(10, 6.5), sharex=True, constrained_layout=True)
+        measured_cuts(axes, res["runs"], REFINED_SERIES)
+        fig.legend(loc="outside right upper")
+        study.save_figure(fig, FIG / "11_thermal_cutting_refined.png", dpi=100)
     fig, axes = plt.subplots(1, 2, figsize=(11, 4.2), constrained_layout=True)
     for ax, mat in zip(axes, ("AISI1045", "Ti6Al4V")):
         for k, vc in enumerate(sorted({r["vc"] for r in rows if r["material"] == mat})):

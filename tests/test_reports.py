@@ -598,6 +598,24 @@ def test_thermal_cutting_dof_figure_is_what_the_code_draws(tmp_path):
     assert new.shape == old.shape and np.abs(new - old).max() < 0.05
 
 
+def test_thermal_cutting_refined_figure_draws_each_recorded_case_of_both_numerics():
+    """The 'refined' figure: measured_cuts with REFINED_SERIES draws the t_u/10 table's 18 cases and, for the
+    reference update 0.1, exactly the cases recorded ok."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from refsph.teaching.plots import measured_cuts
+    mod = _script("thermal_cutting")
+    runs = json.loads((ROOT / "benchmarks" / "thermal_cutting.json").read_text())["runs"]
+    fig, axes = plt.subplots(3, 1)
+    drawn = measured_cuts(axes, runs, mod.REFINED_SERIES)
+    plt.close(fig)
+    (sweep, _, _, _), (refined, suffix, _, _) = mod.REFINED_SERIES
+    assert suffix == mod.REFINED and drawn[sweep] == list(range(1, 19))
+    assert drawn[refined] == [n for n in range(1, 19) if runs.get(f"case {n}{suffix}", {}).get("status") == "ok"]
+
+
 def test_dof_changes_counts_the_moves_between_resolutions():
     mod = _script("thermal_cutting")
     base = {f"{q}_{m}": 10.0 for q, _ in mod.DOF_QUANTITIES for m in ("pfem", "sph")}

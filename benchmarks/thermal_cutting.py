@@ -1391,13 +1391,13 @@ def figures(res: dict) -> None:
     rows = comparison(res)
     with plt.rc_context(slide_style()):                     # the figure chapter 11 shows, drawn by the same code
         fig, axes = plt.subplots(3, 1, figsize=(10, 6.5), sharex=True, constrained_layout=True)
-        measured_cuts(axes, res["runs"])
+        measured_cuts(axes, res["runs"], retries=RETRIES)
         fig.legend(loc="outside right upper")
         fig.savefig(FIG / "11_thermal_cutting_vs_measured.png", dpi=100)
     plt.close(fig)
     with plt.rc_context(slide_style()):                     # the 'refined' study beside the t_u/10 table
         fig, axes = plt.subplots(3, 1, figsize=(10, 6.5), sharex=True, constrained_layout=True)
-        measured_cuts(axes, res["runs"], REFINED_SERIES)
+        measured_cuts(axes, res["runs"], REFINED_SERIES, RETRIES)
         fig.legend(loc="outside right upper")
         study.save_figure(fig, FIG / "11_thermal_cutting_refined.png", dpi=100)
     fig, axes = plt.subplots(1, 2, figsize=(11, 4.2), constrained_layout=True)

@@ -612,8 +612,18 @@ def test_thermal_cutting_refined_figure_draws_each_recorded_case_of_both_numeric
     drawn = measured_cuts(axes, runs, mod.REFINED_SERIES)
     plt.close(fig)
     (sweep, _, _, _), (refined, suffix, _, _) = mod.REFINED_SERIES
-    assert suffix == mod.REFINED and drawn[sweep] == list(range(1, 19))
-    assert drawn[refined] == [n for n in range(1, 19) if runs.get(f"case {n}{suffix}", {}).get("status") == "ok"]
+    assert suffix == mod.REFINED and drawn[sweep] == list(range(1, 19))     # case 9 by its retry
+    assert runs["case 9"]["status"] != "ok" and runs["case 9" + mod.RETRY]["status"] == "ok"
+    assert drawn[refined] == [n for n in range(1, 19) if any(runs.get(f"case {n}{suffix}{t}", {}).get("status") == "ok"
+                                                             for t in ("",) + mod.RETRIES[suffix])]
+
+
+def test_measured_cuts_takes_the_sweeps_retries():
+    """The figure's default retries are the sweep's (a failed case is drawn from the same retry the tables take)."""
+    from refsph.teaching.plots import CUT_RETRIES, CUT_SERIES
+    mod = _script("thermal_cutting")
+    assert CUT_RETRIES == {k: v for k, v in mod.RETRIES.items() if k in CUT_RETRIES}
+    assert {s for _, s, *_ in CUT_SERIES + mod.REFINED_SERIES if s in mod.RETRIES} <= set(CUT_RETRIES)
 
 
 def test_dof_changes_counts_the_moves_between_resolutions():

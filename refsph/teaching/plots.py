@@ -141,20 +141,32 @@ def stability_map(axes, runs: dict, cases=None, variants: dict | None = None) ->
 # (label, record key suffix, marker, colour) of refsph's series in :func:`measured_cuts`
 CUT_SERIES = (("refsph SPH, t_u/5", " n_tu 5", "o", "C0"), ("refsph SPH, t_u/10", "", "D", "C1"),
               ("refsph PFEM, t_u/5", " pfem n_tu 5", "P", "C2"), ("refsph PFEM, t_u/10", " pfem", "X", "C2"))
+# a series' case that failed, run again under 'case N' + suffix + one of these (the sweep's retries, in the order it
+# takes them: benchmarks/thermal_cutting.py's RETRIES): SPH at a quarter of the step, the PFEM with damped rules
+CUT_RETRIES = {"": (" courant 0.075",), " pfem": (" n_tu 10 bossak -0.1", " n_tu 10 gamma 0.6"),
+               " ref update 0.1 frequency step 0.5": (" courant 0.15",)}
 
 
-def measured_cuts(axes, runs: dict, series=CUT_SERIES) -> dict:
+def measured_cuts(axes, runs: dict, series=CUT_SERIES, retries: dict | None = None) -> dict:
     """The 18 measured cuts of Rodriguez Prieto, Larsson & Afrasiabi (2023) against refsph and the paper, case by case,
     on three Axes: the rake-face temperature, the free chip surface temperature and the force ratio Fp/Fc. The
     measurement is a black bar, the paper's SPH and PFEM grey open squares and triangles, refsph's runs (``runs``:
     the records of ``benchmarks/thermal_cutting.json``, ``'case N' + suffix`` for each of ``series``) filled
-    markers, only where a run is recorded and ended well. Returns {series label: the cases drawn}."""
+    markers, only where a run is recorded and ended well; where it did not, its first retry that did (``retries``:
+    {series suffix: the retries' key suffixes}, default :data:`CUT_RETRIES`). Returns {series label: the cases
+    drawn}."""
     from ..paper_data import rla_cutting_case
 
     quantities = (("TRF", "rake_face_temperature_K", "T$_{RF}$ [K]"),
                   ("TFCS", "free_chip_surface_temperature_K", "T$_{FCS}$ [K]"), ("ratio", "force_ratio", "Fp / Fc"))
     paper = [rla_cutting_case(n) for n in range(1, 19)]
     drawn = {label: [] for label, *_ in series}
+    retries = CUT_RETRIES if retries is None else retries
+
+    def record(m: int, suffix: str):
+        key = f"case {m}{suffix}"
+        ok = [key] + [key + t for t in retries.get(suffix, ())]
+        return next((runs[k] for k in ok if runs.get(k, {}).get("status") == "ok"), None)
     for k, (ax, (q, key, ylabel)) in enumerate(zip(axes, quantities)):
         def value(c, src):
             return c[f"Fp_{src}_N"] / c[f"Fc_{src}_N"] if q == "ratio" else c[f"{q}_{src}_K"]
@@ -165,8 +177,8 @@ def measured_cuts(axes, runs: dict, series=CUT_SERIES) -> dict:
             ax.plot(n + dx, [value(c, src) for c in paper], mk, mfc="none", color="0.45", ms=7,
                     label=lab if k == 0 else None)
         for j, (label, suffix, mk, col) in enumerate(series):
-            pts = [(m, r["metrics"][key]) for m in range(1, 19) for r in [runs.get(f"case {m}{suffix}")]
-                   if r is not None and r.get("status") == "ok" and r.get("metrics", {}).get(key) is not None]
+            pts = [(m, r["metrics"][key]) for m in range(1, 19) for r in [record(m, suffix)]
+                   if r is not None and r.get("metrics", {}).get(key) is not None]
             if pts:
                 p = np.array(pts, dtype=float)
                 ax.plot(p[:, 0] + 0.14 * (1 + j % 2), p[:, 1], mk, color=col, ms=8, label=label if k == 0 else None)

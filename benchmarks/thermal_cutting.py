@@ -686,7 +686,8 @@ def report(res: dict, before: dict | None = None) -> str:
         v = _values(res["runs"][r["key"]]) if r["status"] == "ok" else {}
         lines.append(_row([(r["case"], "d")] + [(v.get(key), fmt) for _, key, fmt in STEADY_COLUMNS]))
     lines += ["", P("trends")]
-    for label, sel in (("SPH, t_u/10", rows), ("SPH, t_u/5", coarse), ("PFEM, t_u/5", pfem), ("PFEM, t_u/10", pfem10)):
+    for label, sel in (("SPH, t_u/10", rows), (f"SPH, t_u/10, ref update {REF_UPDATE:g}", comparison(res, REFINED)),
+                       ("SPH, t_u/5", coarse), ("PFEM, t_u/5", pfem), ("PFEM, t_u/10", pfem10)):
         for mat, t in trends(sel).items():
             lines.append(f"| {mat} | {label} | " + " | ".join(_trend_cell(t, n) for n in TREND_NAMES) + " |")
     lines += ["", P("rake_ceiling")] + _ceiling_lines(rows)

@@ -128,6 +128,7 @@ RETRIES = {"": (RETRY,), PFEM10: (f" n_tu 10{BOSSAK}", DAMPED), REFINED: (REFINE
 PFEM_OPTIONS = ("case", "n_tu", "travel", "length", "gamma", "remesh_when_needed", "bossak")   # what the PFEM takes
 REMESH = " remesh when needed"              # the key suffix of a PFEM cut that remeshes only where the quality asks
 PAPER_CUT = (1.5e-3, 2.0e-3)   # m of tool travel: the last quarter of the paper's PFEM cut, 2/3 of its 3 mm workpiece
+TO_CHIP = " all friction heat to the chip"   # key suffix: chip_fraction 1 (the paper's SPH code's choice; scene 0.5)
 TO_2MM = " 2 mm"               # key suffix: a t_u = 0.1 mm case cut to 2 mm (20 t_u) on the paper's 3 mm workpiece
 TU_01 = (1, 4, 7, 10, 13, 16)   # the cases at t_u = 0.1 mm
 PFEM_FINE = ((1, 15.0), (2, 15.0), (3, 20.0))   # (case, nodes across t_u) of the PFEM finer than t_u/10
@@ -208,7 +209,7 @@ def jobs(studies=STUDY_NAMES, only=None) -> dict:
     add("tool", "case 1 n_tu 5 4 t_u uncut", converged(1, n_tu=5.0, uncut=4.0))
     add("tool", "case 1 tool 5x3, 4 t_u uncut", converged(1, uncut=4.0, **SMALL))      # (at the scene's step)
     add("contact", "case 1 pinball", converged(1), sweep_numerics(contact="pinball"))
-    add("contact", "case 1 all friction heat to the chip", converged(1, chip_fraction=1.0), sweep_numerics())
+    add("contact", f"case 1{TO_CHIP}", converged(1, chip_fraction=1.0), sweep_numerics())
     # case 9 blew up at 0.73 ms of 1.07 at courant 0.15 (22 chip particles past 1500 K, 0.4 mm up the rake face, then
     # two inverted particles; from its 0.67 ms checkpoint the same at 0.15, none at 0.075): again at half that step;
     # the report takes it for case 9's row (RETRY)
@@ -236,6 +237,10 @@ def more_jobs() -> list[tuple[str, str, dict, dict]]:
             for key, (options, numerics) in gain_step_jobs().items()]
     out += [("refined", f"case {n}{REFINED}", converged(n), dict(REFINED_NUMERICS)) for n in range(1, 19)]
     # the resolution check at REF_UPDATE (the 'resolution' study's runs are at the scene's 0.5): t_u/15 of cases 1, 10
+    # at REF_UPDATE the frictional heat is 9-19 % of the tool's work (1-10 % at the scene's 0.5), so where it is put
+    # matters more: cases 1 and 10 with all of it in the chip (the paper's SPH code's choice), before the t_u/15 runs
+    out += [("contact", f"case {n}{REFINED}{TO_CHIP}", converged(n, chip_fraction=1.0), dict(REFINED_NUMERICS))
+            for n in (10, 1)]
     out += [("refined", f"case {n} n_tu 15{REFINED}", converged(n, n_tu=15.0), dict(REFINED_NUMERICS))
             for n in (1, 10)]
     # case 10 at s/2 moved Fc by -21 %, T_RF by -12 %, one run against case 10's scatter of three: its scatter at s/2
@@ -1126,8 +1131,11 @@ STUDIES = (
      "by the largest gain, or held under half of 2 / w_max (t_u/10: case 10 at 0.3, the sweep's case 10 at 0.15; "
      "case 1 at reference update 0.1 at 0.15, at 0.075, and at 0.3 with either); a failed run shows its status",
      GAIN_RUNS, BASIC + (("steps", "n_steps", "d"), ("CPU [min]", "cpu_min", ".1f"), ("wall [s]", "wall", ".0f"))),
-    ("Contact and heat split (case 1: penalty contact, half the frictional heat into the chip)",
-     ("case 1", "case 1 pinball", "case 1 all friction heat to the chip"),
+    ("Contact and heat split (case 1: penalty contact, half the frictional heat into the chip; then cases 1 and 10 at "
+     f"ref update {REF_UPDATE:g}, where the frictional heat is a larger part of the tool's work, with all of it in "
+     "the chip, the paper's SPH code's choice)",
+     ("case 1", "case 1 pinball", f"case 1{TO_CHIP}") + tuple(k for n in (1, 10) for k in (
+         f"case {n}{REFINED}", f"case {n}{REFINED}{TO_CHIP}")),
      BASIC + (("friction heat [% of work]", "friction_of_work", ".1f"),
               ("viscosity + damping heat [% of work]", "dissipation_of_work", ".1f"))),
 )

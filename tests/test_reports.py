@@ -547,6 +547,19 @@ def test_thermal_cutting_refined_study_is_the_sweep_at_the_tighter_reference_upd
     assert todo["case 1" + mod.REFINED] == mod.jobs(studies=("frequency",))["case 1" + mod.REFINED]
 
 
+def test_thermal_cutting_heat_split_at_the_refined_update():
+    """The 'contact' study's runs at REF_UPDATE: cases 10 and 1 as their 'refined' runs, with chip_fraction 1 only,
+    and in the study's table beside them."""
+    mod = _script("thermal_cutting")
+    todo, refined = mod.jobs(studies=("contact",)), mod.jobs(studies=("refined",))
+    for n in (1, 10):
+        key = f"case {n}{mod.REFINED}"
+        options, numerics = todo[key + mod.TO_CHIP]
+        assert options == dict(refined[key][0], chip_fraction=1.0) and numerics == refined[key][1]
+        assert refined[key][0].get("chip_fraction", 0.5) == 0.5
+        assert {key, key + mod.TO_CHIP} <= set(next(k for t, k, _ in mod.STUDIES if t.startswith("Contact and heat")))
+
+
 def test_thermal_cutting_ledger_line_compares_where_the_work_goes():
     """_ledger_line: per material, the mean share of each heat source in the tool's work over the cases both groups
     have recorded ok, and the ratio of the tool's work; a case recorded in one group only is left out."""

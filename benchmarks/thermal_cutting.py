@@ -551,7 +551,8 @@ def _exp_name(name: str) -> str:
 def trends(rows) -> dict:
     """Per material: does Fc (Fp) rise with t_u at every v_c, T_RF rise and Fc fall with v_c at every t_u (refsph
     and measured; TREND_NAMES)? The verdict is None where a case is missing; '<key>_lines' counts (lines that go
-    that way, lines with every case recorded, lines), so that a partial sweep still shows the lines it has."""
+    that way, lines with every case recorded, lines), so that a partial sweep still shows the lines it has. The
+    measured verdict and counts are taken over the lines refsph has recorded (over every line where it has none)."""
     out = {}
     columns = dict(Fc=("Fc_N_per_mm", "Fc_exp"), Fp=("Fp_N_per_mm", "Fp_exp"), TRF=("TRF", "TRF_exp"))
     for mat in ("AISI1045", "Ti6Al4V"):
@@ -560,13 +561,16 @@ def trends(rows) -> dict:
         t = out[mat] = {}
         for name in TREND_NAMES:
             q, along_tu, sign = name.split("_")[0], name.endswith("_tu"), -1.0 if "_falls_" in name else 1.0
+            verdicts = {}
             for label, k in zip((name, _exp_name(name)), columns[q]):
                 lines = [[get[(v, u)][k] for u in tus] for v in vcs] if along_tu else \
                     [[get[(v, u)][k] for v in vcs] for u in tus]
-                verdicts = [_rising([None if x is None else sign * x for x in vals]) for vals in lines]
-                known = [v for v in verdicts if v is not None]
-                t[label] = None if None in verdicts or not verdicts else all(verdicts)
-                t[label + "_lines"] = (sum(known), len(known), len(verdicts))
+                verdicts[label] = [_rising([None if x is None else sign * x for x in vals]) for vals in lines]
+            have = [v is not None for v in verdicts[name]]      # the measured over refsph's recorded lines only
+            for label, vs in verdicts.items():
+                known = [v for v, h in zip(vs, have if any(have) else [True] * len(vs)) if h and v is not None]
+                t[label] = None if None in vs or not vs else all(known)
+                t[label + "_lines"] = (sum(known), len(known), len(vs))
     return out
 
 
@@ -981,8 +985,8 @@ REF_RUNS = tuple(f"case {n}{COARSE}{REF_KEY}{r:g}" if r != SCENE_REF_UPDATE else
     f"case {n}{COARSE}{REF_KEY}{r:g} courant {COURANT:g}" for n, r in REF_FAILED)
 HALF_STEP_RUNS = tuple(f"case {n}{COARSE}{HALF_STEP}" for n in range(1, 19))
 REFINED_RUNS = tuple(f"case {n}{REFINED}" for n in range(1, 19))
-REFINED_SERIES = (("refsph SPH, t_u/10,\nref update 0.5", "", "D", "C1"),     # the figure's series (measured_cuts)
-                  (f"refsph SPH, t_u/10,\nref update {REF_UPDATE:g}", REFINED, "o", "C3"))
+REFINED_SERIES = (("refsph SPH, t_u/10,\nref update 0.5,\ncourant 0.15", "", "D", "C1"),   # the figure's series
+                  (f"refsph SPH, t_u/10,\nref update {REF_UPDATE:g},\nfrequency step", REFINED, "o", "C3"))
 # the resolution check at REF_UPDATE: each case at t_u/5 (the 'refupdate' study's run, courant 0.3), t_u/10 and t_u/15
 REFINED_RESOLUTION = tuple(k for n in (1, 10) for k in (f"case {n}{COARSE}{REF_KEY}{REF_UPDATE:g}",
                                                           f"case {n}{REFINED}", f"case {n} n_tu 15{REFINED}"))
@@ -1194,10 +1198,11 @@ LEDGER_SHARES = (("plastic", "plastic_of_work"), ("friction", "friction_of_work"
                  ("viscosity + contact damping", "dissipation_of_work"))
 
 
-def _ledger_line(res: dict, suffix: str, base: str) -> str:
-    """Where the tool's work goes in the group of key suffix ``suffix`` beside the group ``base``, per material over
-    the cases both have recorded 'ok' (the mean over those cases of each heat source in percent of the tool's work,
-    :func:`_values`), and the tool's work of the group over the base's (the mean of the per-case ratios)."""
+def _ledger_line(res: dict, suffix: str, base: str, name: str = "the t_u/10 table") -> str:
+    """Where the tool's work goes in the group of key suffix ``suffix`` beside the group ``base`` (its ``name`` in
+    the line), per material over the cases both have recorded 'ok' (the mean over those cases of each heat source
+    in percent of the tool's work, :func:`_values`), and the tool's work of the group over the base's (the mean of
+    the per-case ratios)."""
     parts = []
     for material in ("AISI1045", "Ti6Al4V"):
         here, other = both_ok(comparison(res, suffix), comparison(res, base), material)
@@ -1205,12 +1210,12 @@ def _ledger_line(res: dict, suffix: str, base: str) -> str:
             continue
         a = [_values(res["runs"][r["key"]]) for r in here]
         b = [_values(res["runs"][r["key"]]) for r in other]
-        shares = ", ".join(f"{name} {np.mean([v[k] for v in a]):.1f} % ({np.mean([v[k] for v in b]):.1f} %)"
-                           for name, k in LEDGER_SHARES)
+        shares = ", ".join(f"{label} {np.mean([v[k] for v in a]):.1f} % ({np.mean([v[k] for v in b]):.1f} %)"
+                           for label, k in LEDGER_SHARES)
         work = np.mean([x["tool_work_J_per_m"] / y["tool_work_J_per_m"] for x, y in zip(a, b)])
-        parts.append(f"{material} ({len(here)} cases): {shares}; the tool's work {work:.2f} of the other's")
+        parts.append(f"{material} ({len(here)} cases): {shares}; the tool's work {work:.2f} of {name}'s")
     return ("Where the tool's work goes (the heat made, percent of the tool's work, mean over the cases recorded "
-            "here), beside the t_u/10 table's on the same cases in brackets: "
+            f"both here and in {name}, its means in brackets): "
             + ("; ".join(parts) if parts else "none recorded yet") + ".")
 
 

@@ -89,7 +89,12 @@ def test_thermal_cutting_trends_read_every_line():
     t = mod.trends(rows)["AISI1045"]                                   # the line at vc 60 is still read
     assert t["Fp_rises_with_tu_lines"] == (1, 1, 2) and t["Fc_rises_with_tu_lines"] == (2, 2, 2)
     assert mod._trend_cell(t, "Fp_rises_with_tu") == "yes, 1 of 2 lines recorded / yes"
-    rows[4]["Fp_N_per_mm"] = 0.0
+    rows[4]["Fp_exp"] = 0.0                          # a measured dip on the line refsph has not recorded: not read
+    t = mod.trends(rows)["AISI1045"]
+    assert t["Fp_exp_rises_with_tu"] is True and t["Fp_exp_rises_with_tu_lines"] == (1, 1, 2)
+    rows[4]["Fp_N_per_mm"] = 0.0                     # recorded now: the measured dip counts
+    assert mod.trends(rows)["AISI1045"]["Fp_exp_rises_with_tu_lines"] == (1, 2, 2)
+    rows[4]["Fp_exp"] = 0.15
     assert mod._trend_cell(mod.trends(rows)["AISI1045"], "Fp_rises_with_tu") == "no (1 of 2 rise) / yes"
     assert mod._trend_cell(mod.trends(rows)["Ti6Al4V"], "Fc_rises_with_tu") == "- / -"
     t = mod.trends(rows)["AISI1045"]                 # Fc = 100 tu + vc rises with vc: it does not fall, on two lines
@@ -562,7 +567,8 @@ def test_thermal_cutting_heat_split_at_the_refined_update():
 
 def test_thermal_cutting_ledger_line_compares_where_the_work_goes():
     """_ledger_line: per material, the mean share of each heat source in the tool's work over the cases both groups
-    have recorded ok, and the ratio of the tool's work; a case recorded in one group only is left out."""
+    have recorded ok, and the mean of the per-case ratios of the tool's work; a case recorded in one group only is
+    left out."""
     mod = _script("thermal_cutting")
     ok = json.loads((ROOT / "benchmarks" / "thermal_cutting.json").read_text())["runs"]["case 3"]
 
@@ -570,10 +576,15 @@ def test_thermal_cutting_ledger_line_compares_where_the_work_goes():
         return dict(ok, metrics=dict(ok["metrics"], tool_work_J_per_m=work),
                     heat_balance=dict(ok["heat_balance"], plastic_J=plastic, friction_J=friction, dissipation_J=diss))
     runs = {"case 3": rec(100.0, 70.0, 2.0, 20.0), "case 3" + mod.REFINED: rec(80.0, 64.0, 8.0, 4.0),
+            "case 2": rec(100.0, 70.0, 4.0, 20.0), "case 2" + mod.REFINED: rec(40.0, 32.0, 2.0, 4.0),
             "case 4": rec(100.0, 10.0, 10.0, 10.0)}         # not in the refined group: left out
     line = mod._ledger_line(dict(runs=runs), mod.REFINED, "")
-    assert "AISI1045 (1 cases): plastic 80.0 % (70.0 %), friction 10.0 % (2.0 %)" in line
-    assert "viscosity + contact damping 5.0 % (20.0 %); the tool's work 0.80 of the other's" in line
+    # case 3: 80 / 10 / 5 % (70 / 2 / 20), case 2: 80 / 5 / 10 % (70 / 4 / 20); work 0.8 and 0.4: mean 0.6 (the
+    # ratio of the means would be 120 / 200 = 0.6 too, so case 2's base work differs below)
+    assert "AISI1045 (2 cases): plastic 80.0 % (70.0 %), friction 7.5 % (3.0 %)" in line
+    assert "viscosity + contact damping 7.5 % (20.0 %); the tool's work 0.60 of the t_u/10 table's" in line
+    runs["case 2"] = rec(50.0, 35.0, 2.0, 10.0)       # the same shares; work ratios 0.8 and 0.8 (means: 120 / 150)
+    assert "the tool's work 0.80 of" in mod._ledger_line(dict(runs=runs), mod.REFINED, "")
     assert "Ti6Al4V" not in line
     assert "none recorded yet" in mod._ledger_line(dict(runs={"case 4": runs["case 4"]}), mod.REFINED, "")
 
@@ -627,8 +638,19 @@ def test_thermal_cutting_refined_figure_draws_each_recorded_case_of_both_numeric
     (sweep, _, _, _), (refined, suffix, _, _) = mod.REFINED_SERIES
     assert suffix == mod.REFINED and drawn[sweep] == list(range(1, 19))     # case 9 by its retry
     assert runs["case 9"]["status"] != "ok" and runs["case 9" + mod.RETRY]["status"] == "ok"
-    assert drawn[refined] == [n for n in range(1, 19) if any(runs.get(f"case {n}{suffix}{t}", {}).get("status") == "ok"
-                                                             for t in ("",) + mod.RETRIES[suffix])]
+    for label, sfx, *_ in mod.REFINED_SERIES:      # the cases the tables take, those recorded ok or retried ok
+        assert drawn[label] == [r["case"] for r in mod.comparison(dict(runs=runs), sfx) if r["status"] == "ok"]
+    ok, bad = runs["case 3"], dict(runs["case 3"], status="blow-up")
+    retry = dict(ok, metrics=dict(ok["metrics"], rake_face_temperature_K=-1.0))    # told apart by T_RF
+    for made, want in (({"case 3": ok, "case 3" + mod.RETRY: retry}, [ok]),    # both ok: the run itself
+                       ({"case 3" + mod.RETRY: retry}, []),                    # no run: its retry is not drawn
+                       ({"case 3": bad, "case 3" + mod.RETRY: retry}, [retry])):   # failed: its retry
+        fig, axes = plt.subplots(3, 1)
+        drawn = measured_cuts(axes, made, mod.REFINED_SERIES[:1], mod.RETRIES)
+        T = [y for line in axes[0].lines if line.get_label() == sweep for y in line.get_ydata()]
+        plt.close(fig)
+        assert T == [r["metrics"]["rake_face_temperature_K"] for r in want]
+        assert [r["case"] for r in mod.comparison(dict(runs=made)) if r["status"] == "ok"] == [3] * len(want)
 
 
 def test_measured_cuts_takes_the_sweeps_retries():

@@ -152,7 +152,7 @@ def measured_cuts(axes, runs: dict, series=CUT_SERIES, retries: dict | None = No
     on three Axes: the rake-face temperature, the free chip surface temperature and the force ratio Fp/Fc. The
     measurement is a black bar, the paper's SPH and PFEM grey open squares and triangles, refsph's runs (``runs``:
     the records of ``benchmarks/thermal_cutting.json``, ``'case N' + suffix`` for each of ``series``) filled
-    markers, only where a run is recorded and ended well; where it did not, its first retry that did (``retries``:
+    markers, only where a run is recorded and ended well; where it failed, its first retry that did (``retries``:
     {series suffix: the retries' key suffixes}, default :data:`CUT_RETRIES`). Returns {series label: the cases
     drawn}."""
     from ..paper_data import rla_cutting_case
@@ -163,10 +163,12 @@ def measured_cuts(axes, runs: dict, series=CUT_SERIES, retries: dict | None = No
     drawn = {label: [] for label, *_ in series}
     retries = CUT_RETRIES if retries is None else retries
 
-    def record(m: int, suffix: str):
+    def record(m: int, suffix: str):                     # as the sweep's tables: a retry only of a failed run
         key = f"case {m}{suffix}"
-        ok = [key] + [key + t for t in retries.get(suffix, ())]
-        return next((runs[k] for k in ok if runs.get(k, {}).get("status") == "ok"), None)
+        if key not in runs or runs[key].get("status") == "ok":
+            return runs.get(key)
+        return next((runs[k] for k in (key + t for t in retries.get(suffix, ()))
+                     if runs.get(k, {}).get("status") == "ok"), runs[key])
     for k, (ax, (q, key, ylabel)) in enumerate(zip(axes, quantities)):
         def value(c, src):
             return c[f"Fp_{src}_N"] / c[f"Fc_{src}_N"] if q == "ratio" else c[f"{q}_{src}_K"]
@@ -178,7 +180,7 @@ def measured_cuts(axes, runs: dict, series=CUT_SERIES, retries: dict | None = No
                     label=lab if k == 0 else None)
         for j, (label, suffix, mk, col) in enumerate(series):
             pts = [(m, r["metrics"][key]) for m in range(1, 19) for r in [record(m, suffix)]
-                   if r is not None and r.get("metrics", {}).get(key) is not None]
+                   if r is not None and r.get("status") == "ok" and r.get("metrics", {}).get(key) is not None]
             if pts:
                 p = np.array(pts, dtype=float)
                 ax.plot(p[:, 0] + 0.14 * (1 + j % 2), p[:, 1], mk, color=col, ms=8, label=label if k == 0 else None)

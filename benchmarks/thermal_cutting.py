@@ -668,6 +668,7 @@ def report(res: dict, before: dict | None = None) -> str:
     done = [r for r in rows if r["status"] == "ok"]
     lines = [P("head", n_tu=f"{N_TU:g}", travel=f"{TRAVEL:g}", inertia=f"{100 * INERTIA:g}", done=len(done))]
     lines += [_case_line(r) for r in rows] + ["", P("mean_errors")] + _mean_error_lines(rows, old)
+    lines += ["", P("refined_errors")] + _mean_error_lines(comparison(res, REFINED), old)
     coarse = comparison(res, COARSE)
     lines += ["", P("coarse", done=sum(r["status"] == "ok" for r in coarse))] + [_case_line(r) for r in coarse]
     lines += ["", P("coarse_errors")] + _mean_error_lines(coarse, old)

@@ -489,15 +489,12 @@ def comparison(res: dict, suffix: str = "") -> list[dict]:
     """Per case: refsph, the measurement and the paper's SPH and PFEM, with the percent errors (``suffix``: the
     records 'case N' + suffix, e.g. COARSE)."""
     from refsph.paper_data import rla_cutting_case
+    from refsph.teaching.plots import cut_record
     rows = []
     for n in range(1, 19):
         c = rla_cutting_case(n)
-        key = f"case {n}{suffix}"
-        r = res["runs"].get(key)
-        retry = next((key + t for t in RETRIES.get(suffix, ()) if res["runs"].get(key + t, {}).get("status") == "ok"),
-                     None)
-        if r is not None and r["status"] != "ok" and retry is not None:
-            key, r = retry, res["runs"][retry]              # the case again at half the step, or damped (RETRIES)
+        # a failed case: its retry at a smaller step, or damped (RETRIES), where one is recorded ok
+        key, r = cut_record(res["runs"], f"case {n}{suffix}", RETRIES.get(suffix, ()))
         status = "to run" if r is None else r["status"]
         m = (r or {}).get("metrics", {})
         ok = r is not None and r["status"] == "ok"
@@ -1402,19 +1399,15 @@ def figures(res: dict) -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from refsph.teaching.plots import measured_cuts, slide_style
+    from refsph.teaching.plots import CUT_SERIES, measured_cuts, slide_style
     rows = comparison(res)
-    with plt.rc_context(slide_style()):                     # the figure chapter 11 shows, drawn by the same code
-        fig, axes = plt.subplots(3, 1, figsize=(10, 6.5), sharex=True, constrained_layout=True)
-        measured_cuts(axes, res["runs"], retries=RETRIES)
-        fig.legend(loc="outside right upper")
-        fig.savefig(FIG / "11_thermal_cutting_vs_measured.png", dpi=100)
-    plt.close(fig)
-    with plt.rc_context(slide_style()):                     # the 'refined' study beside the t_u/10 table
-        fig, axes = plt.subplots(3, 1, figsize=(10, 6.5), sharex=True, constrained_layout=True)
-        measured_cuts(axes, res["runs"], REFINED_SERIES, RETRIES)
-        fig.legend(loc="outside right upper")
-        study.save_figure(fig, FIG / "11_thermal_cutting_refined.png", dpi=100)
+    # the figure chapter 11 shows (drawn by the same code), then the 'refined' study beside the t_u/10 table
+    for series, name in ((CUT_SERIES, "vs_measured"), (REFINED_SERIES, "refined")):
+        with plt.rc_context(slide_style()):
+            fig, axes = plt.subplots(3, 1, figsize=(10, 6.5), sharex=True, constrained_layout=True)
+            measured_cuts(axes, res["runs"], series, RETRIES)
+            fig.legend(loc="outside right upper")
+            study.save_figure(fig, FIG / f"11_thermal_cutting_{name}.png", dpi=100)
     fig, axes = plt.subplots(1, 2, figsize=(11, 4.2), constrained_layout=True)
     for ax, mat in zip(axes, ("AISI1045", "Ti6Al4V")):
         for k, vc in enumerate(sorted({r["vc"] for r in rows if r["material"] == mat})):

@@ -100,7 +100,7 @@ def colorbar(fig, mappable, ax, label: str, **kwargs):
 # the chapters and the benchmark scripts (benchmarks/stability_map.py, benchmarks/thermal_cutting.py).
 # ------------------------------------------------------------------------------------------------------------------
 
-__all__ += ["stability_map", "measured_cuts", "CUT_SERIES"]
+__all__ += ["stability_map", "measured_cuts", "cut_record", "CUT_SERIES"]
 
 
 def stability_map(axes, runs: dict, cases=None, variants: dict | None = None) -> None:
@@ -147,6 +147,16 @@ CUT_RETRIES = {"": (" courant 0.075",), " pfem": (" n_tu 10 bossak -0.1", " n_tu
                " ref update 0.1 frequency step 0.5": (" courant 0.15",)}
 
 
+def cut_record(runs: dict, key: str, retries=()) -> tuple[str, dict | None]:
+    """(key, record) that the sweep's tables and :func:`measured_cuts` take for ``key``: the run itself (None if not
+    recorded), or where it failed, its first retry ``key + suffix`` (``retries``: the suffixes, in order) recorded
+    'ok', else the failed run."""
+    r = runs.get(key)
+    if r is None or r.get("status") == "ok":
+        return key, r
+    return next(((key + t, runs[key + t]) for t in retries if runs.get(key + t, {}).get("status") == "ok"), (key, r))
+
+
 def measured_cuts(axes, runs: dict, series=CUT_SERIES, retries: dict | None = None) -> dict:
     """The 18 measured cuts of Rodriguez Prieto, Larsson & Afrasiabi (2023) against refsph and the paper, case by case,
     on three Axes: the rake-face temperature, the free chip surface temperature and the force ratio Fp/Fc. The
@@ -163,12 +173,8 @@ def measured_cuts(axes, runs: dict, series=CUT_SERIES, retries: dict | None = No
     drawn = {label: [] for label, *_ in series}
     retries = CUT_RETRIES if retries is None else retries
 
-    def record(m: int, suffix: str):                     # as the sweep's tables: a retry only of a failed run
-        key = f"case {m}{suffix}"
-        if key not in runs or runs[key].get("status") == "ok":
-            return runs.get(key)
-        return next((runs[k] for k in (key + t for t in retries.get(suffix, ()))
-                     if runs.get(k, {}).get("status") == "ok"), runs[key])
+    def record(m: int, suffix: str):
+        return cut_record(runs, f"case {m}{suffix}", retries.get(suffix, ()))[1]
     for k, (ax, (q, key, ylabel)) in enumerate(zip(axes, quantities)):
         def value(c, src):
             return c[f"Fp_{src}_N"] / c[f"Fc_{src}_N"] if q == "ratio" else c[f"{q}_{src}_K"]

@@ -667,3 +667,27 @@ def test_dof_changes_counts_the_moves_between_resolutions():
     fine = dict(base, TRF_pfem=12.5, ratio_sph=4.0, TFCS_sph=float("nan"))
     rows = [dict(base, dx="t_u/5", material="AISI1045"), dict(fine, dx="t_u/10", material="AISI1045")]
     assert mod.dof_changes(rows) == dict(n=5, fall=1, rise=1, lo="-6.0", hi="+2.5")
+
+
+def test_thermal_cutting_scatter_and_mass_scale_at_the_refined_update():
+    """Case 10's scatter at REF_UPDATE: the 'refined' run's options with the seeds of SCATTER_TI10's jitter, and the
+    same three at half the mass scale, all at REFINED_NUMERICS; each group compared with the group at the scene's
+    update or at s (COMPARED), the t_u/15 check and the heat split read against it (SINGLES)."""
+    mod = _script("thermal_cutting")
+    todo, refined = mod.jobs(studies=("scatter", "scaling")), mod.jobs(studies=("refined",))
+    base_options, base_numerics = refined[f"case 10{mod.REFINED}"]
+    sweep_jitter = mod.jobs(studies=("scatter",))
+    for key, key_s2 in zip(mod.SCATTER_TI10_REF, mod.SCATTER_TI10_REF_S2):
+        options, numerics = refined[key] if key in refined else todo[key]
+        options_s2, numerics_s2 = todo[key_s2]
+        assert numerics == numerics_s2 == base_numerics
+        assert {k: v for k, v in options.items() if k not in ("jitter", "seed")} == base_options
+        assert options_s2 == dict(options, mass_scale=base_options.get("mass_scale", mod._s(10)) / 2)
+        if key != f"case 10{mod.REFINED}":
+            old = sweep_jitter[key.replace(mod.REFINED, "")][0]
+            assert (options["jitter"], options["seed"]) == (old["jitter"], old["seed"])
+    assert mod.COMPARED[mod.SCATTER_TI10_REF] == mod.SCATTER_TI10
+    assert mod.COMPARED[mod.SCATTER_TI10_REF_S2] == mod.SCATTER_TI10_REF
+    assert f"case 10 n_tu 15{mod.REFINED}" in mod.SINGLES[mod.SCATTER_TI10_REF]
+    tables = [k for _, k, _ in mod.STUDIES]
+    assert mod.SCATTER_TI10_REF in tables and mod.SCATTER_TI10_REF_S2 in tables

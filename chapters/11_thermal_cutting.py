@@ -24,15 +24,16 @@
 # This chapter derives the three new pieces — conduction, friction with its heat, and finding the free surface —
 # checks each against plain code, runs one cut, and compares the 18 cases with the measurements.
 #
-# Which formulation? Friction needs a contact law: TLSPH's pinball (chapter 5) has one; ESPH's tool is a set of
-# SPH neighbours with no friction law. The scene `thermal_cutting` therefore runs TLSPH only.
+# Which formulation? Both take the penalty contact of chapter 5 (continued) and its friction law, but ESPH
+# computes no heat of its artificial viscosity, so the tool's work would not all end up as heat (section 4). The
+# scene `thermal_cutting` therefore runs TLSPH only, as the paper's cuts are run.
 
 # %%
 import json
 import matplotlib.pyplot as plt
 import numpy as np
 from refsph.teaching.notebook import chapter, repository_root
-from refsph.teaching.plots import measured_cuts, particle_field
+from refsph.teaching.plots import CUT_RETRIES, cut_record, measured_cuts, particle_field
 ch = chapter("11_thermal_cutting")
 
 # %% [markdown]
@@ -109,11 +110,14 @@ for name, rows in conv.items():
 # ## 2. Friction whose coefficient falls with temperature
 #
 # Coulomb friction $f_t \le \mu(T) f_n$ with (their Eqs. (10)–(11))
-# $\mu(T) = \mu_0\,(1 - T^{*q})$, $T^* = (T - T_r)/(T_m - T_r)$, acts in each pinball contact pair against the
-# sliding velocity; it can stop the sliding within a step but never reverse it (the cap $m_{ij}|v_t|/\Delta t$).
-# The work friction does, $\eta\,|f_t|\,|v_t|$ with $\eta = 1$ (their Eq. (7)), becomes heat: refsph puts half of
-# it into the chip particle of the pair and half into the tool particle (the paper does not say; conduction across
-# the interface then redistributes it).
+# $\mu(T) = \mu_0\,(1 - T^{*q})$, $T^* = (T - T_r)/(T_m - T_r)$, acts on each workpiece particle that the tool's
+# outline pushes (the penalty contact, section 4), as a return map: a particle sticks while its tangential force
+# stays below $\mu(T) f_n$ and slides at that bound otherwise. (With the first paper's pinball it acts in each
+# contact pair, capped at $m_{ij}|v_t|/\Delta t$ so that it stops the sliding within a step but never reverses
+# it.) The work friction does, $\eta\,|f_t|\,|v_t|$ with $\eta = 1$ (their Eq. (7)), becomes heat: refsph puts
+# half of it into the chip particle and half into the nearest tool particle (the paper does not say; conduction
+# across the interface then redistributes it; `--option chip_fraction=1` puts it all in the chip, as the paper's
+# SPH code does).
 
 # %%
 from refsph.contact import CoulombFriction
@@ -343,8 +347,8 @@ display(Markdown(split_page.split("\n\n", 1)[1]))             # the page without
 #   against three; measured 668), Ti6Al4V at $t_u/10$ 835 → 959 K (measured 701). Steel at 0.05 stays within the
 #   scatter of the three runs at 0.1 but for $T_{RF}$ (−2 %); Ti6Al4V's chip surface cools 8 % more.
 #   But 3 of 12 runs at 0.2 and below failed. At half the step both $t_u/5$ failures ran to the end; keeping the
-#   chip's paired particles apart (`self_contact`) did not make the runs safer (chapter 10, section 6). The
-#   default stays at 0.5 until the 18 cuts are run again at the smaller step.
+#   chip's paired particles apart (`self_contact`) did not make the runs safer (chapter 10, section 6). The 18
+#   cuts ran at 0.1 since (below); the default stays 0.5, as the sweep's keys record only the numerics they set.
 #
 # %% [markdown]
 # * **Mass scaling** changes inertia by the factor $s$, and with it the artificial viscosity's stress ($\propto
@@ -383,7 +387,7 @@ display(Markdown(split_page.split("\n\n", 1)[1]))             # the page without
 # * **Two steps that follow it.** $C_{crit}$ times the largest gain stays at 0.72–1.06, so the gain tracks the
 #   stable step, and at 0.3 the gain step keeps a margin of 2.6 or more. `--set frequency_step=0.5` holds the
 #   step under half of each reference configuration's $2/\omega_{max}$ instead: the six $t_u/5$ runs that broke
-#   down at 0.3 ran to the end in 0.54–1.25 (mean 0.70) of the steps of half the step, 0.66 of its CPU, and 0.75
+#   down at 0.3 ran to the end in 0.53–1.25 (mean 0.70) of the steps of half the step, 0.66 of its CPU, and 0.75
 #   of the gain step's steps. At $t_u/10$ case 10 ran too, but in 1.10 of the steps of half the step: by its step
 #   count $C_{crit}$ averaged about 0.27 there, so half the step was already about half the critical one. Case 1
 #   at reference update 0.1 took 0.59 of the steps of the sweep's case 1 (the page's gain table; one run each).
@@ -469,8 +473,8 @@ MEASURED = {"force_ratio": "force_ratio", "rake_face_temperature_K": "T_RF_K",
             "free_chip_surface_temperature_K": "T_FCS_K"}
 err = {}
 for n in range(1, 19):
-    r = records.get(f"case {n} n_tu 5", {})                 # the sweep at t_u/5: the cases recorded so far
-    if r.get("status") == "ok":
+    _, r = cut_record(records, f"case {n}", CUT_RETRIES[""])   # the t_u/10 table's run (case 9: its retry)
+    if r is not None and r.get("status") == "ok":
         m = r["metrics"]
         err[n] = m[QUANTITY] / m["measured"][MEASURED[QUANTITY]] - 1
 print(f"{QUANTITY}, refsph / measured - 1: " + ", ".join(f"case {n} {100 * e:+.0f} %" for n, e in err.items()))
@@ -478,11 +482,12 @@ print(f"{QUANTITY}, refsph / measured - 1: " + ", ".join(f"case {n} {100 * e:+.0
 # %% [markdown]
 # <details><summary>What you should see</summary>
 #
-# The same sign in every steel case, for all three quantities: the force ratio 35–60 % too low, the free chip
-# surface 7–15 % too cold, the rake face too cold by an error that grows with the cutting speed (0 % at 60 m/min
-# and the thinnest chip, over 30 % at 180 m/min). A systematic error points at the model (friction, the edge and
-# flank forces, heat that the measurement sees and the model does not make), not at noise; the titanium cases
-# are wrong the other way, far too hot.
+# The same sign in every steel case, for all three quantities: the force ratio 39–51 % too low, the free chip
+# surface 15–24 % too cold, the rake face 7–26 % too cold, more at the higher cutting speeds (7–18 % at 60 m/min,
+# 22–26 % at 180 m/min). A systematic error points at the model (friction, the edge and flank forces, heat that
+# the measurement sees and the model does not make) or at the numerics, not at noise; the titanium rake faces are
+# wrong the other way, 19–38 % too hot. The numerics can flip a sign: at the converged reference update 0.1
+# (section 7's 'refined' runs) the steel rake faces are 0–27 % too *hot*, while the force ratio stays too low.
 # </details>
 
 # %% [markdown]

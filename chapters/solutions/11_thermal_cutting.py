@@ -86,29 +86,37 @@ assert round(dt_wave * 1e6, 3) == 0.063 and round(np.sqrt(info["mass_scale"])) =
 # %% [markdown]
 # ### Solution 3 — Systematic or random?
 #
-# Systematic: in all nine steel cases at $t_u/5$ refsph is below the measurement on all three quantities. The force
-# ratio is 37–58 % low, the free chip surface 7–15 % cold; the rake face is 0.3 % cold in case 1 (60 m/min, the
-# thinnest chip) and 31 % in case 9 (180 m/min, the thickest), because the measured rake-face temperature rises
-# with the speed far faster than refsph's. Nine cases with one sign are not noise (the run-to-run scatter of
-# section 6 is a few per cent): the model lacks something, such as thrust from the edge and the flank, friction
-# above the law's $\mu$ (Merchant, "Where it fails") or heat at the rake face. The titanium case is the other way:
-# 48 % too hot at the rake face, 20 % at the free surface.
+# Systematic: in all nine steel cases of the $t_u/10$ table refsph is below the measurement on all three
+# quantities. The force ratio is 39–51 % low, the free chip surface 15–24 % cold, the rake face 7–26 % cold (14 %
+# in case 1), colder at 120 and 180 m/min than at 60, because the measured rake-face temperature rises with the
+# speed faster than refsph's. Nine cases with one sign are not noise (the run-to-run scatter of section 6 is a few
+# per cent): the model lacks something, such as thrust from the edge and the flank, friction above the law's
+# $\mu$ (Merchant, "Where it fails") or heat at the rake face. The titanium case is the other way: 19 % too hot at
+# the rake face, 12 % at the free surface. The rake face's sign is the numerics' as much as the model's: at the
+# converged reference update 0.1 every steel rake face is 0–27 % too hot, while the force ratio stays 46–57 % low.
 
 # %%
 err_all = {}
 for q, mq in MEASURED.items():
-    err_all[q] = {n: records[f"case {n} n_tu 5"]["metrics"][q] / records[f"case {n} n_tu 5"]["metrics"]["measured"][mq]
-                  - 1 for n in range(1, 10)}
+    err_all[q] = {}
+    for n in range(1, 10):
+        m = cut_record(records, f"case {n}", CUT_RETRIES[""])[1]["metrics"]
+        err_all[q][n] = m[q] / m["measured"][mq] - 1
     e = np.array(list(err_all[q].values()))
     print(f"{q:33s} steel: {100 * e.min():+.1f} % to {100 * e.max():+.1f} %")
 assert all(e < 0 for q in err_all for e in err_all[q].values())
 ratio, rake, free = (np.array(list(err_all[q].values())) for q in MEASURED)
-assert (round(-100 * ratio.max()), round(-100 * ratio.min())) == (37, 58)
-assert (round(-100 * free.max()), round(-100 * free.min())) == (7, 15)
-assert round(100 * err_all["rake_face_temperature_K"][1], 1) == -0.3 and round(100 * rake.min()) == -31
-ti = records["case 10 n_tu 5"]["metrics"]
-assert round(100 * (ti["rake_face_temperature_K"] / ti["measured"]["T_RF_K"] - 1)) == 48
-assert round(100 * (ti["free_chip_surface_temperature_K"] / ti["measured"]["T_FCS_K"] - 1)) == 20
+assert (round(-100 * ratio.max()), round(-100 * ratio.min())) == (39, 51)
+assert (round(-100 * free.max()), round(-100 * free.min())) == (15, 24)
+assert (round(-100 * rake.max()), round(-100 * rake.min())) == (7, 26)
+assert round(100 * err_all["rake_face_temperature_K"][1]) == -14
+ti = records["case 10"]["metrics"]
+assert round(100 * (ti["rake_face_temperature_K"] / ti["measured"]["T_RF_K"] - 1)) == 19
+assert round(100 * (ti["free_chip_surface_temperature_K"] / ti["measured"]["T_FCS_K"] - 1)) == 12
+refined = [records[f"case {n} ref update 0.1 frequency step 0.5"]["metrics"] for n in range(1, 10)]
+hot = np.array([m["rake_face_temperature_K"] / m["measured"]["T_RF_K"] - 1 for m in refined])
+low = np.array([m["force_ratio"] / m["measured"]["force_ratio"] - 1 for m in refined])
+assert (round(100 * hot.min()), round(100 * hot.max())) == (0, 27) and (round(-100 * low.max()), round(-100 * low.min())) == (46, 57)
 
 # %% [markdown]
 # ### Solution 4 — Write the heat flow between two materials yourself

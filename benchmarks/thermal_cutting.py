@@ -996,8 +996,9 @@ REFINED_RUNS = tuple(f"case {n}{REFINED}" for n in range(1, 19))
 REFINED_SERIES = (("refsph SPH, t_u/10,\nref update 0.5,\ncourant 0.15", "", "D", "C1"),   # the figure's series
                   (f"refsph SPH, t_u/10,\nref update {REF_UPDATE:g},\nfrequency step", REFINED, "o", "C3"))
 # the resolution check at REF_UPDATE: each case at t_u/5 (the 'refupdate' study's run, courant 0.3), t_u/10 and t_u/15
-REFINED_RESOLUTION = tuple(k for n in (1, 10) for k in (f"case {n}{COARSE}{REF_KEY}{REF_UPDATE:g}",
-                                                          f"case {n}{REFINED}", f"case {n} n_tu 15{REFINED}"))
+REFINED_RESOLUTION_KEYS = {n: (f"case {n}{COARSE}{REF_KEY}{REF_UPDATE:g}", f"case {n}{REFINED}",
+                               f"case {n} n_tu 15{REFINED}") for n in (1, 10)}
+REFINED_RESOLUTION = tuple(k for keys in REFINED_RESOLUTION_KEYS.values() for k in keys)
 # the 'gain' study's table: each run with the step over the gradient's gain beside the same run at the scene's step
 # (courant 0.3) and at half of it
 GAIN_T5 = (*(f"case {n}{COARSE}{REF_KEY}{r:g}" for n, r in REF_FAILED), f"case 10{COARSE}{SELF_KEY}",
@@ -1026,6 +1027,9 @@ RESOLUTION_RUNS = tuple(k for keys in RESOLUTION_KEYS.values() for k in keys)   
 RESOLUTION_NOISE = {1: (SCATTER_T5, SCATTER_KEYS),
                     10: (("case 10 n_tu 5", "case 10 n_tu 5 jitter 1", "case 10 n_tu 5 jitter 2",
                           "case 10 n_tu 5 jitter 3"), SCATTER_TI10)}
+# ... and at REF_UPDATE (the 'refined' resolution check): measured there where it has been, case 1's at t_u/5
+# (REF_SCATTER) and case 10's at t_u/10 (SCATTER_TI10_REF); the other two taken from the scene's 0.5
+REFINED_NOISE = {1: (REF_SCATTER, SCATTER_KEYS), 10: (RESOLUTION_NOISE[10][0], SCATTER_TI10_REF)}
 STUDIES = (
     ("Mass scaling: s halved (the rule's factor 0.01 A in s rho vc^2 = 0.01 A halved to 0.005 A)",
      ("case 1", "case 1 s/2", "case 10", "case 10 s/2", "case 1 n_tu 5", "case 1 n_tu 5 s/2", "case 10 n_tu 5",
@@ -1197,6 +1201,8 @@ def _study_lines(res: dict) -> list[str]:
             lines += [_single_run_line(res, k, keys) for k in SINGLES.get(keys, ())]
         if keys == RESOLUTION_RUNS:
             lines += _resolution_lines(res)
+        if keys == REFINED_RESOLUTION:
+            lines += _resolution_lines(res, REFINED_RESOLUTION_KEYS, REFINED_NOISE, "refined_orders")
         if keys == REF_RUNS:
             lines += [_single_run_line(res, k, group) for group, singles in REF_SINGLES for k in singles]
         if keys == HALF_STEP_RUNS:
@@ -1251,18 +1257,21 @@ def _group_errors(res: dict, suffix: str = COARSE + HALF_STEP, base: str = COARS
             "same cases ('before'): " + ("; ".join(parts) if parts else "none recorded yet") + ".")
 
 
-def resolution_convergence(res: dict) -> list[dict]:
-    """Per case of the resolution study and basic quantity: its values f at 5, 10 and 15 particles across t_u, the
+def resolution_convergence(res: dict, resolution_keys=None, noise=None) -> list[dict]:
+    """Per case of a resolution study (``resolution_keys``: case -> its keys at t_u/5, /10, /15, default
+    RESOLUTION_KEYS; ``noise``: case -> its scatter groups at t_u/5 and t_u/10, default RESOLUTION_NOISE) and basic
+    quantity: its values f at 5, 10 and 15 particles across t_u, the
     changes between successive resolutions with their z (the change over its standard deviation from the scatter
     groups: sqrt(s5^2 + s10^2) for t_u/5 -> t_u/10, sqrt(2) s10 for t_u/10 -> t_u/15, t_u/15's spread taken as
     t_u/10's), the verdict (``_verdict``), and where both changes exceed twice their standard deviation with the
     same sign, the observed order p of f = f0 + C dx^p with its range (``_order_range``) and the extrapolated f0
     (``study.observed_order``, ``study.richardson``)."""
     h, out = [1.0 / n for n in RESOLUTION_N], []
-    for case, keys in RESOLUTION_KEYS.items():
+    resolution_keys, noise = resolution_keys or RESOLUTION_KEYS, noise or RESOLUTION_NOISE
+    for case, keys in resolution_keys.items():
         runs = [res["runs"].get(k) for k in keys]
         vals = [_values(r) if r is not None and r.get("status") == "ok" else {} for r in runs]
-        g5, g10 = (_groups(res, grp) for grp in RESOLUTION_NOISE[case])
+        g5, g10 = (_groups(res, grp) for grp in noise[case])
         for name, q, spec in BASIC:
             f = [float(v.get(q, math.nan)) for v in vals]
             sd5, sd10 = (float(g[q].std(ddof=1)) if len(g[q]) >= 2 else math.nan for g in (g5, g10))
@@ -1330,12 +1339,13 @@ def _order_cell(r: dict) -> str:
     return f"{fmt(r['p'])} ({fmt(r['p_range'][0])}-{fmt(r['p_range'][1])})"
 
 
-def _resolution_lines(res: dict) -> list[str]:
-    """The resolution study's convergence table (``resolution_convergence``) with its prose."""
-    lines = ["", study.Page("thermal_cutting_report")("resolution_orders"), "",
+def _resolution_lines(res: dict, resolution_keys=None, noise=None, section="resolution_orders") -> list[str]:
+    """A resolution study's convergence table (``resolution_convergence``) with its prose (the page's
+    ``section``)."""
+    lines = ["", study.Page("thermal_cutting_report")(section), "",
              "| case | quantity | t_u/5 | t_u/10 | t_u/15 | t_u/5 -> 10 (z) | t_u/10 -> 15 (z) | observed order "
              "| extrapolated | t_u/10 from it |", "|---" * 10 + "|"]
-    for r in resolution_convergence(res):
+    for r in resolution_convergence(res, resolution_keys, noise):
         f, spec = r["f"], r["spec"]
         off = _rel(f[1], r["f0"]) if r["f0"] is not None else math.nan
         cells = [r["case"], r["name"]] + [_f(x, spec) for x in f] + [_change_cell(r["d1"], r["z1"]),

@@ -243,11 +243,11 @@ def more_jobs() -> list[tuple[str, str, dict, dict]]:
             for n in (10, 1)]
     out += [("refined", f"case {n} n_tu 15{REFINED}", converged(n, n_tu=15.0), dict(REFINED_NUMERICS))
             for n in (1, 10)]
-    # the scatter and the mass scale at REF_UPDATE (SCATTER_TI10 and SCATTER_TI10_S2 are at the scene's 0.5): case 10
-    # with the seeds of SCATTER_TI10, then at s/2 with the same seeds, so that the t_u/15 check, the heat split and
-    # halving s at the converged update are read against a scatter measured there
-    out += [("scatter", f"case 10{REFINED} jitter {seed}", converged(10, jitter=0.01, seed=seed),
-             dict(REFINED_NUMERICS)) for seed in (1, 2)]
+    # the scatter and the mass scale at REF_UPDATE (SCATTER_TI10, SCATTER_KEYS and SCATTER_TI10_S2 are at the scene's
+    # 0.5): cases 10 and 1 with the seeds of their scatter at 0.5, then case 10 at s/2 with the same seeds, so that
+    # the t_u/15 checks, the heat split and halving s at the converged update are read against a scatter measured there
+    out += [("scatter", f"case {n}{REFINED} jitter {seed}", converged(n, jitter=0.01, seed=seed),
+             dict(REFINED_NUMERICS)) for n in (10, 1) for seed in (1, 2)]
     out += [("scaling", f"case 10 s/2{REFINED}" + (f" jitter {seed}" if seed else ""),
              converged(10, mass_scale=_s(10) / 2, **(dict(jitter=0.01, seed=seed) if seed else {})),
              dict(REFINED_NUMERICS)) for seed in (0, 1, 2)]
@@ -983,6 +983,7 @@ SCATTER_TI10 = ("case 10", "case 10 jitter 1", "case 10 jitter 2")              
 SCATTER_TI10_S2 = tuple(k.replace("case 10", "case 10 s/2") for k in SCATTER_TI10)        # ... and at s/2
 SCATTER_TI10_REF = tuple(f"case 10{REFINED}" + k[len("case 10"):] for k in SCATTER_TI10)  # ... at REF_UPDATE
 SCATTER_TI10_REF_S2 = tuple(k.replace("case 10", "case 10 s/2", 1) for k in SCATTER_TI10_REF)   # ... and at s/2
+SCATTER_REF = tuple(f"case 1{REFINED}" + k[len("case 1"):] for k in SCATTER_KEYS[:3])   # case 1's at REF_UPDATE
 # the 'refupdate' study: case 1's scatter at REF_UPDATE (t_u/5, the seeds of SCATTER_T5) and the study's table (each
 # case at t_u/5 from the loosest threshold to the tightest, the scene's among them, then t_u/10)
 REF_SCATTER = tuple(f"case 1{COARSE}{REF_KEY}{REF_UPDATE:g}" + k[len("case 1 n_tu 5"):] for k in SCATTER_T5[:3])
@@ -1027,9 +1028,9 @@ RESOLUTION_RUNS = tuple(k for keys in RESOLUTION_KEYS.values() for k in keys)   
 RESOLUTION_NOISE = {1: (SCATTER_T5, SCATTER_KEYS),
                     10: (("case 10 n_tu 5", "case 10 n_tu 5 jitter 1", "case 10 n_tu 5 jitter 2",
                           "case 10 n_tu 5 jitter 3"), SCATTER_TI10)}
-# ... and at REF_UPDATE (the 'refined' resolution check): measured there where it has been, case 1's at t_u/5
-# (REF_SCATTER) and case 10's at t_u/10 (SCATTER_TI10_REF); the other two taken from the scene's 0.5
-REFINED_NOISE = {1: (REF_SCATTER, SCATTER_KEYS), 10: (RESOLUTION_NOISE[10][0], SCATTER_TI10_REF)}
+# ... and at REF_UPDATE (the 'refined' resolution check): measured there, but for case 10's at t_u/5, taken from the
+# scene's 0.5
+REFINED_NOISE = {1: (REF_SCATTER, SCATTER_REF), 10: (RESOLUTION_NOISE[10][0], SCATTER_TI10_REF)}
 STUDIES = (
     ("Mass scaling: s halved (the rule's factor 0.01 A in s rho vc^2 = 0.01 A halved to 0.005 A)",
      ("case 1", "case 1 s/2", "case 10", "case 10 s/2", "case 1 n_tu 5", "case 1 n_tu 5 s/2", "case 10 n_tu 5",
@@ -1061,6 +1062,9 @@ STUDIES = (
     ("Run-to-run scatter of Ti6Al4V at t_u/10, reference update 0.1 and s/2 (the same three runs at s/2): whether "
      "halving s moves case 10 by more than the scatter at the converged update, two groups of three runs",
      SCATTER_TI10_REF_S2, BASIC),
+    ("Run-to-run scatter of AISI 1045 at t_u/10 at reference update 0.1 (the 'refined' study's case 1 and two runs "
+     "with the perturbations of case 1's scatter at 0.5): whether the converged update, t_u/15 and the heat split "
+     "move case 1 by more than the scatter measured at that update", SCATTER_REF, BASIC),
     ("Run-to-run scatter of Ti6Al4V at t_u/5 (case 10, the same perturbation)",
      ("case 10 n_tu 5", "case 10 n_tu 5 jitter 1", "case 10 n_tu 5 jitter 2", "case 10 n_tu 5 jitter 3"), BASIC),
     ("Resolution (particles across t_u; at courant 0.15)", RESOLUTION_RUNS,
@@ -1364,9 +1368,10 @@ def _change_cell(d: float, z: float = math.nan) -> str:
 
 # a scatter group -> the group it is compared with (_difference_line)
 COMPARED = {SCATTER_S2: SCATTER_T5, REF_SCATTER: SCATTER_T5, SELF_SCATTER: SCATTER_T5, SCATTER_TI10_S2: SCATTER_TI10,
-            SCATTER_TI10_REF: SCATTER_TI10, SCATTER_TI10_REF_S2: SCATTER_TI10_REF}
+            SCATTER_TI10_REF: SCATTER_TI10, SCATTER_TI10_REF_S2: SCATTER_TI10_REF, SCATTER_REF: SCATTER_KEYS}
 SINGLES = {SCATTER_KEYS: ("case 1 s/2", "case 1 heat every 8"), SCATTER_TI10: ("case 10 s/2",),   # one run each
-           SCATTER_TI10_REF: (f"case 10 n_tu 15{REFINED}", f"case 10{REFINED}{TO_CHIP}")}
+           SCATTER_TI10_REF: (f"case 10 n_tu 15{REFINED}", f"case 10{REFINED}{TO_CHIP}"),
+           SCATTER_REF: (f"case 1 n_tu 15{REFINED}", f"case 1{REFINED}{TO_CHIP}")}
 # the 'refupdate' study's single runs, each against the scatter group of its resolution and material (at the
 # scene's reference update, or at REF_UPDATE for case 1 at t_u/5): which changes the scatter does not explain
 REF_SINGLES = ((SCATTER_T5, tuple(f"case 1{COARSE}{REF_KEY}{r:g}" for r in REF_UPDATES if r > SCENE_REF_UPDATE)

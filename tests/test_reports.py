@@ -698,7 +698,8 @@ def test_thermal_cutting_refined_resolution_reads_the_scatter_at_its_update():
     group the one measured at REF_UPDATE, not SCATTER_TI10): Fc = 300 + C dx^2 with a scatter of 1 N/mm there gives
     the order 2 even where the groups at the scene's 0.5 spread by 100; the page's table has the section's prose."""
     mod = _script("thermal_cutting")
-    assert mod.REFINED_NOISE[10][1] == mod.SCATTER_TI10_REF and mod.REFINED_NOISE[1][0] == mod.REF_SCATTER
+    assert mod.REFINED_NOISE[10][1] == mod.SCATTER_TI10_REF and mod.REFINED_NOISE[1] == (mod.REF_SCATTER,
+                                                                                     mod.SCATTER_REF)
 
     def rec(fc, n):
         return dict(status="ok", dp=1e-4 / n, scene_info=dict(tu_m=1e-4),
@@ -710,18 +711,18 @@ def test_thermal_cutting_refined_resolution_reads_the_scatter_at_its_update():
     for group in (mod.SCATTER_TI10, mod.SCATTER_KEYS):           # the scene's 0.5: a large spread
         for k, sign in zip(group, (1, -1, 1, -1)):
             runs[k] = rec(300.0 + 1e4 / 100 + sign * 100.0, 10.0)
+    runs[mod.SCATTER_REF[2]] = rec(300.0 + 1e4 / 100 + 100.0, 10.0)   # case 1 at 0.1: one jittered run far off
     for case, keys in mod.REFINED_RESOLUTION_KEYS.items():
         for key, n in zip(keys, mod.RESOLUTION_N):
             runs[key] = rec(300.0 + 1e4 * (1 / n) ** 2, n)
         for group, n in zip(mod.REFINED_NOISE[case], (5.0, 10.0)):
             for k, sign in zip(group, (1, -1, 1, -1)):
-                runs.setdefault(k, rec(300.0 + 1e4 * (1 / n) ** 2 + sign * (100.0 if group == mod.SCATTER_KEYS
-                                                                            else 1.0), n))
+                runs.setdefault(k, rec(300.0 + 1e4 * (1 / n) ** 2 + sign * 1.0, n))
     res = dict(runs=runs)
     rows = {(r["case"], r["name"]): r for r in mod.resolution_convergence(res, mod.REFINED_RESOLUTION_KEYS,
                                                                           mod.REFINED_NOISE)}
     assert rows[(10, "Fc [N/mm]")]["verdict"] == "order" and abs(rows[(10, "Fc [N/mm]")]["p"] - 2.0) < 1e-6
-    assert rows[(1, "Fc [N/mm]")]["verdict"] != "order"          # case 1's t_u/10 scatter is the scene's (100)
+    assert rows[(1, "Fc [N/mm]")]["verdict"] != "order"          # case 1's t_u/10 scatter at 0.1 is wide
     assert rows[(10, "Fc [N/mm]")]["f"] == [700.0, 400.0, 300.0 + 1e4 / 225]
     text = "\n".join(mod._resolution_lines(res, mod.REFINED_RESOLUTION_KEYS, mod.REFINED_NOISE, "refined_orders"))
     assert "The same reading at ref update 0.1" in text and "| 10 | Fc [N/mm] | 700.0 | 400.0 | 344.4 |" in text

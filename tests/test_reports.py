@@ -400,6 +400,14 @@ def test_thermal_cutting_means_at_the_paper_length_of_cut():
     assert row["2mm"]["TRF"][0] == pytest.approx(mod.window_means(done, 1.0, *mod.PAPER_CUT)["TRF"])
 
 
+def _resolution_record(fc, n):
+    """A made-up 'ok' record of a cut at n particles across t_u with Fc = ``fc`` N/mm (the other quantities fixed)."""
+    return dict(status="ok", dp=1e-4 / n, scene_info=dict(tu_m=1e-4),
+                metrics=dict(cutting_force_N_per_m=1e3 * fc, passive_force_N_per_m=5e4, force_ratio=50 / fc,
+                             rake_face_temperature_K=600.0, rake_face_temperature_max_K=650.0,
+                             free_chip_surface_temperature_K=500.0, chip_thickness_mm=0.3, contact_length_mm=0.3))
+
+
 def test_thermal_cutting_resolution_order_is_read_only_where_the_changes_beat_the_scatter():
     """resolution_convergence: Fc = 300 + C dx^2 through t_u/5, /10, /15 with a scatter of 1 N/mm gives the order 2
     and the limit 300; the same runs with a scatter of 100 N/mm give no order (both changes inside the scatter), and
@@ -413,12 +421,7 @@ def test_thermal_cutting_resolution_order_is_read_only_where_the_changes_beat_th
     assert abs(st.richardson(h, [1 + 2 * x**1.5 for x in h], 1.5) - 1.0) < 1e-12
     assert st.observed_order(h, [1.0, 2.0, 1.5]) is None
 
-    def rec(fc, n):
-        return dict(status="ok", dp=1e-4 / n, scene_info=dict(tu_m=1e-4),
-                    metrics=dict(cutting_force_N_per_m=1e3 * fc, passive_force_N_per_m=5e4, force_ratio=50 / fc,
-                                 rake_face_temperature_K=600.0, rake_face_temperature_max_K=650.0,
-                                 free_chip_surface_temperature_K=500.0, chip_thickness_mm=0.3,
-                                 contact_length_mm=0.3))
+    rec = _resolution_record
 
     def records(spread, with_fine=True):
         runs = {}
@@ -701,12 +704,7 @@ def test_thermal_cutting_refined_resolution_reads_the_scatter_at_its_update():
     assert mod.REFINED_NOISE[10][1] == mod.SCATTER_TI10_REF and mod.REFINED_NOISE[1] == (mod.REF_SCATTER,
                                                                                      mod.SCATTER_REF)
 
-    def rec(fc, n):
-        return dict(status="ok", dp=1e-4 / n, scene_info=dict(tu_m=1e-4),
-                    metrics=dict(cutting_force_N_per_m=1e3 * fc, passive_force_N_per_m=5e4, force_ratio=50 / fc,
-                                 rake_face_temperature_K=600.0, rake_face_temperature_max_K=650.0,
-                                 free_chip_surface_temperature_K=500.0, chip_thickness_mm=0.3,
-                                 contact_length_mm=0.3))
+    rec = _resolution_record
     runs = {}
     for group in (mod.SCATTER_TI10, mod.SCATTER_KEYS):           # the scene's 0.5: a large spread
         for k, sign in zip(group, (1, -1, 1, -1)):

@@ -651,6 +651,35 @@ def _own_ceiling_lines(rows: list, pfem10: list) -> list[str]:
                                        for k in sets) + " |" for mat in ("AISI1045", "Ti6Al4V")]
 
 
+def rake_gaps(rows: list, groups: dict) -> list[dict]:
+    """Per case, how much hotter the rake face is than the free chip surface, T_RF - T_FCS [K]: measured, the
+    paper's SPH and PFEM (``rows``: :func:`comparison`'s) and refsph's ``groups`` ({label: comparison rows}; None
+    where a case is not recorded ok)."""
+    out = []
+    for i, r in enumerate(rows):
+        gap = {"measured": r["TRF_exp"] - r["TFCS_exp"], "paper SPH": r["TRF_sph"] - r["TFCS_sph"],
+               "paper PFEM": r["TRF_pfem"] - r["TFCS_pfem"]}
+        for label, sel in groups.items():
+            g = sel[i]
+            gap[label] = g["TRF"] - g["TFCS"] if g["TRF"] is not None and g["TFCS"] is not None else None
+        out.append(dict(case=r["case"], material=r["material"], gap=gap))
+    return out
+
+
+def _rake_gap_lines(gaps: list) -> list[str]:
+    """The table of :func:`rake_gaps`, then each material's mean over the cases with every column recorded."""
+    labels = list(gaps[0]["gap"])
+    lines = ["| case | material | " + " | ".join(labels) + " |", "|---" * (len(labels) + 2) + "|"]
+    lines += [f"| {g['case']} | {g['material']} | " + " | ".join(_f(g["gap"][k], ".0f") for k in labels) + " |"
+              for g in gaps]
+    for mat in ("AISI1045", "Ti6Al4V"):
+        full = [g for g in gaps if g["material"] == mat and all(v is not None for v in g["gap"].values())]
+        if full:
+            lines.append(f"| mean ({len(full)} cases) | {mat} | "
+                         + " | ".join(f"{np.mean([g['gap'][k] for g in full]):.0f}" for k in labels) + " |")
+    return lines
+
+
 def _ceiling_lines(rows: list) -> list[str]:
     return [f"| {c['material']} | {c['mu0']:.2f} | {c['measured'][0]:.2f}-{c['measured'][1]:.2f} | "
             f"{c['ceiling_mu0']:.3f} | {c['error_mu0']:.1f} | {c['ceiling_T'][0]:.3f}-{c['ceiling_T'][1]:.3f} | "
@@ -707,6 +736,9 @@ def report(res: dict, before: dict | None = None) -> str:
             lines.append(f"| {mat} | {label} | " + " | ".join(_trend_cell(t, n) for n in TREND_NAMES) + " |")
     lines += ["", P("rake_ceiling")] + _ceiling_lines(rows)
     lines += ["", P("own_ceiling")] + _own_ceiling_lines(rows, pfem10)
+    gaps = rake_gaps(rows, {"refsph SPH": rows, f"refsph SPH, ref update {REF_UPDATE:g}": comparison(res, REFINED),
+                            "refsph PFEM": pfem10})
+    lines += ["", P("rake_gap"), ""] + _rake_gap_lines(gaps)
     lines += _study_lines(res)
     todo = [k for k in dict(jobs(), **retry_jobs(res["runs"])) if k not in res["runs"]]
     recorded = [r for r in res["runs"].values() if r.get("wall_time_s")]

@@ -724,3 +724,21 @@ def test_thermal_cutting_refined_resolution_reads_the_scatter_at_its_update():
     assert rows[(10, "Fc [N/mm]")]["f"] == [700.0, 400.0, 300.0 + 1e4 / 225]
     text = "\n".join(mod._resolution_lines(res, mod.REFINED_RESOLUTION_KEYS, mod.REFINED_NOISE, "refined_orders"))
     assert "The same reading at ref update 0.1" in text and "| 10 | Fc [N/mm] | 700.0 | 400.0 | 344.4 |" in text
+
+
+def test_thermal_cutting_rake_gap_is_the_rake_face_less_the_free_surface():
+    """rake_gaps: T_RF - T_FCS per case for the measurement, the paper's two methods and each of refsph's groups
+    (None where a case is not recorded); the table's mean per material is over the cases every column has."""
+    mod = _script("thermal_cutting")
+    rows = [dict(case=n, material="AISI1045" if n < 10 else "Ti6Al4V", TRF_exp=700.0 + n, TFCS_exp=600.0,
+                 TRF_sph=800.0, TFCS_sph=650.0, TRF_pfem=900.0, TFCS_pfem=640.0, TRF=750.0 + 10 * n, TFCS=600.0)
+            for n in range(1, 19)]
+    other = [dict(r, TRF=None) if r["case"] == 2 else dict(r, TRF=1000.0) for r in rows]
+    gaps = mod.rake_gaps(rows, {"a": rows, "b": other})
+    assert gaps[0]["gap"] == {"measured": 101.0, "paper SPH": 150.0, "paper PFEM": 260.0, "a": 160.0, "b": 400.0}
+    assert gaps[1]["gap"]["b"] is None and gaps[1]["gap"]["a"] == 170.0
+    lines = mod._rake_gap_lines(gaps)
+    steel = next(x for x in lines if x.startswith("| mean") and "AISI1045" in x)
+    # cases 1 and 3-9 (case 2 lacks 'b'): mean n = 5.375, so measured 105.4, 'a' 150 + 10 mean n = 203.75
+    assert steel == "| mean (8 cases) | AISI1045 | 105 | 150 | 260 | 204 | 400 |"
+    assert "| 2 | AISI1045 | 102 | 150 | 260 | 170 | - |" in lines

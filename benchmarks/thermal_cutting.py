@@ -91,7 +91,7 @@ def _s(case: int) -> float:
 
 
 STUDY_NAMES = ("cases", "coarse", "pfem", "detector", "scaling", "scatter", "resolution", "timestep", "tool",
-               "contact", "refupdate", "selfcontact", "gain", "frequency", "refined")
+               "contact", "refupdate", "selfcontact", "gain", "frequency", "refined", "gap")
 COURANT = 0.15                             # every run at dx <= t_u / 10: half the scene's step (module text)
 COARSE = " n_tu 5"                         # the key suffix of the 'coarse' study: all 18 cases at dx = t_u / 5
 PFEM = " pfem n_tu 5"                      # the key suffix of the 'pfem' study: the 18 cases with the PFEM at t_u / 5
@@ -122,6 +122,8 @@ BOSSAK = f" bossak {BOSSAK_ALPHA:g}"         # its key suffix (gamma 0.6 too, be
 # the tables that take such a run for a failed case's row, the first recorded 'ok' of each tuple: for the PFEM the
 # Bossak-Newmark run before the damped one, for its order (second; on the whole cuts of cases 1 and 8 at t_u/5 the
 # two damped rules move Fp by 5-30 % from the trapezoidal rule's, each the more on one case: the time-rule table)
+GAP_CHANGES = ((" frictionless", dict(friction=False)),           # the 'gap' study: key suffix, scene option
+               (" no dissipation heat", dict(dissipation_heat=False)))
 REFINED_NUMERICS = dict(ref_update_strain=REF_UPDATE, frequency_step=FREQUENCY_STEP)   # what 'refined' sets
 REFINED_RETRY = f" courant {COURANT:g}"      # a 'refined' case that failed: again at half the CFL part of its step
 RETRIES = {"": (RETRY,), PFEM10: (f" n_tu 10{BOSSAK}", DAMPED), REFINED: (REFINED_RETRY,)}
@@ -255,6 +257,11 @@ def more_jobs() -> list[tuple[str, str, dict, dict]]:
     # too (the same two seeds), so that the forces' dependence on s is read between two groups of three
     out += [("scaling", f"case 10 s/2 jitter {seed}", converged(10, mass_scale=_s(10) / 2, jitter=0.01, seed=seed),
              sweep_numerics()) for seed in (1, 2)]
+    # what makes the rake face stand far above the free chip surface at REF_UPDATE (T_RF - T_FCS twice the measured
+    # for steel, three times for Ti6Al4V; already at t_u/5, where a run costs 3-6 min): cases 10 and 1 at t_u/5 as
+    # the 'refupdate' study's runs, with friction off and with the numerical dissipation's heat left out
+    out += [("gap", f"case {n}{COARSE}{REF_KEY}{REF_UPDATE:g}{sfx}", converged(n, n_tu=5.0, **change),
+             dict(ref_update_strain=REF_UPDATE)) for n in (10, 1) for sfx, change in GAP_CHANGES]
     out += [("pfem", key, options, pfem) for key, options in time_rule_jobs() + remesh_jobs() + pfem_resolution_jobs()]
     out += [("pfem", f"case {n}{PFEM10}{TO_2MM}", to_2mm(n, n_tu=10.0), pfem) for n in TU_01]
     return out + [("cases", f"case {n}{TO_2MM}", to_2mm(n), sweep_numerics()) for n in TU_01]
@@ -992,6 +999,7 @@ def _values(r: dict) -> dict:
     for key in ("plastic_J", "friction_J", "dissipation_J", "removed_J", "lost_J"):
         out[f"{key[:-2]}_of_work"] = 100.0 * hb.get(key, math.nan) / work
     out["made_of_work"] = 100.0 * out["made"] / work
+    out["gap"] = m.get("rake_face_temperature_K", math.nan) - m.get("free_chip_surface_temperature_K", math.nan)
     damping = (r.get("heat_dissipation") or {}).get("contact_damping_J")
     out["damping_of_work"] = math.nan if damping is None else 100.0 * damping / work
     return out
@@ -1026,6 +1034,8 @@ REF_RUNS = tuple(f"case {n}{COARSE}{REF_KEY}{r:g}" if r != SCENE_REF_UPDATE else
     f"case {n}{COARSE}{REF_KEY}{r:g} courant {COURANT:g}" for n, r in REF_FAILED)
 HALF_STEP_RUNS = tuple(f"case {n}{COARSE}{HALF_STEP}" for n in range(1, 19))
 REFINED_RUNS = tuple(f"case {n}{REFINED}" for n in range(1, 19))
+GAP_RUNS = tuple(f"case {n}{COARSE}{REF_KEY}{REF_UPDATE:g}{sfx}" for n in (10, 1) for sfx in ("",) + tuple(
+    x for x, _ in GAP_CHANGES))
 REFINED_SERIES = (("refsph SPH, t_u/10,\nref update 0.5,\ncourant 0.15", "", "D", "C1"),   # the figure's series
                   (f"refsph SPH, t_u/10,\nref update {REF_UPDATE:g},\nfrequency step", REFINED, "o", "C3"))
 # the resolution check at REF_UPDATE: each case at t_u/5 (the 'refupdate' study's run, courant 0.3), t_u/10 and t_u/15
@@ -1094,6 +1104,12 @@ STUDIES = (
     ("Run-to-run scatter of Ti6Al4V at t_u/10, reference update 0.1 and s/2 (the same three runs at s/2): whether "
      "halving s moves case 10 by more than the scatter at the converged update, two groups of three runs",
      SCATTER_TI10_REF_S2, BASIC),
+    ("What makes the rake face hotter than the free chip surface (T_RF - T_FCS; t_u/5 at ref update 0.1, courant "
+     "0.3): cases 10 and 1 as the 'refupdate' study's runs, with friction off (no frictional heat, and a chip that "
+     "slides freely) and with the artificial viscosity's and contact damping's work left out of the heat; read "
+     "with the scatter at ref update 0.1 (case 1, t_u/5) below", GAP_RUNS,
+     BASIC + (("T_RF - T_FCS [K]", "gap", ".0f"), ("friction heat [% of work]", "friction_of_work", ".1f"),
+              ("viscosity + damping heat [% of work]", "dissipation_of_work", ".1f"), ("CPU [min]", "cpu_min", ".1f"))),
     ("Run-to-run scatter of AISI 1045 at t_u/10 at reference update 0.1 (the 'refined' study's case 1 and two runs "
      "with the perturbations of case 1's scatter at 0.5): whether the converged update, t_u/15 and the heat split "
      "move case 1 by more than the scatter measured at that update", SCATTER_REF, BASIC),
@@ -1241,6 +1257,8 @@ def _study_lines(res: dict) -> list[str]:
             lines += _resolution_lines(res, REFINED_RESOLUTION_KEYS, REFINED_NOISE, "refined_orders")
         if keys == REF_RUNS:
             lines += [_single_run_line(res, k, group) for group, singles in REF_SINGLES for k in singles]
+        if keys == GAP_RUNS:                                   # case 1's against its scatter at REF_UPDATE, t_u/5
+            lines += [_single_run_line(res, k, REF_SCATTER) for k in keys if k.startswith("case 1 ")]
         if keys == HALF_STEP_RUNS:
             lines += ["", _group_errors(res)]
         if keys == REFINED_RUNS:

@@ -742,3 +742,21 @@ def test_thermal_cutting_rake_gap_is_the_rake_face_less_the_free_surface():
     # cases 1 and 3-9 (case 2 lacks 'b'): mean n = 5.375, so measured 105.4, 'a' 150 + 10 mean n = 203.75
     assert steel == "| mean (8 cases) | AISI1045 | 105 | 150 | 260 | 204 | 400 |"
     assert "| 2 | AISI1045 | 102 | 150 | 260 | 170 | - |" in lines
+
+
+def test_thermal_cutting_gap_study_changes_one_option_of_the_refupdate_runs():
+    """The 'gap' study: cases 10 and 1 at t_u/5 and REF_UPDATE as the 'refupdate' study's runs, each with one scene
+    option changed (friction off; the numerical dissipation's heat left out), in its table beside them; _values'
+    gap is T_RF - T_FCS."""
+    mod = _script("thermal_cutting")
+    gap, base = mod.jobs(studies=("gap",)), mod.jobs(studies=("refupdate",))
+    assert len(gap) == 2 * len(mod.GAP_CHANGES)
+    for n in (10, 1):
+        b_opts, b_num = base[f"case {n} n_tu 5{mod.REF_KEY}0.1"]
+        for sfx, change in mod.GAP_CHANGES:
+            opts, num = gap[f"case {n} n_tu 5{mod.REF_KEY}0.1{sfx}"]
+            assert opts == dict(b_opts, **change) and num == b_num and len(change) == 1
+    assert set(gap) | {f"case {n} n_tu 5{mod.REF_KEY}0.1" for n in (10, 1)} == set(mod.GAP_RUNS)
+    assert mod.GAP_RUNS in [k for _, k, _ in mod.STUDIES]
+    rec = _resolution_record(300.0, 5.0)
+    assert mod._values(rec)["gap"] == 100.0

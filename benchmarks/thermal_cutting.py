@@ -123,7 +123,8 @@ BOSSAK = f" bossak {BOSSAK_ALPHA:g}"         # its key suffix (gamma 0.6 too, be
 # Bossak-Newmark run before the damped one, for its order (second; on the whole cuts of cases 1 and 8 at t_u/5 the
 # two damped rules move Fp by 5-30 % from the trapezoidal rule's, each the more on one case: the time-rule table)
 GAP_CHANGES = ((" frictionless", dict(friction=False)),           # the 'gap' study: key suffix, scene option
-               (" no dissipation heat", dict(dissipation_heat=False)))
+               (" no dissipation heat", dict(dissipation_heat=False)),
+               (" friction without heat", dict(eta=0.0)))        # friction's mechanics without its heat
 REFINED_NUMERICS = dict(ref_update_strain=REF_UPDATE, frequency_step=FREQUENCY_STEP)   # what 'refined' sets
 REFINED_RETRY = f" courant {COURANT:g}"      # a 'refined' case that failed: again at half the CFL part of its step
 RETRIES = {"": (RETRY,), PFEM10: (f" n_tu 10{BOSSAK}", DAMPED), REFINED: (REFINED_RETRY,)}
@@ -262,6 +263,10 @@ def more_jobs() -> list[tuple[str, str, dict, dict]]:
     # the 'refupdate' study's runs, with friction off and with the numerical dissipation's heat left out
     out += [("gap", f"case {n}{COARSE}{REF_KEY}{REF_UPDATE:g}{sfx}", converged(n, n_tu=5.0, **change),
              dict(ref_update_strain=REF_UPDATE)) for n in (10, 1) for sfx, change in GAP_CHANGES]
+    # case 10's scatter at t_u/5 and REF_UPDATE (the seeds of case 1's, REF_SCATTER), for the gap study's case 10
+    # and the resolution check at REF_UPDATE (REFINED_NOISE), which took it from the scene's 0.5 before
+    out += [("gap", f"case 10{COARSE}{REF_KEY}{REF_UPDATE:g} jitter {seed}",
+             converged(10, n_tu=5.0, jitter=0.01, seed=seed), dict(ref_update_strain=REF_UPDATE)) for seed in (1, 2)]
     out += [("pfem", key, options, pfem) for key, options in time_rule_jobs() + remesh_jobs() + pfem_resolution_jobs()]
     out += [("pfem", f"case {n}{PFEM10}{TO_2MM}", to_2mm(n, n_tu=10.0), pfem) for n in TU_01]
     return out + [("cases", f"case {n}{TO_2MM}", to_2mm(n), sweep_numerics()) for n in TU_01]
@@ -1027,6 +1032,7 @@ SCATTER_REF = tuple(f"case 1{REFINED}" + k[len("case 1"):] for k in SCATTER_KEYS
 # the 'refupdate' study: case 1's scatter at REF_UPDATE (t_u/5, the seeds of SCATTER_T5) and the study's table (each
 # case at t_u/5 from the loosest threshold to the tightest, the scene's among them, then t_u/10)
 REF_SCATTER = tuple(f"case 1{COARSE}{REF_KEY}{REF_UPDATE:g}" + k[len("case 1 n_tu 5"):] for k in SCATTER_T5[:3])
+REF_SCATTER_TI = tuple(k.replace("case 1 ", "case 10 ", 1) for k in REF_SCATTER)            # case 10's, the same seeds
 REF_RUNS = tuple(f"case {n}{COARSE}{REF_KEY}{r:g}" if r != SCENE_REF_UPDATE else f"case {n}{COARSE}"
                  for n in (1, 10) for r in sorted(REF_UPDATES + (SCENE_REF_UPDATE,), reverse=True)) + tuple(
     k for n in (1, 10) for k in (f"case {n}", f"case {n}{REF_KEY}{REF_UPDATE:g}")) + (
@@ -1072,7 +1078,7 @@ RESOLUTION_NOISE = {1: (SCATTER_T5, SCATTER_KEYS),
                           "case 10 n_tu 5 jitter 3"), SCATTER_TI10)}
 # ... and at REF_UPDATE (the 'refined' resolution check): measured there, but for case 10's at t_u/5, taken from the
 # scene's 0.5
-REFINED_NOISE = {1: (REF_SCATTER, SCATTER_REF), 10: (RESOLUTION_NOISE[10][0], SCATTER_TI10_REF)}
+REFINED_NOISE = {1: (REF_SCATTER, SCATTER_REF), 10: (REF_SCATTER_TI, SCATTER_TI10_REF)}
 STUDIES = (
     ("Mass scaling: s halved (the rule's factor 0.01 A in s rho vc^2 = 0.01 A halved to 0.005 A)",
      ("case 1", "case 1 s/2", "case 10", "case 10 s/2", "case 1 n_tu 5", "case 1 n_tu 5 s/2", "case 10 n_tu 5",
@@ -1107,9 +1113,11 @@ STUDIES = (
     ("What makes the rake face hotter than the free chip surface (T_RF - T_FCS; t_u/5 at ref update 0.1, courant "
      "0.3): cases 10 and 1 as the 'refupdate' study's runs, with friction off (no frictional heat, and a chip that "
      "slides freely) and with the artificial viscosity's and contact damping's work left out of the heat; read "
-     "with the scatter at ref update 0.1 (case 1, t_u/5) below", GAP_RUNS,
+     "with each case's scatter at ref update 0.1 and t_u/5 (case 10's below, case 1's further down)", GAP_RUNS,
      BASIC + (("T_RF - T_FCS [K]", "gap", ".0f"), ("friction heat [% of work]", "friction_of_work", ".1f"),
               ("viscosity + damping heat [% of work]", "dissipation_of_work", ".1f"), ("CPU [min]", "cpu_min", ".1f"))),
+    ("Run-to-run scatter of Ti6Al4V at t_u/5 at reference update 0.1 (case 10 and two runs with the perturbations "
+     "of case 1's scatter there)", REF_SCATTER_TI, BASIC + (("T_RF - T_FCS [K]", "gap", ".0f"),)),
     ("Run-to-run scatter of AISI 1045 at t_u/10 at reference update 0.1 (the 'refined' study's case 1 and two runs "
      "with the perturbations of case 1's scatter at 0.5): whether the converged update, t_u/15 and the heat split "
      "move case 1 by more than the scatter measured at that update", SCATTER_REF, BASIC),
@@ -1257,8 +1265,9 @@ def _study_lines(res: dict) -> list[str]:
             lines += _resolution_lines(res, REFINED_RESOLUTION_KEYS, REFINED_NOISE, "refined_orders")
         if keys == REF_RUNS:
             lines += [_single_run_line(res, k, group) for group, singles in REF_SINGLES for k in singles]
-        if keys == GAP_RUNS:                                   # case 1's against its scatter at REF_UPDATE, t_u/5
-            lines += [_single_run_line(res, k, REF_SCATTER) for k in keys if k.startswith("case 1 ")]
+        if keys == GAP_RUNS:                                   # each changed run against its case's scatter there
+            lines += [_single_run_line(res, k, group) for group in (REF_SCATTER_TI, REF_SCATTER) for k in keys
+                      if k.split(" n_tu")[0] == group[0].split(" n_tu")[0] and k not in group]
         if keys == HALF_STEP_RUNS:
             lines += ["", _group_errors(res)]
         if keys == REFINED_RUNS:

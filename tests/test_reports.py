@@ -701,8 +701,7 @@ def test_thermal_cutting_refined_resolution_reads_the_scatter_at_its_update():
     group the one measured at REF_UPDATE, not SCATTER_TI10): Fc = 300 + C dx^2 with a scatter of 1 N/mm there gives
     the order 2 even where the groups at the scene's 0.5 spread by 100; the page's table has the section's prose."""
     mod = _script("thermal_cutting")
-    assert mod.REFINED_NOISE[10][1] == mod.SCATTER_TI10_REF and mod.REFINED_NOISE[1] == (mod.REF_SCATTER,
-                                                                                     mod.SCATTER_REF)
+    assert mod.REFINED_NOISE == {1: (mod.REF_SCATTER, mod.SCATTER_REF), 10: (mod.REF_SCATTER_TI, mod.SCATTER_TI10_REF)}
 
     rec = _resolution_record
     runs = {}
@@ -750,6 +749,11 @@ def test_thermal_cutting_gap_study_changes_one_option_of_the_refupdate_runs():
     gap is T_RF - T_FCS."""
     mod = _script("thermal_cutting")
     gap, base = mod.jobs(studies=("gap",)), mod.jobs(studies=("refupdate",))
+    jitter = {k: gap.pop(k) for k in mod.REF_SCATTER_TI[1:]}           # case 10's scatter at t_u/5 and REF_UPDATE
+    for key, seed in zip(mod.REF_SCATTER_TI[1:], (1, 2)):
+        case1 = base[key.replace("case 10 ", "case 1 ", 1)]
+        assert jitter[key] == (dict(base[mod.REF_SCATTER_TI[0]][0], jitter=0.01, seed=seed), case1[1])
+        assert case1[0]["seed"] == seed
     assert len(gap) == 2 * len(mod.GAP_CHANGES)
     for n in (10, 1):
         b_opts, b_num = base[f"case {n} n_tu 5{mod.REF_KEY}0.1"]

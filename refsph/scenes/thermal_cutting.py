@@ -100,6 +100,8 @@ OPTIONS = {
     "detector": ("sph", "free-surface detector of the heat losses: sph or alpha"),
     "chip_fraction": (0.5, "share of the frictional heat that goes into the chip (the rest into the tool; the "
                            "paper's SPH code: 1)"),
+    "eta": (CONTACT_RLA["friction_work_to_heat"], "fraction of the frictional work that becomes heat (their Eq. (7), "
+                                                  "Table A3: 1; 0: friction acts and makes no heat)"),
     "dissipation_heat": (True, "artificial viscosity and contact damping become heat (false: their work is lost)"),
     "tool_length": (5.0, "the tool's rake face, in units of tu"),
     "tool_depth": (3.0, "the tool's depth behind the rake face, in units of tu"),
@@ -186,7 +188,7 @@ def _default_dp(dim, quick):
 
 
 def _build(dim, dp, quick, *, case, material, vc, tu, n_tu, travel, length, mass_scale, inertia_ratio, detector,
-           chip_fraction, friction, conduction, dissipation_heat, tool_length, tool_depth, jitter, seed):
+           chip_fraction, eta, friction, conduction, dissipation_heat, tool_length, tool_depth, jitter, seed):
     if dim != 2:
         raise ValueError("the thermal cutting scene is 2D plane strain")
     row, material, vc, tu = _case_values(case, material, vc, tu)
@@ -223,14 +225,14 @@ def _build(dim, dp, quick, *, case, material, vc, tu, n_tu, travel, length, mass
                              tools={TOOL_BODY: (tool_mat["k_W_mK"], tool_mat["cp_J_kgK"])},
                              fixed=tuple(int(k) for k in np.concatenate([held, work.n + np.flatnonzero(tool_held)])),
                              T_fixed=T0, loss=loss)
-        friction_heat = FrictionHeat(eta=CONTACT_RLA["friction_work_to_heat"], chip_fraction=float(chip_fraction))
+        friction_heat = FrictionHeat(eta=float(eta), chip_fraction=float(chip_fraction))
         heat_of_dissipation = parse_bool(dissipation_heat, "option dissipation_heat")
     mu = CoulombFriction(mu0=mat["mu0"], q=mat["q_friction"], T_room=T0, T_melt=mat["T_melt_K"])
     info = dict(case=int(case), material=material, vc_m_s=vc, tu_m=tu, dx=dx, length_m=nx * dx, height_m=ny * dx,
                 y0=y0, n_work=work.n, n_tool=tool.n, travel_m=travel * tu, mass_scale=s,
                 inertia_ratio=s * mat["rho"] * vc * vc / mat["A_Pa"], rake_deg=RAKE_DEG, clearance_deg=CLEARANCE_DEG,
                 edge_radius_m=EDGE_RADIUS, apex0=[nx * dx, y0], detector=detector, chip_fraction=float(chip_fraction),
-                A_Pa=mat["A_Pa"], tool_length_m=tool_length * tu, tool_depth_m=tool_depth * tu,
+                eta=float(eta), A_Pa=mat["A_Pa"], tool_length_m=tool_length * tu, tool_depth_m=tool_depth * tu,
                 jitter=float(jitter), seed=int(seed), measured=row)
     body = RigidBody("tool", TOOL_BODY, (-vc, 0.0),
                      shape=tool_shape(tu, (nx * dx, y0), xt.mean(axis=0), tool_length, tool_depth))

@@ -673,7 +673,8 @@ def rake_gaps(rows: list, groups: dict) -> list[dict]:
                "paper PFEM": r["TRF_pfem"] - r["TFCS_pfem"]}
         for label, sel in groups.items():
             g = sel[i]
-            gap[label] = g["TRF"] - g["TFCS"] if g["TRF"] is not None and g["TFCS"] is not None else None
+            ok = all(g[q] is not None and math.isfinite(g[q]) for q in ("TRF", "TFCS"))
+            gap[label] = g["TRF"] - g["TFCS"] if ok else None
         out.append(dict(case=r["case"], material=r["material"], gap=gap))
     return out
 
@@ -1004,7 +1005,7 @@ def _values(r: dict) -> dict:
     for key in ("plastic_J", "friction_J", "dissipation_J", "removed_J", "lost_J"):
         out[f"{key[:-2]}_of_work"] = 100.0 * hb.get(key, math.nan) / work
     out["made_of_work"] = 100.0 * out["made"] / work
-    out["gap"] = m.get("rake_face_temperature_K", math.nan) - m.get("free_chip_surface_temperature_K", math.nan)
+    out["gap"] = (m.get("rake_face_temperature_K") or math.nan) - (m.get("free_chip_surface_temperature_K") or math.nan)
     damping = (r.get("heat_dissipation") or {}).get("contact_damping_J")
     out["damping_of_work"] = math.nan if damping is None else 100.0 * damping / work
     return out

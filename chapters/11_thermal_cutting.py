@@ -499,11 +499,12 @@ print(f"{QUANTITY}, refsph / measured - 1: " + ", ".join(f"case {n} {100 * e:+.0
 # <details><summary>What you should see</summary>
 #
 # The same sign in every steel case, for all three quantities: the force ratio 39–51 % too low, the free chip
-# surface 15–24 % too cold, the rake face 7–26 % too cold, more at the higher cutting speeds (7–18 % at 60 m/min,
-# 22–26 % at 180 m/min). A systematic error points at the model (friction, the edge and flank forces, heat that
+# surface 15–24 % too cold, the rake face 7–26 % too cold, on average more at the higher cutting speeds (13, 21
+# and 24 % at 60, 120 and 180 m/min). A systematic error points at the model (friction, the edge and flank forces, heat that
 # the measurement sees and the model does not make) or at the numerics, not at noise; the titanium rake faces are
 # wrong the other way, 19–38 % too hot. The numerics can flip a sign: at the converged reference update 0.1
-# (section 7's 'refined' runs) the steel rake faces are 0–27 % too *hot*, while the force ratio stays too low.
+# ("Where it fails") seven of the nine steel rake faces are 6–27 % too *hot* and cases 8 and 9 at the
+# measurement, while the force ratio stays too low.
 # </details>
 
 # %% [markdown]

@@ -736,6 +736,7 @@ def test_thermal_cutting_rake_gap_is_the_rake_face_less_the_free_surface():
     gaps = mod.rake_gaps(rows, {"a": rows, "b": other})
     assert gaps[0]["gap"] == {"measured": 101.0, "paper SPH": 150.0, "paper PFEM": 260.0, "a": 160.0, "b": 400.0}
     assert gaps[1]["gap"]["b"] is None and gaps[1]["gap"]["a"] == 170.0
+    assert mod.rake_gaps(rows[:1], {"c": [dict(rows[0], TFCS=float("nan"))]})[0]["gap"]["c"] is None
     lines = mod._rake_gap_lines(gaps)
     steel = next(x for x in lines if x.startswith("| mean") and "AISI1045" in x)
     # cases 1 and 3-9 (case 2 lacks 'b'): mean n = 5.375, so measured 105.4, 'a' 150 + 10 mean n = 203.75

@@ -765,3 +765,22 @@ def test_thermal_cutting_gap_study_changes_one_option_of_the_refupdate_runs():
     assert mod.GAP_RUNS in [k for _, k, _ in mod.STUDIES]
     rec = _resolution_record(300.0, 5.0)
     assert mod._values(rec)["gap"] == 100.0
+
+
+def test_thermal_cutting_every_key_the_page_reads_is_a_run_the_sweep_makes():
+    """Every key of the page's study tables, its group comparisons (COMPARED, SINGLES, REF_SINGLES) and the
+    resolution checks' scatter groups is a run that jobs() makes, or the retry of one (retry_jobs, asked as if every
+    run had failed): a misspelt key would show 'to run' forever."""
+    mod = _script("thermal_cutting")
+    made = set(mod.jobs())
+    failed = {k: dict(status="blow-up") for k in made}
+    made |= set(mod.retry_jobs(failed))
+    read = {k for _, keys, _ in mod.STUDIES for k in keys}
+    for group, other in mod.COMPARED.items():
+        read |= set(group) | set(other)
+    read |= {k for group, singles in mod.SINGLES.items() for k in (*group, *singles)}
+    read |= {k for group, singles in mod.REF_SINGLES for k in (*group, *singles)}
+    for noise in (mod.RESOLUTION_NOISE, mod.REFINED_NOISE):
+        read |= {k for groups in noise.values() for g in groups for k in g}
+    read |= {k for keys in mod.REFINED_RESOLUTION_KEYS.values() for k in keys}
+    assert not sorted(read - made)

@@ -1113,7 +1113,8 @@ STUDIES = (
      SCATTER_TI10_REF_S2, BASIC),
     ("What makes the rake face hotter than the free chip surface (T_RF - T_FCS; t_u/5 at ref update 0.1, courant "
      "0.3): cases 10 and 1 as the 'refupdate' study's runs, with friction off (no frictional heat, and a chip that "
-     "slides freely) and with the artificial viscosity's and contact damping's work left out of the heat; read "
+     "slides freely), with the artificial viscosity's and contact damping's work left out of the heat, and with "
+     "friction acting but making no heat (eta = 0: its mechanics without its heat); read "
      "with each case's scatter at ref update 0.1 and t_u/5 (case 10's below, case 1's further down)", GAP_RUNS,
      BASIC + (("T_RF - T_FCS [K]", "gap", ".0f"), ("friction heat [% of work]", "friction_of_work", ".1f"),
               ("viscosity + damping heat [% of work]", "dissipation_of_work", ".1f"), ("CPU [min]", "cpu_min", ".1f"))),

@@ -416,7 +416,9 @@ display(Markdown(split_page.split("\n\n", 1)[1]))             # the page without
 #   (gap 236 ± 4 K, measured 21 K) friction acting without making heat ($\eta = 0$) leaves 93 K and a rake face of
 #   648 K (measured 668 K), the forces moving little; frictionless, 7 K, and $F_p/F_c$ falls to about
 #   $\tan(-10°)$ plus the edge's thrust. So about 140 K is the frictional heat's, the rest the shearing friction
-#   causes under the rake face. Leaving the artificial viscosity's heat out moves the gap by less than 10 K.
+#   causes under the rake face. In case 10 at $t_u/10$ (gap 199 ± 11 K, measured −10 K) $\eta = 0$ leaves 7 K
+#   and a rake face of 768 K (measured 701 K) at the same forces: there the frictional heat makes the whole gap.
+#   Leaving the artificial viscosity's heat out moves the gap by less than 10 K.
 #   $\eta = 0$ is a diagnostic, not a model; it says that the measured low-speed cuts leave little room for heat
 #   made at the interface, where Coulomb friction at $\mu(T)$ makes 11–15 % of the tool's work.
 #

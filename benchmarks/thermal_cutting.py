@@ -125,6 +125,7 @@ BOSSAK = f" bossak {BOSSAK_ALPHA:g}"         # its key suffix (gamma 0.6 too, be
 GAP_CHANGES = ((" frictionless", dict(friction=False)),           # the 'gap' study: key suffix, scene option
                (" no dissipation heat", dict(dissipation_heat=False)),
                (" friction without heat", dict(eta=0.0)))        # friction's mechanics without its heat
+WITHOUT_HEAT = GAP_CHANGES[2][0]                               # ... its key suffix, also run at t_u/10
 REFINED_NUMERICS = dict(ref_update_strain=REF_UPDATE, frequency_step=FREQUENCY_STEP)   # what 'refined' sets
 REFINED_RETRY = f" courant {COURANT:g}"      # a 'refined' case that failed: again at half the CFL part of its step
 RETRIES = {"": (RETRY,), PFEM10: (f" n_tu 10{BOSSAK}", DAMPED), REFINED: (REFINED_RETRY,)}
@@ -265,7 +266,8 @@ def more_jobs() -> list[tuple[str, str, dict, dict]]:
              dict(ref_update_strain=REF_UPDATE)) for n in (10, 1) for sfx, change in GAP_CHANGES]
     # at t_u/5 case 10's gap scatters by +-92 K, at t_u/10 by +-11 K: friction without its heat there too, read against
     # SCATTER_TI10_REF (SINGLES)
-    out += [("gap", f"case 10{REFINED}{GAP_CHANGES[2][0]}", converged(10, **GAP_CHANGES[2][1]), dict(REFINED_NUMERICS))]
+    out += [("gap", f"case 10{REFINED}{WITHOUT_HEAT}", converged(10, **dict(GAP_CHANGES)[WITHOUT_HEAT]),
+             dict(REFINED_NUMERICS))]
     # case 10's scatter at t_u/5 and REF_UPDATE (the seeds of case 1's, REF_SCATTER), for the gap study's case 10
     # and the resolution check at REF_UPDATE (REFINED_NOISE), which took it from the scene's 0.5 before
     out += [("gap", f"case 10{COARSE}{REF_KEY}{REF_UPDATE:g} jitter {seed}",
@@ -1044,8 +1046,11 @@ REF_RUNS = tuple(f"case {n}{COARSE}{REF_KEY}{r:g}" if r != SCENE_REF_UPDATE else
     f"case {n}{COARSE}{REF_KEY}{r:g} courant {COURANT:g}" for n, r in REF_FAILED)
 HALF_STEP_RUNS = tuple(f"case {n}{COARSE}{HALF_STEP}" for n in range(1, 19))
 REFINED_RUNS = tuple(f"case {n}{REFINED}" for n in range(1, 19))
-GAP_RUNS = tuple(f"case {n}{COARSE}{REF_KEY}{REF_UPDATE:g}{sfx}" for n in (10, 1) for sfx in ("",) + tuple(
-    x for x, _ in GAP_CHANGES))
+# the 'gap' study: each case's changed runs against its scatter at t_u/5 and REF_UPDATE, whose first run is the
+# unchanged one; the study's table, each case's unchanged run before its changed ones
+GAP_SINGLES = tuple((group, tuple(group[0] + sfx for sfx, _ in GAP_CHANGES))
+                    for group in (REF_SCATTER_TI, REF_SCATTER))
+GAP_RUNS = tuple(k for group, singles in GAP_SINGLES for k in (group[0], *singles))
 REFINED_SERIES = (("refsph SPH, t_u/10,\nref update 0.5,\ncourant 0.15", "", "D", "C1"),   # the figure's series
                   (f"refsph SPH, t_u/10,\nref update {REF_UPDATE:g},\nfrequency step", REFINED, "o", "C3"))
 # the resolution check at REF_UPDATE: each case at t_u/5 (the 'refupdate' study's run, courant 0.3), t_u/10 and t_u/15
@@ -1268,11 +1273,7 @@ def _study_lines(res: dict) -> list[str]:
             lines += _resolution_lines(res)
         if keys == REFINED_RESOLUTION:
             lines += _resolution_lines(res, REFINED_RESOLUTION_KEYS, REFINED_NOISE, "refined_orders")
-        if keys == REF_RUNS:
-            lines += [_single_run_line(res, k, group) for group, singles in REF_SINGLES for k in singles]
-        if keys == GAP_RUNS:                                   # each changed run against its case's scatter there
-            lines += [_single_run_line(res, k, group) for group in (REF_SCATTER_TI, REF_SCATTER) for k in keys
-                      if k.split(" n_tu")[0] == group[0].split(" n_tu")[0] and k not in group]
+        lines += [_single_run_line(res, k, group) for group, singles in TABLE_SINGLES.get(keys, ()) for k in singles]
         if keys == HALF_STEP_RUNS:
             lines += ["", _group_errors(res)]
         if keys == REFINED_RUNS:
@@ -1435,7 +1436,7 @@ COMPARED = {SCATTER_S2: SCATTER_T5, REF_SCATTER: SCATTER_T5, SELF_SCATTER: SCATT
             SCATTER_TI10_REF: SCATTER_TI10, SCATTER_TI10_REF_S2: SCATTER_TI10_REF, SCATTER_REF: SCATTER_KEYS}
 SINGLES = {SCATTER_KEYS: ("case 1 s/2", "case 1 heat every 8"), SCATTER_TI10: ("case 10 s/2",),   # one run each
            SCATTER_TI10_REF: (f"case 10 n_tu 15{REFINED}", f"case 10{REFINED}{TO_CHIP}",
-                              f"case 10{REFINED}{GAP_CHANGES[2][0]}"),
+                              f"case 10{REFINED}{WITHOUT_HEAT}"),
            SCATTER_REF: (f"case 1 n_tu 15{REFINED}", f"case 1{REFINED}{TO_CHIP}")}
 # the 'refupdate' study's single runs, each against the scatter group of its resolution and material (at the
 # scene's reference update, or at REF_UPDATE for case 1 at t_u/5): which changes the scatter does not explain
@@ -1446,6 +1447,7 @@ REF_SINGLES = ((SCATTER_T5, tuple(f"case 1{COARSE}{REF_KEY}{r:g}" for r in REF_U
                (RESOLUTION_NOISE[10][0], tuple(f"case 10{COARSE}{REF_KEY}{r:g}" for r in REF_UPDATES)),
                (SCATTER_KEYS, (f"case 1{REF_KEY}{REF_UPDATE:g}",)),
                (SCATTER_TI10, (f"case 10{REF_KEY}{REF_UPDATE:g}",)))
+TABLE_SINGLES = {REF_RUNS: REF_SINGLES, GAP_RUNS: GAP_SINGLES}   # a table -> (group, its single runs) read under it
 
 
 def _single_run_line(res: dict, key: str, group) -> str:

@@ -770,7 +770,7 @@ def test_thermal_cutting_gap_study_changes_one_option_of_the_refupdate_runs():
 
 
 def test_thermal_cutting_every_key_the_page_reads_is_a_run_the_sweep_makes():
-    """Every key of the page's study tables, its group comparisons (COMPARED, SINGLES, REF_SINGLES) and the
+    """Every key of the page's study tables, its group comparisons (COMPARED, SINGLES, TABLE_SINGLES) and the
     resolution checks' scatter groups is a run that jobs() makes, or the retry of one (retry_jobs, asked as if every
     run had failed): a misspelt key would show 'to run' forever."""
     mod = _script("thermal_cutting")
@@ -781,7 +781,7 @@ def test_thermal_cutting_every_key_the_page_reads_is_a_run_the_sweep_makes():
     for group, other in mod.COMPARED.items():
         read |= set(group) | set(other)
     read |= {k for group, singles in mod.SINGLES.items() for k in (*group, *singles)}
-    read |= {k for group, singles in mod.REF_SINGLES for k in (*group, *singles)}
+    read |= {k for pairs in mod.TABLE_SINGLES.values() for group, singles in pairs for k in (*group, *singles)}
     for noise in (mod.RESOLUTION_NOISE, mod.REFINED_NOISE):
         read |= {k for groups in noise.values() for g in groups for k in g}
     read |= {k for keys in mod.REFINED_RESOLUTION_KEYS.values() for k in keys}

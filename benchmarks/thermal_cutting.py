@@ -265,9 +265,9 @@ def more_jobs() -> list[tuple[str, str, dict, dict]]:
     out += [("gap", f"case {n}{COARSE}{REF_KEY}{REF_UPDATE:g}{sfx}", converged(n, n_tu=5.0, **change),
              dict(ref_update_strain=REF_UPDATE)) for n in (10, 1) for sfx, change in GAP_CHANGES]
     # at t_u/5 case 10's gap scatters by +-92 K, at t_u/10 by +-11 K: friction without its heat there too, read against
-    # SCATTER_TI10_REF (SINGLES)
-    out += [("gap", f"case 10{REFINED}{WITHOUT_HEAT}", converged(10, **dict(GAP_CHANGES)[WITHOUT_HEAT]),
-             dict(REFINED_NUMERICS))]
+    # SCATTER_TI10_REF (SINGLES); then case 1's, read against SCATTER_REF
+    out += [("gap", f"case {n}{REFINED}{WITHOUT_HEAT}", converged(n, **dict(GAP_CHANGES)[WITHOUT_HEAT]),
+             dict(REFINED_NUMERICS)) for n in (10, 1)]
     # case 10's scatter at t_u/5 and REF_UPDATE (the seeds of case 1's, REF_SCATTER), for the gap study's case 10
     # and the resolution check at REF_UPDATE (REFINED_NOISE), which took it from the scene's 0.5 before
     out += [("gap", f"case 10{COARSE}{REF_KEY}{REF_UPDATE:g} jitter {seed}",
@@ -1437,7 +1437,7 @@ COMPARED = {SCATTER_S2: SCATTER_T5, REF_SCATTER: SCATTER_T5, SELF_SCATTER: SCATT
 SINGLES = {SCATTER_KEYS: ("case 1 s/2", "case 1 heat every 8"), SCATTER_TI10: ("case 10 s/2",),   # one run each
            SCATTER_TI10_REF: (f"case 10 n_tu 15{REFINED}", f"case 10{REFINED}{TO_CHIP}",
                               f"case 10{REFINED}{WITHOUT_HEAT}"),
-           SCATTER_REF: (f"case 1 n_tu 15{REFINED}", f"case 1{REFINED}{TO_CHIP}")}
+           SCATTER_REF: (f"case 1 n_tu 15{REFINED}", f"case 1{REFINED}{TO_CHIP}", f"case 1{REFINED}{WITHOUT_HEAT}")}
 # the 'refupdate' study's single runs, each against the scatter group of its resolution and material (at the
 # scene's reference update, or at REF_UPDATE for case 1 at t_u/5): which changes the scatter does not explain
 REF_SINGLES = ((SCATTER_T5, tuple(f"case 1{COARSE}{REF_KEY}{r:g}" for r in REF_UPDATES if r > SCENE_REF_UPDATE)

@@ -129,7 +129,7 @@ WITHOUT_HEAT = GAP_CHANGES[2][0]                               # ... its key suf
 REFINED_NUMERICS = dict(ref_update_strain=REF_UPDATE, frequency_step=FREQUENCY_STEP)   # what 'refined' sets
 REFINED_RETRY = f" courant {COURANT:g}"      # a 'refined' case that failed: again at half the CFL part of its step
 RETRIES = {"": (RETRY,), PFEM10: (f" n_tu 10{BOSSAK}", DAMPED), REFINED: (REFINED_RETRY,)}
-PFEM_OPTIONS = ("case", "n_tu", "travel", "length", "gamma", "remesh_when_needed", "bossak")   # what the PFEM takes
+PFEM_OPTIONS = ("case", "n_tu", "travel", "length", "gamma", "remesh_when_needed", "bossak", "eta")  # the PFEM's
 REMESH = " remesh when needed"              # the key suffix of a PFEM cut that remeshes only where the quality asks
 PAPER_CUT = (1.5e-3, 2.0e-3)   # m of tool travel: the last quarter of the paper's PFEM cut, 2/3 of its 3 mm workpiece
 TO_CHIP = " all friction heat to the chip"   # key suffix: chip_fraction 1 (the paper's SPH code's choice; scene 0.5)
@@ -268,6 +268,10 @@ def more_jobs() -> list[tuple[str, str, dict, dict]]:
     # SCATTER_TI10_REF (SINGLES); then case 1's, read against SCATTER_REF
     out += [("gap", f"case {n}{REFINED}{WITHOUT_HEAT}", converged(n, **dict(GAP_CHANGES)[WITHOUT_HEAT]),
              dict(REFINED_NUMERICS)) for n in (10, 1)]
+    # the PFEM's rake face stands 217 K (case 1) and 35 K (case 10) above its free chip surface with 6 and 13 % of
+    # the work made frictional heat: the same split there, case 1 and case 10 at t_u/10 (PFEM_GAP_RUNS)
+    out += [("gap", f"case {n}{PFEM10}{WITHOUT_HEAT}", dict(converged(n, n_tu=10.0), **dict(GAP_CHANGES)[WITHOUT_HEAT]),
+             pfem) for n in (1, 10)]
     # case 10's scatter at t_u/5 and REF_UPDATE (the seeds of case 1's, REF_SCATTER), for the gap study's case 10
     # and the resolution check at REF_UPDATE (REFINED_NOISE), which took it from the scene's 0.5 before
     out += [("gap", f"case 10{COARSE}{REF_KEY}{REF_UPDATE:g} jitter {seed}",
@@ -1051,6 +1055,7 @@ REFINED_RUNS = tuple(f"case {n}{REFINED}" for n in range(1, 19))
 GAP_SINGLES = tuple((group, tuple(group[0] + sfx for sfx, _ in GAP_CHANGES))
                     for group in (REF_SCATTER_TI, REF_SCATTER))
 GAP_RUNS = tuple(k for group, singles in GAP_SINGLES for k in (group[0], *singles))
+PFEM_GAP_RUNS = tuple(f"case {n}{PFEM10}{sfx}" for n in (1, 10) for sfx in ("", WITHOUT_HEAT))   # ... the PFEM's
 REFINED_SERIES = (("refsph SPH, t_u/10,\nref update 0.5,\ncourant 0.15", "", "D", "C1"),   # the figure's series
                   (f"refsph SPH, t_u/10,\nref update {REF_UPDATE:g},\nfrequency step", REFINED, "o", "C3"))
 # the resolution check at REF_UPDATE: each case at t_u/5 (the 'refupdate' study's run, courant 0.3), t_u/10 and t_u/15
@@ -1126,6 +1131,10 @@ STUDIES = (
      "with each case's scatter at ref update 0.1 and t_u/5 (case 10's below, case 1's further down)", GAP_RUNS,
      BASIC + (("T_RF - T_FCS [K]", "gap", ".0f"), ("friction heat [% of work]", "friction_of_work", ".1f"),
               ("viscosity + damping heat [% of work]", "dissipation_of_work", ".1f"), ("CPU [min]", "cpu_min", ".1f"))),
+    ("The same in the PFEM (t_u/10, the sweep's runs): friction acting but making no heat (eta = 0); one run each, "
+     "the PFEM being deterministic", PFEM_GAP_RUNS,
+     BASIC + (("T_RF - T_FCS [K]", "gap", ".0f"), ("friction heat [% of work]", "friction_of_work", ".1f"),
+              ("CPU [min]", "cpu_min", ".1f"))),
     ("Run-to-run scatter of Ti6Al4V at t_u/5 at reference update 0.1 (case 10 and two runs with the perturbations "
      "of case 1's scatter there)", REF_SCATTER_TI, BASIC + (("T_RF - T_FCS [K]", "gap", ".0f"),)),
     ("Run-to-run scatter of AISI 1045 at t_u/10 at reference update 0.1 (the 'refined' study's case 1 and two runs "

@@ -291,6 +291,23 @@ def test_remeshing_when_needed_is_an_option():
         _options(dict(remesh_when_needed="sometimes"), quick=True)
 
 
+def test_friction_without_its_heat_is_an_option():
+    """--option eta=0: friction acts (its force on the tool) but its work makes no heat, in the chip or the tool;
+    the default is the paper's eta = 1 (Eq. (7)); eta outside [0, 1] is refused."""
+    from refsph.pfem.cutting import pfem_cut, run_pfem_cut
+    from refsph.pfem_run import _options
+
+    kw = _options(dict(SHORT, travel="0.6", eta="0"), quick=True)
+    cold, hot = pfem_cut(**kw), pfem_cut(**_options(dict(SHORT, travel="0.6"), quick=True))
+    assert kw["eta"] == 0.0 and cold.info["eta"] == 0.0 and cold.heat.eta == 0.0 and hot.info["eta"] == 1.0
+    a, b = run_pfem_cut(cold), run_pfem_cut(hot)
+    assert b["heat_balance"]["friction_J"] > 0.0 and b["heat_balance"]["friction_to_tool_J"] > 0.0
+    assert a["heat_balance"]["friction_J"] == 0.0 and a["heat_balance"]["friction_to_tool_J"] == 0.0
+    assert abs(a["metrics"]["passive_force_N_per_m"]) > 0.0
+    with pytest.raises(ValueError, match="eta"):
+        pfem_cut(**_options(dict(SHORT, eta="1.5"), quick=True))
+
+
 def test_a_checkpoint_without_cpu_seconds_continues_with_them_unknown():
     """CutRun.restore of a checkpoint written before the CPU seconds were kept: the run goes on and says it does
     not know them (None), rather than counting from zero; a checkpoint that kept them goes on counting."""

@@ -758,6 +758,9 @@ def test_thermal_cutting_gap_study_changes_one_option_of_the_refupdate_runs():
     for n in (10, 1):                                                   # and at t_u/10, where it scatters less
         refined = mod.jobs(studies=("refined",))[f"case {n}{mod.REFINED}"]
         assert gap.pop(f"case {n}{mod.REFINED} friction without heat") == (dict(refined[0], eta=0.0), refined[1])
+    for n in (1, 10):                                                   # the same split in the PFEM
+        pfem = mod.jobs(studies=("pfem",))[f"case {n} pfem"]
+        assert gap.pop(f"case {n} pfem friction without heat") == (dict(pfem[0], eta=0.0), pfem[1])
     assert len(gap) == 2 * len(mod.GAP_CHANGES)
     for n in (10, 1):
         b_opts, b_num = base[f"case {n} n_tu 5{mod.REF_KEY}0.1"]

@@ -212,7 +212,8 @@ def pfem_cut(case: int, n_tu: float = 10.0, travel: float = 16.0, length: float 
              courant: float = 0.25, alpha: float = 1.4, penalty: float = 20.0, friction: bool = True,
              conduction: bool = True, chip_fraction: float = 0.5, refine: bool = True, r_min: float = 0.5,
              a_max: float = 2.5, gamma: float = 0.5, edge_nodes: bool = False,
-             remesh_when_needed: bool = False, bossak: float = 0.0, edge_radius: float = EDGE_RADIUS) -> PFEMCut:
+             remesh_when_needed: bool = False, bossak: float = 0.0, edge_radius: float = EDGE_RADIUS,
+             eta: float = CONTACT_RLA["friction_work_to_heat"]) -> PFEMCut:
     """The cut of row ``case`` of the paper's Appendix B: dx = t_u / n_tu, ``travel`` t_u of cut on a workpiece
     ``length`` [m] long (default (travel + 12) t_u), dt = courant dx / v_c, contact penalties ``penalty`` G / dx;
     ``conduction``: the heat step (module text; False: adiabatic), ``chip_fraction`` of the frictional heat into
@@ -224,18 +225,20 @@ def pfem_cut(case: int, n_tu: float = 10.0, travel: float = 16.0, length: float 
     ``edge_nodes``: the mesh kept off the tool (:class:`PFEMCut`; with ``refine``); ``remesh_when_needed``:
     Algorithm 1's "if remeshing is needed" read literally, a remeshing only where a triangle's quality falls below
     ``remesh_quality`` (False: after every step as well, refsph's default; module text); ``edge_radius`` [m]: the
-    tool's edge radius in the contact's outline (the paper's 10 um; the meshed tool of the heat step keeps it)."""
+    tool's edge radius in the contact's outline (the paper's 10 um; the meshed tool of the heat step keeps it);
+    ``eta``: the fraction of the frictional work that becomes heat (Eq. (7); the paper's 1; 0 keeps friction's
+    mechanics without its heat)."""
     row = rla_cutting_case(int(case))
     mat = MATERIALS[row["material"]]
     vc, tu = row["vc_m_per_min"] / 60.0, row["tu_mm"] * 1e-3
     dx = tu / n_tu
     length = (travel + 12.0) * tu if length is None else length
     if not (n_tu >= 2 and travel > 0 and length > 1.25 * travel * tu and courant > 0 and penalty > 0
-            and 0.0 <= chip_fraction <= 1.0):
+            and 0.0 <= chip_fraction <= 1.0 and 0.0 <= eta <= 1.0):
         raise ValueError(f"PFEM cut: need n_tu >= 2, travel > 0, a cut within 80 % of the workpiece, courant > 0, "
-                         f"penalty > 0 and 0 <= chip_fraction <= 1; got n_tu = {n_tu!r}, travel = {travel!r} tu, "
+                         f"penalty > 0, 0 <= chip_fraction <= 1 and 0 <= eta <= 1; got n_tu = {n_tu!r}, travel = {travel!r} tu, "
                          f"length = {length!r} m, courant = {courant!r}, penalty = {penalty!r}, "
-                         f"chip_fraction = {chip_fraction!r}")
+                         f"chip_fraction = {chip_fraction!r}, eta = {eta!r}")
     if bossak != 0.0 and gamma != 0.5:
         raise ValueError(f"PFEM cut: give gamma (damped Newmark) or bossak (Bossak-Newmark), not both; got gamma = "
                          f"{gamma!r}, bossak = {bossak!r}")
@@ -273,7 +276,7 @@ def pfem_cut(case: int, n_tu: float = 10.0, travel: float = 16.0, length: float 
                        tool_edges=tmesh.edges[~np.isin(tmesh.edges, np.flatnonzero(tool_held)).all(axis=1)],
                        T_fixed=T0, h_int=2.0 * k_w * k_t / (k_w + k_t) / dx,
                        loss=SurfaceLoss(**RLA_SURFACE_LOSS, T_ambient=T0), chip_fraction=float(chip_fraction),
-                       eta=CONTACT_RLA["friction_work_to_heat"])
+                       eta=float(eta))
     info = dict(case=int(case), material=row["material"], vc_m_s=vc, tu_m=tu, dx=dx, length_m=float(x[:, 0].max()),
                 height_m=H, y0=y0, n_work=len(x), n_tool=len(xt), travel_m=travel * tu, mass_scale=1.0,
                 inertia_ratio=mat["rho"] * vc * vc / mat["A_Pa"], rake_deg=RAKE_DEG, clearance_deg=CLEARANCE_DEG,
@@ -281,7 +284,8 @@ def pfem_cut(case: int, n_tu: float = 10.0, travel: float = 16.0, length: float 
                 courant=courant, penalty=penalty, conduction=bool(conduction), chip_fraction=float(chip_fraction),
                 h_int=None if heat is None else heat.h_int, refine=bool(refine), r_min=r_min, a_max=a_max,
                 newmark_gamma=float(newmark.gamma), edge_nodes=bool(edge_nodes),
-                remesh_when_needed=bool(remesh_when_needed), **({"newmark_alpha_B": float(bossak)} if bossak else {}))
+                remesh_when_needed=bool(remesh_when_needed), eta=float(eta),
+                **({"newmark_alpha_B": float(bossak)} if bossak else {}))
     return PFEMCut(nodes=nodes, h=h, fixed=fixed, law=law, shape=shape, shift0=centroid, v_tool=np.array([-vc, 0.0]),
                    contact=contact, alpha=alpha, dt=courant * dx / vc, t_end=travel * tu / vc, X0=x.copy(), info=info,
                    heat=heat, node_rule=NodeRule(r_min=r_min, a_max=a_max) if refine else None, newmark=newmark,

@@ -23,8 +23,8 @@ The folder (:mod:`refsph.io` documents the common files):
 element (the mean stress, positive in compression like the SPH snapshots' pressure).
 
 Scene options (``--option NAME=VALUE``): case, n_tu, travel, length, penalty, courant, alpha, friction, conduction,
-chip_fraction, eta, ... (:func:`refsph.pfem.cutting.pfem_cut`); ``--quick``: case 1's short cut at dx = t_u / 5 (4 t_u of a
-workpiece 1.2 mm long, the SPH scene's quick cut).
+chip_fraction, eta and the rest of :func:`refsph.pfem.cutting.pfem_cut`'s parameters; ``--quick``: case 1's short cut
+at dx = t_u / 5 (4 t_u of a workpiece 1.2 mm long, the SPH scene's quick cut).
 """
 from __future__ import annotations
 

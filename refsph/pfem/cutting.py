@@ -236,9 +236,9 @@ def pfem_cut(case: int, n_tu: float = 10.0, travel: float = 16.0, length: float 
     if not (n_tu >= 2 and travel > 0 and length > 1.25 * travel * tu and courant > 0 and penalty > 0
             and 0.0 <= chip_fraction <= 1.0 and 0.0 <= eta <= 1.0):
         raise ValueError(f"PFEM cut: need n_tu >= 2, travel > 0, a cut within 80 % of the workpiece, courant > 0, "
-                         f"penalty > 0, 0 <= chip_fraction <= 1 and 0 <= eta <= 1; got n_tu = {n_tu!r}, travel = {travel!r} tu, "
-                         f"length = {length!r} m, courant = {courant!r}, penalty = {penalty!r}, "
-                         f"chip_fraction = {chip_fraction!r}, eta = {eta!r}")
+                         f"penalty > 0, 0 <= chip_fraction <= 1 and 0 <= eta <= 1; got n_tu = {n_tu!r}, "
+                         f"travel = {travel!r} tu, length = {length!r} m, courant = {courant!r}, "
+                         f"penalty = {penalty!r}, chip_fraction = {chip_fraction!r}, eta = {eta!r}")
     if bossak != 0.0 and gamma != 0.5:
         raise ValueError(f"PFEM cut: give gamma (damped Newmark) or bossak (Bossak-Newmark), not both; got gamma = "
                          f"{gamma!r}, bossak = {bossak!r}")

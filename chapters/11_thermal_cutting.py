@@ -400,7 +400,9 @@ display(Markdown(split_page.split("\n\n", 1)[1]))             # the page without
 #   updated before $\lVert\mathbf E\rVert_F$ passes 0.1, all 18 cuts ran in 0.43–0.94 of the sweep's steps, 11–39
 #   min of CPU each. $F_c$ falls by 13–41 %, and every rake face is hotter. Steel's mean $T_{RF}$ error is 12.1 %
 #   (0–27 % too hot; the sweep's 19.3 %, 7–26 % too cold). Ti6Al4V's is 50.5 % (30.3 %), too hot in every case,
-#   as with both of the paper's methods. $F_p/F_c$ misses by 50.6 / 48.8 % (44.5 / 41.7 %). The heat ledger says
+#   as with both of the paper's methods and with the SPH and FEM of the measurements' own source (Afrasiabi et al.,
+#   *Metals* 11 (2021) 1683, whose abstract gives their thermal loads within 5–20 % "except for the rake face
+#   temperature of Ti6Al4V"). $F_p/F_c$ misses by 50.6 / 48.8 % (44.5 / 41.7 %). The heat ledger says
 #   why the face is hotter: friction turns 10 / 16 % of the tool's work into heat at 0.1 (2 / 9 % at 0.5; steel /
 #   Ti6Al4V means), the artificial viscosity 6 / 8 % (16 / 21 %). At 0.5 less of the chip slid on the tool, and more
 #   of the work went into numerical dissipation. So part of the sweep's agreement was the unconverged update's.

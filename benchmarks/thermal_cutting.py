@@ -255,6 +255,8 @@ def more_jobs() -> list[tuple[str, str, dict, dict]]:
     out += [("scaling", f"case 10 s/2{REFINED}" + (f" jitter {seed}" if seed else ""),
              converged(10, mass_scale=_s(10) / 2, **(dict(jitter=0.01, seed=seed) if seed else {})),
              dict(REFINED_NUMERICS)) for seed in (0, 1, 2)]
+    # ... and steel's at REF_UPDATE: case 1 at s/2 (one run), read against case 1's scatter there (SINGLES)
+    out += [("scaling", f"case 1 s/2{REFINED}", converged(1, mass_scale=_s(1) / 2), dict(REFINED_NUMERICS))]
     # case 10 at s/2 moved Fc by -21 %, T_RF by -12 %, one run against case 10's scatter of three: its scatter at s/2
     # too (the same two seeds), so that the forces' dependence on s is read between two groups of three
     out += [("scaling", f"case 10 s/2 jitter {seed}", converged(10, mass_scale=_s(10) / 2, jitter=0.01, seed=seed),
@@ -1138,8 +1140,9 @@ STUDIES = (
     ("Run-to-run scatter of Ti6Al4V at t_u/5 at reference update 0.1 (case 10 and two runs with the perturbations "
      "of case 1's scatter there)", REF_SCATTER_TI, BASIC + (("T_RF - T_FCS [K]", "gap", ".0f"),)),
     ("Run-to-run scatter of AISI 1045 at t_u/10 at reference update 0.1 (the 'refined' study's case 1 and two runs "
-     "with the perturbations of case 1's scatter at 0.5): whether the converged update, t_u/15 and the heat split "
-     "move case 1 by more than the scatter measured at that update", SCATTER_REF, BASIC),
+     "with the perturbations of case 1's scatter at 0.5): whether the converged update, t_u/15, the heat split, "
+     "friction without its heat and half the mass scale move case 1 by more than the scatter measured at that update",
+     SCATTER_REF, BASIC),
     ("Run-to-run scatter of Ti6Al4V at t_u/5 (case 10, the same perturbation)",
      ("case 10 n_tu 5", "case 10 n_tu 5 jitter 1", "case 10 n_tu 5 jitter 2", "case 10 n_tu 5 jitter 3"), BASIC),
     ("Resolution (particles across t_u; at courant 0.15)", RESOLUTION_RUNS,
@@ -1446,7 +1449,8 @@ COMPARED = {SCATTER_S2: SCATTER_T5, REF_SCATTER: SCATTER_T5, SELF_SCATTER: SCATT
 SINGLES = {SCATTER_KEYS: ("case 1 s/2", "case 1 heat every 8"), SCATTER_TI10: ("case 10 s/2",),   # one run each
            SCATTER_TI10_REF: (f"case 10 n_tu 15{REFINED}", f"case 10{REFINED}{TO_CHIP}",
                               f"case 10{REFINED}{WITHOUT_HEAT}"),
-           SCATTER_REF: (f"case 1 n_tu 15{REFINED}", f"case 1{REFINED}{TO_CHIP}", f"case 1{REFINED}{WITHOUT_HEAT}")}
+           SCATTER_REF: (f"case 1 n_tu 15{REFINED}", f"case 1{REFINED}{TO_CHIP}", f"case 1{REFINED}{WITHOUT_HEAT}",
+                         f"case 1 s/2{REFINED}")}
 # the 'refupdate' study's single runs, each against the scatter group of its resolution and material (at the
 # scene's reference update, or at REF_UPDATE for case 1 at t_u/5): which changes the scatter does not explain
 REF_SINGLES = ((SCATTER_T5, tuple(f"case 1{COARSE}{REF_KEY}{r:g}" for r in REF_UPDATES if r > SCENE_REF_UPDATE)

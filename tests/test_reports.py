@@ -692,6 +692,9 @@ def test_thermal_cutting_scatter_and_mass_scale_at_the_refined_update():
     assert mod.COMPARED[mod.SCATTER_TI10_REF] == mod.SCATTER_TI10
     assert mod.COMPARED[mod.SCATTER_TI10_REF_S2] == mod.SCATTER_TI10_REF
     assert f"case 10 n_tu 15{mod.REFINED}" in mod.SINGLES[mod.SCATTER_TI10_REF]
+    steel, steel_s2 = refined[f"case 1{mod.REFINED}"], todo[f"case 1 s/2{mod.REFINED}"]   # steel's, one run at s/2
+    assert steel_s2 == (dict(steel[0], mass_scale=mod._s(1) / 2), steel[1])
+    assert f"case 1 s/2{mod.REFINED}" in mod.SINGLES[mod.SCATTER_REF]
     tables = [k for _, k, _ in mod.STUDIES]
     assert mod.SCATTER_TI10_REF in tables and mod.SCATTER_TI10_REF_S2 in tables
 

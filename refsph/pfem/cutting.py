@@ -208,6 +208,19 @@ def graded_workpiece(length: float, tu: float, dx: float) -> tuple[np.ndarray, n
     return x, h
 
 
+def _check_cut(*, n_tu, travel, length, tu, courant, penalty, chip_fraction, eta, gamma, bossak) -> None:
+    """ValueError naming what :func:`pfem_cut` cannot take."""
+    if not (n_tu >= 2 and travel > 0 and length > 1.25 * travel * tu and courant > 0 and penalty > 0
+            and 0.0 <= chip_fraction <= 1.0 and 0.0 <= eta <= 1.0):
+        raise ValueError(f"PFEM cut: need n_tu >= 2, travel > 0, a cut within 80 % of the workpiece, courant > 0, "
+                         f"penalty > 0, 0 <= chip_fraction <= 1 and 0 <= eta <= 1; got n_tu = {n_tu!r}, "
+                         f"travel = {travel!r} tu, length = {length!r} m, courant = {courant!r}, "
+                         f"penalty = {penalty!r}, chip_fraction = {chip_fraction!r}, eta = {eta!r}")
+    if bossak != 0.0 and gamma != 0.5:
+        raise ValueError(f"PFEM cut: give gamma (damped Newmark) or bossak (Bossak-Newmark), not both; got gamma = "
+                         f"{gamma!r}, bossak = {bossak!r}")
+
+
 def pfem_cut(case: int, n_tu: float = 10.0, travel: float = 16.0, length: float | None = None,
              courant: float = 0.25, alpha: float = 1.4, penalty: float = 20.0, friction: bool = True,
              conduction: bool = True, chip_fraction: float = 0.5, refine: bool = True, r_min: float = 0.5,
@@ -233,15 +246,8 @@ def pfem_cut(case: int, n_tu: float = 10.0, travel: float = 16.0, length: float 
     vc, tu = row["vc_m_per_min"] / 60.0, row["tu_mm"] * 1e-3
     dx = tu / n_tu
     length = (travel + 12.0) * tu if length is None else length
-    if not (n_tu >= 2 and travel > 0 and length > 1.25 * travel * tu and courant > 0 and penalty > 0
-            and 0.0 <= chip_fraction <= 1.0 and 0.0 <= eta <= 1.0):
-        raise ValueError(f"PFEM cut: need n_tu >= 2, travel > 0, a cut within 80 % of the workpiece, courant > 0, "
-                         f"penalty > 0, 0 <= chip_fraction <= 1 and 0 <= eta <= 1; got n_tu = {n_tu!r}, "
-                         f"travel = {travel!r} tu, length = {length!r} m, courant = {courant!r}, "
-                         f"penalty = {penalty!r}, chip_fraction = {chip_fraction!r}, eta = {eta!r}")
-    if bossak != 0.0 and gamma != 0.5:
-        raise ValueError(f"PFEM cut: give gamma (damped Newmark) or bossak (Bossak-Newmark), not both; got gamma = "
-                         f"{gamma!r}, bossak = {bossak!r}")
+    _check_cut(n_tu=n_tu, travel=travel, length=length, tu=tu, courant=courant, penalty=penalty,
+               chip_fraction=chip_fraction, eta=eta, gamma=gamma, bossak=bossak)
     newmark = (Newmark.bossak(bossak) if bossak != 0.0 else TRAPEZOIDAL if gamma == 0.5      # raise out of range
                else Newmark((gamma + 0.5) ** 2 / 4.0, gamma))
     x, h = graded_workpiece(length, tu, dx)

@@ -406,9 +406,11 @@ display(Markdown(split_page.split("\n\n", 1)[1]))             # the page without
 #   why the face is hotter: friction turns 10 / 16 % of the tool's work into heat at 0.1 (2 / 9 % at 0.5; steel /
 #   Ti6Al4V means), the artificial viscosity 6 / 8 % (16 / 21 %). At 0.5 less of the chip slid on the tool, and more
 #   of the work went into numerical dissipation. So part of the sweep's agreement was the unconverged update's.
-#   At 0.1 both cases checked are converged at $t_u/10$: $t_u/15$ moves every quantity but case 10's hottest
-#   contact particle by less than twice the scatter of three runs (case 1: $F_c$ −4.5 %, $T_{RF}$ −0.6 %; case 10:
-#   +1.3 %, −2.3 %).
+#
+# %% [markdown]
+# * **Converged at 0.1.** Both cases checked are converged at $t_u/10$: $t_u/15$ moves every quantity but case
+#   10's hottest contact particle by less than twice the scatter of three runs (case 1: $F_c$ −4.5 %, $T_{RF}$
+#   −0.6 %; case 10: +1.3 %, −2.3 %).
 #
 # %% [markdown]
 # * **Steel's 12.1 % is partly two errors cancelling.** At 0.1 the steel chip's free surface is 13–21 % too cold,

@@ -434,9 +434,9 @@ display(Markdown(split_page.split("\n\n", 1)[1]))             # the page without
 # %% [markdown]
 # * **Which side of the face?** A rake face belongs to the tool, and $T_{RF}$ here is the chip's contact layer,
 #   $dx/2$ in front of it. `benchmarks/rake_interface.py` reads the tool's first row behind the face as well. For
-#   steel it is 10–18 K cooler at every resolution; for Ti6Al4V, whose conductivity is an eighth of the tool's,
-#   128 K at $t_u/5$ and 77 K at $t_u/10$ (case 10: 909 K against 701 K measured). The step shrinks with $dx$, and
-#   neither side closes Ti6Al4V's miss.
+#   steel it is 10–33 K cooler at every resolution and mass scale; for Ti6Al4V, whose conductivity is an eighth
+#   of the tool's, 128 K at $t_u/5$ and 77 K at $t_u/10$ (case 10: 909 K against 701 K measured). The step shrinks
+#   with $dx$, and neither side closes Ti6Al4V's miss.
 #
 # ## Your turn
 #

@@ -5,9 +5,9 @@ the last quarter of thermal-cutting SPH runs.
 
 Issue 22 asks which temperature the measured T_RF is. The scene's T_RF is the mean temperature of the *workpiece*
 particles within one spacing of the rake face, from the edge to the end of contact (fixed before the sweep). A
-"rake face" is a surface of the tool, and the measurements' source measures it on the tool's side (Afrasiabi et al.,
-Metals 11 (2021) 1683, whose abstract names a new way to measure the rake face temperature "without manipulating the
-chip flow"). In the SPH the two bodies meet across one spacing, the chip's contact layer dx/2 in front of the face
+"rake face" is a surface of the tool; the measurements' source introduces a way to measure its temperature "without
+manipulating the chip flow" (Afrasiabi et al., Metals 11 (2021) 1683, abstract), which the paper does not describe,
+so either side of the face may be what was measured. In the SPH the two bodies meet across one spacing, the chip's contact layer dx/2 in front of the face
 and the tool's first row about dx/2 behind it, and the pair conduction between them (harmonic-mean k,
 :mod:`refsph.thermal`) carries a temperature step that shrinks with dx. This script measures that step:
 

@@ -7,9 +7,10 @@ Issue 22 asks which temperature the measured T_RF is. The scene's T_RF is the me
 particles within one spacing of the rake face, from the edge to the end of contact (fixed before the sweep). A
 "rake face" is a surface of the tool; the measurements' source introduces a way to measure its temperature "without
 manipulating the chip flow" (Afrasiabi et al., Metals 11 (2021) 1683, abstract), which the paper does not describe,
-so either side of the face may be what was measured. In the SPH the two bodies meet across one spacing, the chip's contact layer dx/2 in front of the face
-and the tool's first row about dx/2 behind it, and the pair conduction between them (harmonic-mean k,
-:mod:`refsph.thermal`) carries a temperature step that shrinks with dx. This script measures that step:
+so either side of the face may be what was measured. In the SPH the two bodies meet across one spacing, the
+chip's contact layer dx/2 in front of the face and the tool's first row about dx/2 behind it, and the pair
+conduction between them (harmonic-mean k, :mod:`refsph.thermal`) carries a temperature step that shrinks with dx.
+This script measures that step:
 
     chip layer  mean T of the workpiece rows with |n| < dx, 0 <= u       (the scene's T_RF, one snapshot)
     tool layer  mean T of the tool rows with -dx < n <= 0, 0 <= u <= L  (L the contact length of the snapshot)

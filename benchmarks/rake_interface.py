@@ -37,7 +37,6 @@ import numpy as np  # noqa: E402
 
 HERE = Path(__file__).resolve().parent
 OUT_JSON, OUT_MD = HERE / "rake_interface.json", HERE / "rake_interface_report.md"
-STEADY_FROM = 0.75     # the scene's window (refsph.scenes.thermal_cutting.STEADY_FROM): the last quarter of the cut
 
 
 def layers(x: np.ndarray, T: np.ndarray, t: float, info: dict) -> dict | None:
@@ -54,6 +53,7 @@ def layers(x: np.ndarray, T: np.ndarray, t: float, info: dict) -> dict | None:
     L = float(u[touch].max())
     face = ~work & (u >= 0.0) & (u <= L)
     tool, behind = face & (n > -dx) & (n <= 0.0), face & (n > -2 * dx) & (n <= -dx)
+
     def mean(sel):
         return float(T[sel].mean()) if sel.any() else float("nan")
 
@@ -62,11 +62,15 @@ def layers(x: np.ndarray, T: np.ndarray, t: float, info: dict) -> dict | None:
 
 
 def interface(run_dir: Path) -> dict:
-    """The layers of every snapshot of the run's steady window and their means (module text)."""
-    from refsph.io import load_snapshot
-    s = json.loads((run_dir / "summary.json").read_text())
+    """The layers of every snapshot of the run's steady window and their means (module text); ValueError naming
+    the folder for a PFEM run, or a summary without the scene's info or its snapshots."""
+    from refsph.io import load_snapshot, read_json
+    from refsph.scenes.thermal_cutting import STEADY_FROM
+    s = read_json(run_dir / "summary.json", "run summary")
     if s.get("method") == "pfem":
         raise ValueError(f"{run_dir}: a PFEM run (its tool's temperatures are not in the snapshots); SPH runs only")
+    if not all(k in s for k in ("scene_info", "t_end", "snapshots")):
+        raise ValueError(f"{run_dir}: its summary.json lacks scene_info, t_end or snapshots: not a thermal-cutting run")
     info, t_end = s["scene_info"], float(s["t_end"])
     snaps = [load_snapshot(run_dir / "snapshots" / name) for name in s["snapshots"]]
     rows = [r for z in snaps if float(z["t"]) >= STEADY_FROM * t_end - 1e-12
@@ -112,15 +116,15 @@ def main(argv=None) -> int:
         print(f"no run folder at {', '.join(missing)}: run benchmarks/thermal_cutting.py first", file=sys.stderr)
         return 2
     failed = 0
-    for d in args.run:
+    for d in (Path(d).resolve() for d in args.run):
         try:
-            r = interface(Path(d).resolve())
+            r = interface(d)
         except ValueError as e:                  # an unfinished or a PFEM run: said, and the others still kept
             print(e, file=sys.stderr)
             failed += 1
             continue
-        kept[Path(d).resolve().name] = r
-        print(f"{Path(d).name}: chip layer {r['chip_K']:.0f} K, tool face layer {r['tool_K']:.0f} K, "
+        kept[d.name] = r
+        print(f"{d.name}: chip layer {r['chip_K']:.0f} K, tool face layer {r['tool_K']:.0f} K, "
               f"step {r['step_K']:.0f} K over {len(r['snapshots'])} snapshots")
     OUT_JSON.write_text(json.dumps(dict(runs=kept, made_by="python benchmarks/rake_interface.py --run ..."),
                                    indent=1) + "\n")

@@ -78,6 +78,11 @@ def test_interface_means_the_last_quarter_and_keeps_other_runs(tmp_path, monkeyp
     (run / "summary.json").write_text(json.dumps(dict(method="pfem", t_end=1e-3, snapshots=names)))
     assert mod.main(["--run", str(run)]) == 1                          # said, and the JSON kept as it was
     assert json.loads((tmp_path / "ri.json").read_text())["runs"] == kept
+    for text in ("{not json", json.dumps(dict(method="tlsph"))):         # bad summaries: a ValueError naming them
+        (run / "summary.json").write_text(text)
+        with pytest.raises(ValueError, match="summary"):
+            mod.interface(run)
+        assert mod.main(["--run", str(run)]) == 1
 
 
 def test_page_is_generated_from_the_json():

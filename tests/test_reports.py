@@ -400,6 +400,23 @@ def test_thermal_cutting_means_at_the_paper_length_of_cut():
     assert row["2mm"]["TRF"][0] == pytest.approx(mod.window_means(done, 1.0, *mod.PAPER_CUT)["TRF"])
 
 
+def test_thermal_cutting_paper_spacing_takes_the_fine_runs_of_the_thicker_cuts():
+    """paper_spacing_rows: AISI 1045's nine PFEM rows, the t_u = 0.1 mm cases from their t_u/10 runs (with the
+    retries), the others from the runs at 10 um near the tool (15 and 20 nodes across t_u, cases 8 and 9 with the
+    Bossak rule), never from their t_u/10 runs; a fine run's window at 2 mm comes from its own longer cut."""
+    mod = _script("thermal_cutting")
+    runs = mod.load()["runs"]
+    res = dict(runs={k: runs[k] for k in ("case 1 pfem", "case 2 pfem", "case 4 pfem", "case 3 pfem")})
+    res["runs"]["case 2 pfem n_tu 15"] = runs["case 2 pfem"]                 # a stand-in for the fine run
+    rows = {r["case"]: r for r in mod.paper_spacing_rows(res)}
+    assert sorted(rows) == list(range(1, 10))
+    assert rows[1]["key"] == "case 1 pfem" and rows[4]["key"] == "case 4 pfem"
+    assert rows[2]["key"] == "case 2 pfem n_tu 15" and rows[2]["status"] == "ok" and rows[2]["key2"] == rows[2]["key"]
+    assert rows[3]["key"] == "case 3 pfem n_tu 20" and rows[3]["status"] == "to run"      # not its t_u/10 run
+    assert rows[8]["key"] == "case 8 pfem n_tu 15" + mod.BOSSAK and rows[9]["key"] == "case 9 pfem n_tu 20" + mod.BOSSAK
+    assert rows[2]["2mm"]["TRF"][0] == pytest.approx(mod.window_means(runs["case 2 pfem"], 1.0, *mod.PAPER_CUT)["TRF"])
+
+
 def _resolution_record(fc, n):
     """A made-up 'ok' record of a cut at n particles across t_u with Fc = ``fc`` N/mm (the other quantities fixed)."""
     return dict(status="ok", dp=1e-4 / n, scene_info=dict(tu_m=1e-4),

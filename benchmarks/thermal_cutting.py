@@ -608,6 +608,57 @@ def trends(rows) -> dict:
     return out
 
 
+TREND_STEPS = (("Fc with t_u", "Fc_N_per_mm", "Fc_exp", "tu", "Fc"),
+               ("Fp with t_u", "Fp_N_per_mm", "Fp_exp", "tu", "Fp"),
+               ("T_RF with v_c", "TRF", "TRF_exp", "vc", "rake_face_temperature_K"),
+               ("Fc with v_c", "Fc_N_per_mm", "Fc_exp", "vc", "Fc"))   # (name, column, measured, along, scatter's)
+
+
+def trend_steps(rows) -> dict:
+    """Per material and TREND_STEPS entry, each step along a line (t_u or v_c one value up, the other fixed: two
+    steps on each of three lines) as the relative change of refsph and of the measurement: {material: {name:
+    (steps with both recorded, of them the same sign, [(fixed value, refsph %, measured %) of those of opposite
+    sign])}}."""
+    out = {}
+    for mat in ("AISI1045", "Ti6Al4V"):
+        get = {(r["vc"], r["tu"]): r for r in rows if r["material"] == mat}
+        vcs, tus = sorted({k[0] for k in get}), sorted({k[1] for k in get})
+        out[mat] = {}
+        for name, col, exp, along, _ in TREND_STEPS:
+            lines = [(v, [get[(v, u)] for u in tus]) for v in vcs] if along == "tu" else \
+                [(u, [get[(v, u)] for v in vcs]) for u in tus]
+            n, same, other = 0, 0, []
+            for fixed, line in lines:
+                for a, b in zip(line, line[1:]):
+                    if a[col] is None or b[col] is None:
+                        continue
+                    d, de = 100.0 * (b[col] / a[col] - 1.0), 100.0 * (b[exp] / a[exp] - 1.0)
+                    n, same = n + 1, same + (np.sign(d) == np.sign(de))
+                    if np.sign(d) != np.sign(de):
+                        other.append((fixed, d, de))
+            out[mat][name] = (n, same, other)
+    return out
+
+
+def _trend_step_lines(sets: dict, noise: dict) -> list[str]:
+    """The step-by-step trends table: per refsph set ({label: comparison rows}) and material, each TREND_STEPS
+    entry's 'same of steps', and the steps of opposite sign as 'refsph / measured %' at the line's fixed value, with
+    the run-to-run scatter of that quantity ({material: scatter()} where measured; sd in percent)."""
+    lines = []
+    for label, rows in sets.items():
+        for mat, t in trend_steps(rows).items():
+            cells = []
+            for name, _, _, along, sd_key in TREND_STEPS:
+                n, same, other = t[name]
+                unit = "mm" if along == "vc" else "m/min"
+                off = "; ".join(f"{d:+.1f} / {de:+.1f} at {x:g} {unit}" for x, d, de in other)
+                sd = noise.get((label, mat), {}).get(sd_key)
+                cells.append(f"{same} of {n}" + (f" ({off})" if off else "")
+                             + (f", sd {sd['std_pct']:.1f} %" if off and sd else ""))
+            lines.append(f"| {label} | {mat} | " + " | ".join(cells) + " |")
+    return lines
+
+
 def _trend_cell(t: dict, name: str) -> str:
     """'yes' / 'no (k of n rise)' (or 'fall') for refsph, with 'k of n lines recorded' where cases are missing; then
     the measured."""
@@ -769,6 +820,13 @@ def report(res: dict, before: dict | None = None) -> str:
                        ("SPH, t_u/5", coarse), ("PFEM, t_u/5", pfem), ("PFEM, t_u/10", pfem10)):
         for mat, t in trends(sel).items():
             lines.append(f"| {mat} | {label} | " + " | ".join(_trend_cell(t, n) for n in TREND_NAMES) + " |")
+    refined = comparison(res, REFINED)
+    noise = {(f"SPH, t_u/10, ref update {REF_UPDATE:g}", m): scatter(res, keys) for m, keys in
+             (("AISI1045", SCATTER_REF), ("Ti6Al4V", SCATTER_TI10_REF))}
+    noise.update({("SPH, t_u/10", m): scatter(res, keys) for m, keys in (("AISI1045", SCATTER_KEYS),
+                                                                          ("Ti6Al4V", SCATTER_TI10))})
+    lines += ["", P("trend_steps")] + _trend_step_lines(
+        {"SPH, t_u/10": rows, f"SPH, t_u/10, ref update {REF_UPDATE:g}": refined, "PFEM, t_u/10": pfem10}, noise)
     lines += ["", P("rake_ceiling")] + _ceiling_lines(rows)
     lines += ["", P("own_ceiling")] + _own_ceiling_lines(rows, pfem10)
     gaps = rake_gaps(rows, {"refsph SPH": rows, f"refsph SPH, ref update {REF_UPDATE:g}": comparison(res, REFINED),

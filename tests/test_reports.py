@@ -73,6 +73,26 @@ def test_pfem_alpha_report_is_generated_from_the_json():
         assert mod.DEFAULT in alphas and min(alphas) < mod.DEFAULT < max(alphas), cut
 
 
+def test_thermal_cutting_trend_steps_compare_each_step_sign():
+    """thermal_cutting.trend_steps: two steps on each line; a step counts as the measured's when the two changes have
+    one sign, and one of opposite sign is listed with both changes in percent at the line's fixed value; a missing
+    case drops its steps; the table's cell names the scatter only where a step went the other way."""
+    mod = _script("thermal_cutting")
+    rows = [dict(material="AISI1045", vc=vc, tu=tu, Fc_N_per_mm=100 * tu, Fc_exp=tu, Fp_N_per_mm=tu, Fp_exp=tu,
+                 TRF=vc + tu, TRF_exp=vc) for vc in (60, 120, 180) for tu in (0.1, 0.15, 0.2)]
+    t = mod.trend_steps(rows)["AISI1045"]
+    assert t["Fc with t_u"] == (6, 6, []) and t["T_RF with v_c"] == (6, 6, [])
+    assert t["Fc with v_c"] == (6, 6, [])          # refsph's Fc flat (sign 0), the measured flat too: the same sign
+    rows[1]["Fc_N_per_mm"] = 5.0                     # vc 60: 10 -> 5 -> 20, measured 0.1 -> 0.15 -> 0.2: one step
+    n, same, other = mod.trend_steps(rows)["AISI1045"]["Fc with t_u"]
+    assert (n, same) == (6, 5) and [(x, round(d), round(de)) for x, d, de in other] == [(60, -50, 50)]
+    rows[4]["Fp_N_per_mm"] = None                    # vc 120, tu 0.15 not recorded: its two Fp steps drop
+    assert mod.trend_steps(rows)["AISI1045"]["Fp with t_u"][0] == 4
+    cells = mod._trend_step_lines({"x": rows}, {("x", "AISI1045"): {"Fc": dict(std_pct=6.0)}})[0].split(" | ")
+    assert cells[2] == "5 of 6 (-50.0 / +50.0 at 60 m/min), sd 6.0 %"
+    assert cells[3] == "4 of 4"
+
+
 def test_thermal_cutting_trends_read_every_line():
     """thermal_cutting.trends: a quantity 'rises with t_u' only if it rises at every v_c (one dip says no), and a
     missing case makes the verdict '-' (None)."""

@@ -353,8 +353,8 @@ display(Markdown(split_page.split("\n\n", 1)[1]))             # the page without
 # %% [markdown]
 # * **Mass scaling** changes inertia by the factor $s$, and with it the artificial viscosity's stress ($\propto
 #   \sqrt{s}$). At $t_u/5$, four runs a side, halving $s$ moves neither force (case 1: $F_c$ −0.5 %) but cools
-#   the rake face by 10 % (Welch's $t = -3.8$). At $s/4$ (one run, Courant 0.15 as its $s$ run) it is 15 % cooler
-#   still, the frictional heat unchanged (1.9 against 1.7 % of the work): a mass-scaling bias of the temperatures.
+#   the rake face by 10 % (Welch's $t = -3.8$). At $s/4$ (one run) it is 15 % cooler than its $s$ run at the same
+#   Courant 0.15, the frictional heat unchanged (1.9 against 1.7 % of the work): a mass-scaling bias of the temperatures.
 #   At $t_u/10$ and reference update 0.1 (case 10, three runs a side) halving $s$ moves $F_c$ by +7 % ($t = 2.3$),
 #   $F_p/F_c$ by −5 %, and cools the free chip surface by 9 % ($t = -3.5$).
 #

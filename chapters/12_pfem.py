@@ -616,9 +616,8 @@ for case in (1, 10):
               f"T_FCS {c[f'TFCS_{t}_K']:.0f} K")
 
 # %% [markdown]
-# **Fails:** Fp/Fc 0.08-0.40 at t_u/10 (measured 0.45-0.83; a 10° rake allows 0.55 / 0.31 at μ0 for steel / Ti, the
-# paper's PFEM above in 13 of 18: not rake friction alone), and not converged at the paper's 10 µm (case 5: 0.21 →
-# 0.23 → 0.26 from 30 to 10 µm, its rake face within 1 %); the trapezoidal rule rings (8, 9, 12, 14): damped rules.
+# **Fails:** Fp/Fc 0.08-0.40 at t_u/10 (measured 0.45-0.83; μ0 allows 0.55 / 0.31; the paper's above in 13 of 18),
+# unconverged at 10 µm (case 5, 30 → 10 µm: 0.21 → 0.26); the trapezoidal rule rings (8, 9, 12, 14): damped rules.
 
 # %% [markdown]
 # ## Your turn

@@ -135,6 +135,7 @@ PAPER_CUT = (1.5e-3, 2.0e-3)   # m of tool travel: the last quarter of the paper
 TO_CHIP = " all friction heat to the chip"   # key suffix: chip_fraction 1 (the paper's SPH code's choice; scene 0.5)
 TO_2MM = " 2 mm"               # key suffix: a t_u = 0.1 mm case cut to 2 mm (20 t_u) on the paper's 3 mm workpiece
 TU_01 = (1, 4, 7, 10, 13, 16)   # the cases at t_u = 0.1 mm
+MATERIAL_NAMES = ("AISI1045", "Ti6Al4V")   # the tables' materials, in their order
 PFEM_FINE = ((1, 15.0), (2, 15.0), (3, 20.0), (5, 15.0), (8, 15.0), (6, 20.0), (9, 20.0))   # (case, nodes across
                                            # t_u) of the PFEM finer than t_u/10: the paper's 10 um near the tool
 PFEM_FINE_BOSSAK = (8, 9)                  # ... with the Bossak rule, as at t_u/10 (the trapezoidal rule stalled)
@@ -418,8 +419,13 @@ def pfem_resolution_jobs() -> list[tuple[str, dict]]:
     20 um); then AISI 1045's other cases at t_u = 0.15 and 0.20 mm at that spacing (at t_u/10 their rake faces are
     44-118 K hotter than the paper's PFEM, where cases 1, 4 and 7, at 10 um, are within 41 K of it), cases 8 and 9
     with the Bossak rule (PFEM_FINE_BOSSAK)."""
-    return [(f"case {n}{PFEM10} n_tu {n_tu:g}" + (BOSSAK if n in PFEM_FINE_BOSSAK else ""),
-             bossak_cut(n, n_tu) if n in PFEM_FINE_BOSSAK else converged(n, n_tu=n_tu)) for n, n_tu in PFEM_FINE]
+    return [(pfem_fine_key(n, n_tu), bossak_cut(n, n_tu) if n in PFEM_FINE_BOSSAK else converged(n, n_tu=n_tu))
+            for n, n_tu in PFEM_FINE]
+
+
+def pfem_fine_key(n: int, n_tu: float) -> str:
+    """The key of case ``n``'s PFEM cut at ``n_tu`` nodes across t_u (PFEM_FINE; BOSSAK for PFEM_FINE_BOSSAK)."""
+    return f"case {n}{PFEM10} n_tu {n_tu:g}" + (BOSSAK if n in PFEM_FINE_BOSSAK else "")
 
 
 QUICK = dict(length=1.2e-3, travel=4.0, n_tu=5.0)   # --quick: chapter 11's short cut at the quick resolution
@@ -589,7 +595,7 @@ def trends(rows) -> dict:
     measured verdict and counts are taken over the lines refsph has recorded (over every line where it has none)."""
     out = {}
     columns = dict(Fc=("Fc_N_per_mm", "Fc_exp"), Fp=("Fp_N_per_mm", "Fp_exp"), TRF=("TRF", "TRF_exp"))
-    for mat in ("AISI1045", "Ti6Al4V"):
+    for mat in MATERIAL_NAMES:
         get = {(r["vc"], r["tu"]): r for r in rows if r["material"] == mat}
         vcs, tus = sorted({k[0] for k in get}), sorted({k[1] for k in get})
         t = out[mat] = {}
@@ -620,7 +626,7 @@ def trend_steps(rows) -> dict:
     (steps with both recorded, of them the same sign, [(fixed value, refsph %, measured %) of those of opposite
     sign])}}."""
     out = {}
-    for mat in ("AISI1045", "Ti6Al4V"):
+    for mat in MATERIAL_NAMES:
         get = {(r["vc"], r["tu"]): r for r in rows if r["material"] == mat}
         vcs, tus = sorted({k[0] for k in get}), sorted({k[1] for k in get})
         out[mat] = {}
@@ -633,8 +639,9 @@ def trend_steps(rows) -> dict:
                     if a[col] is None or b[col] is None:
                         continue
                     d, de = 100.0 * (b[col] / a[col] - 1.0), 100.0 * (b[exp] / a[exp] - 1.0)
-                    n, same = n + 1, same + (np.sign(d) == np.sign(de))
-                    if np.sign(d) != np.sign(de):
+                    agree = np.sign(d) == np.sign(de)
+                    n, same = n + 1, same + agree
+                    if not agree:
                         other.append((fixed, d, de))
             out[mat][name] = (n, same, other)
     return out
@@ -692,7 +699,7 @@ def rake_face_ceiling(rows: list) -> list[dict]:
     whose thrust comes from the rake face's Coulomb friction can reach ('ceiling'; cases whose measured ratio lies
     above it). ``rows``: :func:`comparison`'s (their measured columns only)."""
     out = []
-    for mat in ("AISI1045", "Ti6Al4V"):
+    for mat in MATERIAL_NAMES:
         sel, (mu0, at_mu0, ceiling) = [r for r in rows if r["material"] == mat], _ceiling_law(mat)
         at_T = [ceiling(r["TRF_exp"]) for r in sel]
         exp = [r["ratio_exp"] for r in sel]
@@ -713,7 +720,7 @@ def own_ceilings(sets: dict) -> dict:
     its mean of Fp/Fc over that ceiling. ``sets``: {label: (rows, ratio key, T_RF key)} of :func:`comparison`'s
     rows. Above it, a prediction's thrust does not come from the friction law on the rake face alone."""
     out = {}
-    for mat in ("AISI1045", "Ti6Al4V"):
+    for mat in MATERIAL_NAMES:
         _, _, ceiling = _ceiling_law(mat)
         for label, (rows, rk, tk) in sets.items():
             c = [(r[rk], ceiling(r[tk])) for r in rows
@@ -728,7 +735,7 @@ def _own_ceiling_lines(rows: list, pfem10: list) -> list[str]:
             "refsph SPH": (rows, "ratio", "TRF"), "refsph PFEM": (pfem10, "ratio", "TRF")}
     got = own_ceilings(sets)
     return [f"| {mat} | " + " | ".join(f"{got[(mat, k)][0]} of {got[(mat, k)][1]} ({got[(mat, k)][2]:.2f})"
-                                       for k in sets) + " |" for mat in ("AISI1045", "Ti6Al4V")]
+                                       for k in sets) + " |" for mat in MATERIAL_NAMES]
 
 
 def rake_gaps(rows: list, groups: dict) -> list[dict]:
@@ -753,7 +760,7 @@ def _rake_gap_lines(gaps: list) -> list[str]:
     lines = ["| case | material | " + " | ".join(labels) + " |", "|---" * (len(labels) + 2) + "|"]
     lines += [f"| {g['case']} | {g['material']} | " + " | ".join(_f(g["gap"][k], ".0f") for k in labels) + " |"
               for g in gaps]
-    for mat in ("AISI1045", "Ti6Al4V"):
+    for mat in MATERIAL_NAMES:
         full = [g for g in gaps if g["material"] == mat and all(v is not None for v in g["gap"].values())]
         if full:
             lines.append(f"| mean ({len(full)} cases) | {mat} | "
@@ -783,7 +790,8 @@ def report(res: dict, before: dict | None = None) -> str:
     done = [r for r in rows if r["status"] == "ok"]
     lines = [P("head", n_tu=f"{N_TU:g}", travel=f"{TRAVEL:g}", inertia=f"{100 * INERTIA:g}", done=len(done))]
     lines += [_case_line(r) for r in rows] + ["", P("mean_errors")] + _mean_error_lines(rows, old)
-    lines += ["", P("refined_errors")] + _mean_error_lines(comparison(res, REFINED), old)
+    refined = comparison(res, REFINED)
+    lines += ["", P("refined_errors")] + _mean_error_lines(refined, old)
     coarse = comparison(res, COARSE)
     lines += ["", P("coarse", done=sum(r["status"] == "ok" for r in coarse))] + [_case_line(r) for r in coarse]
     lines += ["", P("coarse_errors")] + _mean_error_lines(coarse, old)
@@ -801,8 +809,8 @@ def report(res: dict, before: dict | None = None) -> str:
     spacing = paper_spacing_rows(res)
     lines += ["", P("paper_spacing", done=sum(r["status"] == "ok" for r in spacing))] + _paper_length_lines(
         spacing, "PFEM")
-    lines += ["", P("paper_spacing_errors")] + [x for x in _same_cases_lines(spacing) if "AISI1045" in x]
-    lines += ["", P("paper_spacing_2mm")] + [x for x in _paper_length_errors(spacing, "PFEM") if "AISI1045" in x]
+    lines += ["", P("paper_spacing_errors")] + _same_cases_lines(spacing, ("AISI1045",))
+    lines += ["", P("paper_spacing_2mm")] + _paper_length_errors(spacing, "PFEM", ("AISI1045",))
     lines += ["", P("pfem_forces")] + [_pfem_force_line(r, res) for r in pfem]
     dof = dof_rows(res)
     lines += ["", P("dof", **dof_changes(dof))] + _dof_lines(dof)
@@ -816,11 +824,10 @@ def report(res: dict, before: dict | None = None) -> str:
         v = _values(res["runs"][r["key"]]) if r["status"] == "ok" else {}
         lines.append(_row([(r["case"], "d")] + [(v.get(key), fmt) for _, key, fmt in STEADY_COLUMNS]))
     lines += ["", P("trends")]
-    for label, sel in (("SPH, t_u/10", rows), (f"SPH, t_u/10, ref update {REF_UPDATE:g}", comparison(res, REFINED)),
+    for label, sel in (("SPH, t_u/10", rows), (f"SPH, t_u/10, ref update {REF_UPDATE:g}", refined),
                        ("SPH, t_u/5", coarse), ("PFEM, t_u/5", pfem), ("PFEM, t_u/10", pfem10)):
         for mat, t in trends(sel).items():
             lines.append(f"| {mat} | {label} | " + " | ".join(_trend_cell(t, n) for n in TREND_NAMES) + " |")
-    refined = comparison(res, REFINED)
     noise = {(f"SPH, t_u/10, ref update {REF_UPDATE:g}", m): scatter(res, keys) for m, keys in
              (("AISI1045", SCATTER_REF), ("Ti6Al4V", SCATTER_TI10_REF))}
     noise.update({("SPH, t_u/10", m): scatter(res, keys) for m, keys in (("AISI1045", SCATTER_KEYS),
@@ -829,7 +836,7 @@ def report(res: dict, before: dict | None = None) -> str:
         {"SPH, t_u/10": rows, f"SPH, t_u/10, ref update {REF_UPDATE:g}": refined, "PFEM, t_u/10": pfem10}, noise)
     lines += ["", P("rake_ceiling")] + _ceiling_lines(rows)
     lines += ["", P("own_ceiling")] + _own_ceiling_lines(rows, pfem10)
-    gaps = rake_gaps(rows, {"refsph SPH": rows, f"refsph SPH, ref update {REF_UPDATE:g}": comparison(res, REFINED),
+    gaps = rake_gaps(rows, {"refsph SPH": rows, f"refsph SPH, ref update {REF_UPDATE:g}": refined,
                             "refsph PFEM": pfem10})
     lines += ["", P("rake_gap"), ""] + _rake_gap_lines(gaps)
     lines += _study_lines(res)
@@ -869,7 +876,7 @@ def dof_rows(res: dict) -> list[dict]:
     out = []
     for label, sfx_pf, sfx_sph in (("t_u/5", PFEM, COARSE), ("t_u/10", PFEM10, "")):
         pf_rows, sph_rows = comparison(res, sfx_pf), comparison(res, sfx_sph)
-        for mat in ("AISI1045", "Ti6Al4V"):
+        for mat in MATERIAL_NAMES:
             pf, sph = both_ok(pf_rows, sph_rows, mat)
             if not pf:
                 continue
@@ -908,7 +915,7 @@ def _dof_lines(rows: list[dict]) -> list[str]:
 def _mean_error_lines(rows: list, old: list | None) -> list[str]:
     """The mean-error table's rows: per material and quantity, refsph's, issue 19's ('before'), the paper's."""
     lines = []
-    for mat in ("AISI1045", "Ti6Al4V"):
+    for mat in MATERIAL_NAMES:
         sel = [r for r in rows if r["material"] == mat]
         was = [r for r in old if r["material"] == mat] if old else None
         ran = [r for r in sel if r["status"] == "ok"]
@@ -922,11 +929,12 @@ def _mean_error_lines(rows: list, old: list | None) -> list[str]:
     return lines
 
 
-def _same_cases_lines(rows: list) -> list[str]:
+def _same_cases_lines(rows: list, materials=MATERIAL_NAMES) -> list[str]:
     """refsph's PFEM against the paper's on the cases refsph recorded: each one's mean error there (against the
-    measurement), and refsph's mean and range of signed differences from the paper's PFEM prediction (percent)."""
+    measurement), and refsph's mean and range of signed differences from the paper's PFEM prediction (percent); a
+    row per quantity of each of ``materials``."""
     lines = []
-    for mat in ("AISI1045", "Ti6Al4V"):
+    for mat in materials:
         ran = [r for r in rows if r["material"] == mat and r["status"] == "ok"]
         for q, name in (("TRF", "T_RF, contact mean"), ("TFCS", "T_FCS"), ("ratio", "Fp/Fc")):
             d = [100.0 * (r[q] / r[f"{q}_pfem"] - 1.0) for r in ran]
@@ -968,7 +976,7 @@ def _gap_lines(gaps: list) -> list[str]:
     lines = [f"| {g['case']}{' †' if g['retried'] else ''} | {g['material']} | "
              + " | ".join(f"{g['ours'][q]:+.0f} | {g['paper'][q]:+.0f}" for q, _, _ in GAP_QUANTITIES) + " |"
              for g in gaps]
-    for mat in ("AISI1045", "Ti6Al4V"):
+    for mat in MATERIAL_NAMES:
         sel = [g for g in gaps if g["material"] == mat]
         if not sel:
             continue
@@ -1017,10 +1025,9 @@ def paper_length_rows(res: dict, suffix: str, keys: dict | None = None) -> list[
 
 def paper_spacing_rows(res: dict) -> list[dict]:
     """AISI 1045's nine PFEM cuts at the paper's node spacing, 10 um near the tool (its Figure 5): the t_u = 0.1 mm
-    cases' t_u/10 runs (PFEM10, with their retries), the others' PFEM_FINE runs (pfem_resolution_jobs), as
+    cases' t_u/10 runs (PFEM10, with their retries), the others' PFEM_FINE runs (pfem_fine_key), as
     :func:`paper_length_rows`."""
-    keys = {int(k.split()[1]): k for k, _ in pfem_resolution_jobs()}
-    keys = {n: k for n, k in keys.items() if n not in TU_01}
+    keys = {n: pfem_fine_key(n, n_tu) for n, n_tu in PFEM_FINE if n not in TU_01}
     return [r for r in paper_length_rows(res, PFEM10, keys) if r["material"] == "AISI1045"]
 
 
@@ -1038,10 +1045,11 @@ def _paper_length_lines(rows: list, method: str) -> list[str]:
     return lines
 
 
-def _paper_length_errors(rows: list, method: str) -> list[str]:
-    """Mean errors per material over the cases with a value at 2 mm: at 2 mm, at 16 t_u, the paper's method."""
+def _paper_length_errors(rows: list, method: str, materials=MATERIAL_NAMES) -> list[str]:
+    """Mean errors per material (of ``materials``) over the cases with a value at 2 mm: at 2 mm, at 16 t_u, the
+    paper's method."""
     lines, src = [], f"_{method.lower()}"
-    for mat in ("AISI1045", "Ti6Al4V"):
+    for mat in materials:
         got = [r for r in rows if r["material"] == mat and r["2mm"] and r["status"] == "ok"]
         for q, name in (("TRF", "T_RF, contact mean"), ("TFCS", "T_FCS"), ("ratio", "Fp/Fc")):
             at2 = float(np.mean([r["2mm"][q][1] for r in got])) if got else float("nan")
@@ -1383,7 +1391,7 @@ def _ledger_line(res: dict, suffix: str, base: str, name: str = "the t_u/10 tabl
     in percent of the tool's work, :func:`_values`), and the tool's work of the group over the base's (the mean of
     the per-case ratios)."""
     parts = []
-    for material in ("AISI1045", "Ti6Al4V"):
+    for material in MATERIAL_NAMES:
         here, other = both_ok(comparison(res, suffix), comparison(res, base), material)
         if not here:
             continue
@@ -1406,7 +1414,7 @@ def _group_errors(res: dict, suffix: str = COARSE + HALF_STEP, base: str = COARS
     :func:`comparison`)."""
     here, coarse = comparison(res, suffix), comparison(res, base)
     parts = []
-    for material in ("AISI1045", "Ti6Al4V"):
+    for material in MATERIAL_NAMES:
         h, c = both_ok(here, coarse, material)
         if h:
             errs = [f"{qn} {_mean(h, q):.1f} % ({'before ' if q == 'TRF_err' else ''}{_mean(c, q):.1f} %)"
@@ -1600,7 +1608,7 @@ def figures(res: dict) -> None:
             fig.legend(loc="outside right upper")
             study.save_figure(fig, FIG / f"11_thermal_cutting_{name}.png", dpi=100)
     fig, axes = plt.subplots(1, 2, figsize=(11, 4.2), constrained_layout=True)
-    for ax, mat in zip(axes, ("AISI1045", "Ti6Al4V")):
+    for ax, mat in zip(axes, MATERIAL_NAMES):
         for k, vc in enumerate(sorted({r["vc"] for r in rows if r["material"] == mat})):
             sel = sorted((r for r in rows if r["material"] == mat and r["vc"] == vc), key=lambda r: r["tu"])
             ax.plot([r["tu"] for r in sel], [r["Fc_exp"] for r in sel], "s--", color=f"C{k}",
@@ -1624,7 +1632,7 @@ def dof_figure(rows: list[dict], plt) -> None:
     measurements over its degrees of freedom, t_u/5 then t_u/10, the paper's SPH and PFEM means on the same cases as
     lines (over the cases of the table's last row of that material)."""
     fig, axes = plt.subplots(2, len(DOF_QUANTITIES), figsize=(12, 6.2), constrained_layout=True, squeeze=False)
-    for i, mat in enumerate(("AISI1045", "Ti6Al4V")):
+    for i, mat in enumerate(MATERIAL_NAMES):
         sel = [r for r in rows if r["material"] == mat]
         for j, (q, name) in enumerate(DOF_QUANTITIES):
             ax = axes[i][j]

@@ -245,8 +245,10 @@ def measure(key: str, travel: float, scratch: Path, folder: Path | None = None, 
     if recorded["status"] != "ok" or len(rows) == 0:
         raise SystemExit(f"{key!r}: the run in {folder} did not end 'ok', or no contact in the window")
     out = split(rows, RAKE_DEG)
-    m, row = recorded["metrics"], recorded["scene_info"]["measured"]
+    m, info = recorded["metrics"], recorded["scene_info"]
+    row = info["measured"]
     return dict(key=label or key, method=method, numerics_changed=dict(numerics or {}), material=row["material"],
+                case=info["case"], dx_m=info["dx"], tu_m=info["tu_m"],
                 measured_force_ratio=row["Fp_exp_N"] / row["Fc_exp_N"], travel_t_u=travel, evaluations=len(rows),
                 t_start_s=recorded["t_final"], t_end_s=window["t_final"],
                 recorded_Fc_N_per_m=m["cutting_force_N_per_m"], recorded_Fp_N_per_m=m["passive_force_N_per_m"], **out)
@@ -259,22 +261,37 @@ def share(r: dict, name: str, k: str) -> float:
     return (p[f"{k}_normal"] + p[f"{k}_friction"]) / r[k]
 
 
-HEAD = ("case", "material", "Fc [N/mm] window (record)", "Fp/Fc window (record)", "Fp/Fc measured",
+def spacing(r: dict, runs: dict) -> tuple:
+    """(case, dx [m]) of row ``r``: recorded in the row, or, for a row made before they were (labelled by its sweep
+    key or that key's run folder, a what-if by the key before its comma), the sweep record's; (None, None) where
+    neither says."""
+    if "dx_m" in r:
+        return r["case"], r["dx_m"]
+    label = r["key"].split(",")[0]
+    for key, record in runs.items():
+        if label in (key, thermal_cutting.run_folder(key).name) and record.get("status") == "ok":
+            return record["scene_info"]["case"], record["scene_info"]["dx"]
+    return None, None
+
+
+HEAD = ("case", "material", "dx [um]", "Fc [N/mm] window (record)", "Fp/Fc window (record)", "Fp/Fc measured",
         "rake face: share of Fc, Fp", "edge", "flank",
         "rake face mu_eff / mu(T)", "slipping share of rake f_N", "Fp/Fc of the rake face alone",
         "Merchant bound at mu(T)", "Fp/Fc with the rake face slipping at mu(T)")
 
 
-def table(results: list) -> str:
-    """The markdown table of the results."""
+def table(results: list, runs: dict | None = None) -> str:
+    """The markdown table of the results (``runs``: the sweep's records, for the spacing of older rows)."""
     rows = []
     for r in results:
+        dx = spacing(r, runs or {})[1]
         rake = r["parts"]["rake face"]
 
         def shares(name):
             return f"{share(r, name, 'Fc'):.2f}, {share(r, name, 'Fp'):.2f}"
         label = r["key"] + (" (PFEM)" if r.get("method") == "pfem" else "")
-        rows.append([label, r["material"], f"{r['Fc'] / 1e3:.0f} ({r['recorded_Fc_N_per_m'] / 1e3:.0f})",
+        rows.append([label, r["material"], "-" if dx is None else f"{dx * 1e6:.1f}",
+                     f"{r['Fc'] / 1e3:.0f} ({r['recorded_Fc_N_per_m'] / 1e3:.0f})",
                      f"{r['force_ratio']:.2f} ({r['recorded_Fp_N_per_m'] / r['recorded_Fc_N_per_m']:.2f})",
                      f"{r['measured_force_ratio']:.2f}",
                      shares("rake face"), shares("edge"), shares("flank"),
@@ -304,7 +321,8 @@ def report(doc: dict) -> str:
     fc_dev = max(abs(r["Fc"] / r["recorded_Fc_N_per_m"] - 1) for r in results)
     ratio_dev = max(abs(r["force_ratio"] - r["recorded_Fp_N_per_m"] / r["recorded_Fc_N_per_m"]) for r in results)
     travel = sorted({r["travel_t_u"] for r in results})
-    parts = [page("head", travel="/".join(f"{t:g}" for t in travel), rake_deg=f"{RAKE_DEG:g}"), table(results),
+    runs = json.loads(SWEEP_JSON.read_text())["runs"] if SWEEP_JSON.exists() else {}
+    parts = [page("head", travel="/".join(f"{t:g}" for t in travel), rake_deg=f"{RAKE_DEG:g}"), table(results, runs),
              page("how_to_read", fc_window_dev=f"{100 * fc_dev:.0f}", ratio_window_dev=f"{ratio_dev:.2f}", **v)]
     for material in sorted({group(r) for r in results}):
         rs = [r for r in results if group(r) == material and not r.get("numerics_changed")]
@@ -328,7 +346,36 @@ def report(doc: dict) -> str:
                       f"at or above the measured ratio in {', '.join(above)}", slipping="; ".join(slipping)))
     parts += [whatif(page, r, base) for r in results if r.get("numerics_changed")
               for base in results if base["key"] == r["key"].split(",")[0]]
+    pairs = spacing_pairs(results, runs)
+    if pairs:
+        parts.append(page("spacing", pairs="; ".join(pairs)))
     return "\n\n".join(parts) + "\n"
+
+
+def spacing_pairs(results: list, runs: dict) -> list:
+    """One phrase per case and method split at more than one node spacing (rows with the sweep's numerics): how
+    the edge's share of Fc and Fp, the rake face's mu_eff / mu(T) and the window's Fp/Fc move from the coarsest
+    spacing to the finest."""
+    groups = {}
+    for r in results:
+        case, dx = spacing(r, runs)
+        if dx is not None and not r.get("numerics_changed"):
+            groups.setdefault((case, r.get("method", "tlsph")), []).append((dx, r))
+    out = []
+    for (case, method), rows in sorted(groups.items()):
+        if len({dx for dx, _ in rows}) < 2:
+            continue
+        rows.sort(key=lambda t: -t[0])
+        (dx0, a), (dx1, b) = rows[0], rows[-1]
+
+        def rake(x):
+            return f"{x['parts']['rake face']['mu_eff']:.2f} / {x['parts']['rake face']['mu_law']:.2f}"
+        out.append(f"case {case} ({'PFEM' if method == 'pfem' else 'SPH'}; '{a['key']}' -> '{b['key']}'), "
+                   f"{dx0 * 1e6:.0f} -> {dx1 * 1e6:.0f} um: "
+                   f"the edge's share of Fc {share(a, 'edge', 'Fc'):.2f} -> {share(b, 'edge', 'Fc'):.2f} and of Fp "
+                   f"{share(a, 'edge', 'Fp'):.2f} -> {share(b, 'edge', 'Fp'):.2f}, the rake face's mu_eff / mu(T) "
+                   f"{rake(a)} -> {rake(b)}, Fp/Fc {a['force_ratio']:.2f} -> {b['force_ratio']:.2f}")
+    return out
 
 
 def whatif(page, r: dict, base: dict) -> str:

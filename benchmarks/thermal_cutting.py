@@ -418,9 +418,13 @@ def pfem_resolution_jobs() -> list[tuple[str, dict]]:
     node spacing, 10 um near the tool (15 and 20 nodes across t_u = 0.15 and 0.20 mm, where t_u/10 is 15 and
     20 um); then AISI 1045's other cases at t_u = 0.15 and 0.20 mm at that spacing (at t_u/10 their rake faces are
     44-118 K hotter than the paper's PFEM, where cases 1, 4 and 7, at 10 um, are within 41 K of it), cases 8 and 9
-    with the Bossak rule (PFEM_FINE_BOSSAK)."""
-    return [(pfem_fine_key(n, n_tu), bossak_cut(n, n_tu) if n in PFEM_FINE_BOSSAK else converged(n, n_tu=n_tu))
+    with the Bossak rule (PFEM_FINE_BOSSAK), and so at t_u/5 too (:func:`pfem_spacing_keys`: the three spacings of
+    one case on one rule; case 8's is the time rule's study's)."""
+    fine = [(pfem_fine_key(n, n_tu), bossak_cut(n, n_tu) if n in PFEM_FINE_BOSSAK else converged(n, n_tu=n_tu))
             for n, n_tu in PFEM_FINE]
+    taken = {k for k, _ in time_rule_jobs()}
+    return fine + [(pfem_spacing_keys(n)[0], bossak_cut(n, 5.0)) for n in PFEM_FINE_BOSSAK
+                   if pfem_spacing_keys(n)[0] not in taken]
 
 
 def pfem_fine_key(n: int, n_tu: float) -> str:
@@ -811,6 +815,7 @@ def report(res: dict, before: dict | None = None) -> str:
         spacing, "PFEM")
     lines += ["", P("paper_spacing_errors")] + _same_cases_lines(spacing, ("AISI1045",))
     lines += ["", P("paper_spacing_2mm")] + _paper_length_errors(spacing, "PFEM", ("AISI1045",))
+    lines += ["", P("pfem_spacing_orders")] + _pfem_spacing_lines(pfem_spacing_convergence(res))
     lines += ["", P("pfem_forces")] + [_pfem_force_line(r, res) for r in pfem]
     dof = dof_rows(res)
     lines += ["", P("dof", **dof_changes(dof))] + _dof_lines(dof)
@@ -1029,6 +1034,70 @@ def paper_spacing_rows(res: dict) -> list[dict]:
     :func:`paper_length_rows`."""
     keys = {n: pfem_fine_key(n, n_tu) for n, n_tu in PFEM_FINE if n not in TU_01}
     return [r for r in paper_length_rows(res, PFEM10, keys) if r["material"] == "AISI1045"]
+
+
+def pfem_spacing_keys(n: int) -> tuple:
+    """Case ``n``'s PFEM cuts at three node spacings near the tool, coarsest first: t_u/5 (PFEM), t_u/10 (PFEM10)
+    and 10 um (pfem_fine_key); a PFEM_FINE_BOSSAK case on the Bossak rule at every spacing, so that only the
+    spacing changes."""
+    rule = BOSSAK if n in PFEM_FINE_BOSSAK else ""
+    fine = dict(PFEM_FINE)[n]
+    return (f"case {n}{PFEM}{rule}", f"case {n}{PFEM10}" + (f" n_tu 10{rule}" if rule else ""), pfem_fine_key(n, fine))
+
+
+PFEM_ORDER_QUANTITIES = (("T_RF [K]", "rake_face_temperature_K", ".0f", "TRF"),
+                         ("T_FCS [K]", "free_chip_surface_temperature_K", ".0f", "TFCS"),
+                         ("Fc [N/mm]", "Fc", ".1f", None), ("Fp [N/mm]", "Fp", ".1f", None),
+                         ("Fp/Fc", "force_ratio", ".3f", "ratio"))
+
+
+def pfem_spacing_convergence(res: dict) -> list[dict]:
+    """Per case of PFEM_FINE with its three spacings recorded (:func:`pfem_spacing_keys`) and per quantity: the
+    values f at dx = t_u/5, t_u/10 and the fine spacing, the changes in percent, the observed order p of
+    f = f0 + C dx^p (``study.observed_order``; None where the changes differ in sign or grow) and the extrapolated
+    f0 (``study.richardson``), beside the measured value and the paper's PFEM (``comparison``)."""
+    from refsph.paper_data import rla_cutting_case
+    out = []
+    for n in sorted(dict(PFEM_FINE)):
+        keys = pfem_spacing_keys(n)
+        runs = [res["runs"].get(k) for k in keys]
+        missing = [k for k, r in zip(keys, runs) if r is None or r.get("status") != "ok"]
+        if missing:
+            out.append(dict(case=n, keys=missing, name=None))
+            continue
+        vals, c = [_values(r) for r in runs], rla_cutting_case(n)
+        h = [v["dx_um"] for v in vals]
+        for name, q, spec, paper in PFEM_ORDER_QUANTITIES:
+            f = [float(v[q]) for v in vals]
+            p = study.observed_order(h, f)
+            f0 = study.richardson(h, f, p) if p is not None and math.isfinite(p) else None
+            if paper == "ratio":
+                exp, pfem = c["Fp_exp_N"] / c["Fc_exp_N"], c["Fp_pfem_N"] / c["Fc_pfem_N"]
+            elif paper:
+                exp, pfem = c[f"{paper}_exp_K"], c[f"{paper}_pfem_K"]
+            else:
+                exp = pfem = None
+            out.append(dict(case=n, keys=keys, name=name, spec=spec, h=h, f=f, p=p, f0=f0, exp=exp, pfem=pfem,
+                            d1=_rel(f[1], f[0]), d2=_rel(f[2], f[1])))
+    return out
+
+
+def _pfem_spacing_lines(rows: list) -> list[str]:
+    """The table of :func:`pfem_spacing_convergence`; a case still to run as one line naming its missing keys."""
+    lines = ["", "| case | quantity | dx [um] | t_u/5 | t_u/10 | fine | t_u/5 -> 10 | t_u/10 -> fine | observed order "
+             "| extrapolated | measured | paper PFEM |", "|---" * 12 + "|"]
+    for r in rows:
+        if r["name"] is None:
+            lines.append(f"| {r['case']} | to run: " + ", ".join(f"'{k}'" for k in r["keys"]) + " |" + " |" * 10)
+            continue
+        spec = r["spec"]
+        order = ("changes differ in sign or grow" if r["p"] is None else
+                 "above 20" if not math.isfinite(r["p"]) else f"{r['p']:.1f}")
+        cells = [r["case"], r["name"], " / ".join(f"{x:.0f}" for x in r["h"])] + [_f(x, spec) for x in r["f"]] + [
+            _change_cell(r["d1"]), _change_cell(r["d2"]), order, _f(r["f0"], spec), _f(r["exp"], spec),
+            _f(r["pfem"], spec)]
+        lines.append("| " + " | ".join(str(x) for x in cells) + " |")
+    return lines
 
 
 def _paper_length_lines(rows: list, method: str) -> list[str]:

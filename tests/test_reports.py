@@ -437,6 +437,29 @@ def test_thermal_cutting_paper_spacing_takes_the_fine_runs_of_the_thicker_cuts()
     assert rows[2]["2mm"]["TRF"][0] == pytest.approx(mod.window_means(runs["case 2 pfem"], 1.0, *mod.PAPER_CUT)["TRF"])
 
 
+
+def test_thermal_cutting_pfem_spacing_order_through_three_spacings():
+    """pfem_spacing_convergence: case 2's three PFEM spacings with Fc = 400 + C dx^2 give the order 2 and the limit
+    400, T_RF changing sign gives no order; a case with a spacing missing names only the missing key; the Bossak
+    cases take their Bossak runs at every spacing."""
+    mod = _script("thermal_cutting")
+    assert mod.pfem_spacing_keys(9) == ("case 9 pfem n_tu 5" + mod.BOSSAK, "case 9 pfem n_tu 10" + mod.BOSSAK,
+                                        "case 9 pfem n_tu 20" + mod.BOSSAK)
+    keys = mod.pfem_spacing_keys(2)
+    assert keys == ("case 2 pfem n_tu 5", "case 2 pfem", "case 2 pfem n_tu 15")
+    runs = {k: _resolution_record(400.0 + 1e3 * (1.0 / n) ** 2, n) for k, n in zip(keys, (5, 10, 15))}
+    for r, t in zip(runs.values(), (600.0, 620.0, 610.0)):
+        r["metrics"]["rake_face_temperature_K"] = t
+    rows = {(r["case"], r["name"]): r for r in mod.pfem_spacing_convergence(dict(runs=runs))}
+    fc = rows[2, "Fc [N/mm]"]
+    assert fc["p"] == pytest.approx(2.0, rel=1e-6) and fc["f0"] == pytest.approx(400.0, rel=1e-9)
+    assert fc["h"] == pytest.approx([20.0, 10.0, 1e2 / 15])
+    assert rows[2, "T_RF [K]"]["p"] is None and rows[2, "T_RF [K]"]["f0"] is None
+    assert rows[2, "T_RF [K]"]["exp"] == 730.0                                   # the measured value of case 2
+    assert rows[3, None]["keys"] == list(mod.pfem_spacing_keys(3))             # nothing of case 3 given
+    del runs["case 2 pfem"]
+    assert [r["keys"] for r in mod.pfem_spacing_convergence(dict(runs=runs)) if r["case"] == 2] == [["case 2 pfem"]]
+
 def _resolution_record(fc, n):
     """A made-up 'ok' record of a cut at n particles across t_u with Fc = ``fc`` N/mm (the other quantities fixed)."""
     return dict(status="ok", dp=1e-4 / n, scene_info=dict(tu_m=1e-4),

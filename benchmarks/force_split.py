@@ -374,7 +374,9 @@ def spacing_pairs(results: list, runs: dict) -> list:
                    f"{dx0 * 1e6:.0f} -> {dx1 * 1e6:.0f} um: "
                    f"the edge's share of Fc {share(a, 'edge', 'Fc'):.2f} -> {share(b, 'edge', 'Fc'):.2f} and of Fp "
                    f"{share(a, 'edge', 'Fp'):.2f} -> {share(b, 'edge', 'Fp'):.2f}, the rake face's mu_eff / mu(T) "
-                   f"{rake(a)} -> {rake(b)}, Fp/Fc {a['force_ratio']:.2f} -> {b['force_ratio']:.2f}")
+                   f"{rake(a)} -> {rake(b)}, Fp/Fc {a['force_ratio']:.2f} -> {b['force_ratio']:.2f} "
+                   f"(Merchant's bound at mu(T) {a['merchant_bound_mu_law']:.2f} -> "
+                   f"{b['merchant_bound_mu_law']:.2f})")
     return out
 
 

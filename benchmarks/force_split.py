@@ -353,30 +353,31 @@ def report(doc: dict) -> str:
 
 
 def spacing_pairs(results: list, runs: dict) -> list:
-    """One phrase per case and method split at more than one node spacing (rows with the sweep's numerics): how
-    the edge's share of Fc and Fp, the rake face's mu_eff / mu(T) and the window's Fp/Fc move from the coarsest
-    spacing to the finest."""
+    """One phrase per case and method split at more than one spacing (rows with the sweep's numerics), coarsest
+    to finest: the edge's share of Fc and Fp, the rake face's slipping share and mu_eff / mu(T), the window's
+    Fp/Fc and Merchant's bound at mu(T)."""
     groups = {}
     for r in results:
         case, dx = spacing(r, runs)
         if dx is not None and not r.get("numerics_changed"):
             groups.setdefault((case, r.get("method", "tlsph")), []).append((dx, r))
     out = []
-    for (case, method), rows in sorted(groups.items()):
-        if len({dx for dx, _ in rows}) < 2:
+    for (case, method), pairs in sorted(groups.items()):
+        if len({dx for dx, _ in pairs}) < 2:
             continue
-        rows.sort(key=lambda t: -t[0])
-        (dx0, a), (dx1, b) = rows[0], rows[-1]
+        pairs.sort(key=lambda t: -t[0])
+        rows, rake = [r for _, r in pairs], [r["parts"]["rake face"] for _, r in pairs]
 
-        def rake(x):
-            return f"{x['parts']['rake face']['mu_eff']:.2f} / {x['parts']['rake face']['mu_law']:.2f}"
-        out.append(f"case {case} ({'PFEM' if method == 'pfem' else 'SPH'}; '{a['key']}' -> '{b['key']}'), "
-                   f"{dx0 * 1e6:.0f} -> {dx1 * 1e6:.0f} um: "
-                   f"the edge's share of Fc {share(a, 'edge', 'Fc'):.2f} -> {share(b, 'edge', 'Fc'):.2f} and of Fp "
-                   f"{share(a, 'edge', 'Fp'):.2f} -> {share(b, 'edge', 'Fp'):.2f}, the rake face's mu_eff / mu(T) "
-                   f"{rake(a)} -> {rake(b)}, Fp/Fc {a['force_ratio']:.2f} -> {b['force_ratio']:.2f} "
-                   f"(Merchant's bound at mu(T) {a['merchant_bound_mu_law']:.2f} -> "
-                   f"{b['merchant_bound_mu_law']:.2f})")
+        def chain(values, spec=".2f") -> str:
+            return " -> ".join(v if isinstance(v, str) else format(v, spec) for v in values)
+        keys = chain([repr(r["key"]) for r in rows])
+        edge_fc, edge_fp = (chain([share(r, "edge", k) for r in rows]) for k in ("Fc", "Fp"))
+        mus = chain([f"{x['mu_eff']:.2f} / {x['mu_law']:.2f}" for x in rake])
+        out.append(f"case {case} ({'PFEM' if method == 'pfem' else 'SPH'}; {keys}), "
+                   f"{chain([1e6 * dx for dx, _ in pairs], '.1f')} um: the edge's share of Fc {edge_fc} and of Fp "
+                   f"{edge_fp}, the rake face's slipping share {chain([x['slip_share'] for x in rake])} and mu_eff / "
+                   f"mu(T) {mus}, Fp/Fc {chain([r['force_ratio'] for r in rows])} (Merchant's bound at mu(T) "
+                   f"{chain([r['merchant_bound_mu_law'] for r in rows])})")
     return out
 
 

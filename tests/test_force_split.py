@@ -161,6 +161,6 @@ def test_spacing_pairs_compare_one_case_across_spacings():
     assert fs.spacing(dict(rows[0], key="case_3_pfem"), runs) == (3, 2e-5)
     assert fs.spacing(dict(rows[0], key="case 3 pfem, penalty 1"), runs) == (3, 2e-5)
     (phrase,) = fs.spacing_pairs([a, b, dict(a, key="what-if", numerics_changed={"x": 1}, dx_m=5e-6)], {})
-    assert phrase.startswith("case 7 (PFEM; 'coarse' -> 'fine'), 20 -> 10 um: the edge's share of Fc 0.00 -> "
+    assert phrase.startswith("case 7 (PFEM; 'coarse' -> 'fine'), 20.0 -> 10.0 um: the edge's share of Fc 0.00 -> "
                              f"{fs.share(a, 'edge', 'Fc'):.2f}")
     assert fs.spacing_pairs([a], {}) == []

@@ -354,13 +354,16 @@ def report(doc: dict) -> str:
 
 def spacing_pairs(results: list, runs: dict) -> list:
     """One phrase per case and method split at more than one spacing (rows with the sweep's numerics), coarsest
-    to finest: the edge's share of Fc and Fp, the rake face's slipping share and mu_eff / mu(T), the window's
-    Fp/Fc and Merchant's bound at mu(T)."""
+    to finest (of rows at the same spacing the first in ``results``): the edge's share of Fc and Fp, the rake
+    face's slipping share and mu_eff / mu(T), the window's Fp/Fc and Merchant's bound at mu(T)."""
     groups = {}
     for r in results:
         case, dx = spacing(r, runs)
-        if dx is not None and not r.get("numerics_changed"):
-            groups.setdefault((case, r.get("method", "tlsph")), []).append((dx, r))
+        if dx is None or r.get("numerics_changed"):
+            continue
+        rows = groups.setdefault((case, r.get("method", "tlsph")), [])
+        if all(dx != d for d, _ in rows):                  # one row per spacing: the first in the file
+            rows.append((dx, r))
     out = []
     for (case, method), pairs in sorted(groups.items()):
         if len({dx for dx, _ in pairs}) < 2:

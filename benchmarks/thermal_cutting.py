@@ -1038,8 +1038,8 @@ def paper_spacing_rows(res: dict) -> list[dict]:
 
 def pfem_spacing_keys(n: int) -> tuple:
     """Case ``n``'s PFEM cuts at three node spacings near the tool, coarsest first: t_u/5 (PFEM), t_u/10 (PFEM10)
-    and 10 um (pfem_fine_key); a PFEM_FINE_BOSSAK case on the Bossak rule at every spacing, so that only the
-    spacing changes."""
+    and PFEM_FINE's (pfem_fine_key: 10 um, t_u/15 for case 1); a PFEM_FINE_BOSSAK case on the Bossak rule at
+    every spacing, so that only the spacing changes."""
     rule = BOSSAK if n in PFEM_FINE_BOSSAK else ""
     fine = dict(PFEM_FINE)[n]
     return (f"case {n}{PFEM}{rule}", f"case {n}{PFEM10}" + (f" n_tu 10{rule}" if rule else ""), pfem_fine_key(n, fine))
@@ -1061,7 +1061,8 @@ def pfem_spacing_convergence(res: dict) -> list[dict]:
     for n in sorted(dict(PFEM_FINE)):
         keys = pfem_spacing_keys(n)
         runs = [res["runs"].get(k) for k in keys]
-        missing = [k for k, r in zip(keys, runs) if r is None or r.get("status") != "ok"]
+        missing = [f"'{k}'" + ("" if r is None else f" ({r.get('status')})") for k, r in zip(keys, runs)
+                   if r is None or r.get("status") != "ok"]
         if missing:
             out.append(dict(case=n, keys=missing, name=None))
             continue
@@ -1083,12 +1084,13 @@ def pfem_spacing_convergence(res: dict) -> list[dict]:
 
 
 def _pfem_spacing_lines(rows: list) -> list[str]:
-    """The table of :func:`pfem_spacing_convergence`; a case still to run as one line naming its missing keys."""
+    """The table of :func:`pfem_spacing_convergence`; a case still to run as one line naming its missing keys (a
+    failed record with its status)."""
     lines = ["", "| case | quantity | dx [um] | t_u/5 | t_u/10 | fine | t_u/5 -> 10 | t_u/10 -> fine | observed order "
              "| extrapolated | measured | paper PFEM |", "|---" * 12 + "|"]
     for r in rows:
         if r["name"] is None:
-            lines.append(f"| {r['case']} | to run: " + ", ".join(f"'{k}'" for k in r["keys"]) + " |" + " |" * 10)
+            lines.append(f"| {r['case']} | to run: " + ", ".join(r["keys"]) + " |" + " |" * 10)
             continue
         spec = r["spec"]
         order = ("changes differ in sign or grow" if r["p"] is None else

@@ -153,14 +153,17 @@ def test_spacing_pairs_compare_one_case_across_spacings():
     """A row's spacing comes from the row or from the sweep's record of its key (or run folder); rows of one case
     and method at two spacings give one phrase, coarsest to finest; a what-if or a lone spacing gives none."""
     fs = _script()
-    rows = json.loads((ROOT / "benchmarks" / "force_split.json").read_text())["results"]
-    a, b = (dict(rows[0], key=k, method="pfem", case=7, dx_m=dx) for k, dx in (("fine", 1e-5), ("coarse", 2e-5)))
+    row = {k: v for k, v in json.loads((ROOT / "benchmarks" / "force_split.json").read_text())["results"][0].items()
+           if k not in ("case", "dx_m", "tu_m")}                     # a row as made before the spacing was kept
+    rows = [row]
+    a, b = (dict(row, key=k, method="pfem", case=7, dx_m=dx) for k, dx in (("fine", 1e-5), ("coarse", 2e-5)))
     b["parts"] = dict(b["parts"], edge={k: 0.0 for k in b["parts"]["edge"]})
     assert fs.spacing(a, {}) == (7, 1e-5) and fs.spacing(dict(rows[0], key="nowhere"), {}) == (None, None)
     runs = {"case 3 pfem": dict(status="ok", scene_info=dict(case=3, dx=2e-5))}
     assert fs.spacing(dict(rows[0], key="case_3_pfem"), runs) == (3, 2e-5)
     assert fs.spacing(dict(rows[0], key="case 3 pfem, penalty 1"), runs) == (3, 2e-5)
-    (phrase,) = fs.spacing_pairs([a, b, dict(a, key="what-if", numerics_changed={"x": 1}, dx_m=5e-6)], {})
+    (phrase,) = fs.spacing_pairs([a, b, dict(a, key="what-if", numerics_changed={"x": 1}, dx_m=5e-6),
+                                  dict(b, key="coarse again")], {})            # one row per spacing: the first
     assert phrase.startswith("case 7 (PFEM; 'coarse' -> 'fine'), 20.0 -> 10.0 um: the edge's share of Fc 0.00 -> "
                              f"{fs.share(a, 'edge', 'Fc'):.2f}")
     assert fs.spacing_pairs([a], {}) == []

@@ -456,9 +456,15 @@ def test_thermal_cutting_pfem_spacing_order_through_three_spacings():
     assert fc["h"] == pytest.approx([20.0, 10.0, 1e2 / 15])
     assert rows[2, "T_RF [K]"]["p"] is None and rows[2, "T_RF [K]"]["f0"] is None
     assert rows[2, "T_RF [K]"]["exp"] == 730.0                                   # the measured value of case 2
-    assert rows[3, None]["keys"] == list(mod.pfem_spacing_keys(3))             # nothing of case 3 given
-    del runs["case 2 pfem"]
-    assert [r["keys"] for r in mod.pfem_spacing_convergence(dict(runs=runs)) if r["case"] == 2] == [["case 2 pfem"]]
+    assert rows[3, None]["keys"] == [f"'{k}'" for k in mod.pfem_spacing_keys(3)]   # nothing of case 3 given
+    runs["case 2 pfem"] = dict(status="failed")
+    (row,) = [r for r in mod.pfem_spacing_convergence(dict(runs=runs)) if r["case"] == 2]
+    assert row["keys"] == ["'case 2 pfem' (failed)"]
+    lines = mod._pfem_spacing_lines([row])
+    assert lines[-1].count("|") == lines[1].count("|") and "'case 2 pfem' (failed)" in lines[-1]
+    jobs = [k for k, _ in mod.pfem_resolution_jobs()]
+    assert "case 9 pfem n_tu 5" + mod.BOSSAK in jobs and "case 8 pfem n_tu 5" + mod.BOSSAK not in jobs   # the
+    assert "case 8 pfem n_tu 5" + mod.BOSSAK in [k for k, _ in mod.time_rule_jobs()]       # time rule's study's
 
 def _resolution_record(fc, n):
     """A made-up 'ok' record of a cut at n particles across t_u with Fc = ``fc`` N/mm (the other quantities fixed)."""

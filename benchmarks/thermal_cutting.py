@@ -1045,6 +1045,8 @@ def pfem_spacing_keys(n: int) -> tuple:
     return (f"case {n}{PFEM}{rule}", f"case {n}{PFEM10}" + (f" n_tu 10{rule}" if rule else ""), pfem_fine_key(n, fine))
 
 
+PFEM_ORDER_MIN = 0.5    # below this observed order the extrapolation of pfem_spacing_convergence is not made: its
+#                         correction would be many times the last change (case 8's T_FCS at p = 0.2: +356 K on +28 K)
 PFEM_ORDER_QUANTITIES = (("T_RF [K]", "rake_face_temperature_K", ".0f", "TRF"),
                          ("T_FCS [K]", "free_chip_surface_temperature_K", ".0f", "TFCS"),
                          ("Fc [N/mm]", "Fc", ".1f", None), ("Fp [N/mm]", "Fp", ".1f", None),
@@ -1055,7 +1057,8 @@ def pfem_spacing_convergence(res: dict) -> list[dict]:
     """Per case of PFEM_FINE with its three spacings recorded (:func:`pfem_spacing_keys`) and per quantity: the
     values f at dx = t_u/5, t_u/10 and the fine spacing, the changes in percent, the observed order p of
     f = f0 + C dx^p (``study.observed_order``; None where the changes differ in sign or grow) and the extrapolated
-    f0 (``study.richardson``), beside the measured value and the paper's PFEM (``comparison``)."""
+    f0 (``study.richardson``; None below PFEM_ORDER_MIN), beside the measured value and the paper's PFEM
+    (``comparison``)."""
     from refsph.paper_data import rla_cutting_case
     out = []
     for n in sorted(dict(PFEM_FINE)):
@@ -1071,7 +1074,7 @@ def pfem_spacing_convergence(res: dict) -> list[dict]:
         for name, q, spec, paper in PFEM_ORDER_QUANTITIES:
             f = [float(v[q]) for v in vals]
             p = study.observed_order(h, f)
-            f0 = study.richardson(h, f, p) if p is not None and math.isfinite(p) else None
+            f0 = study.richardson(h, f, p) if p is not None and PFEM_ORDER_MIN <= p < math.inf else None
             if paper == "ratio":
                 exp, pfem = c["Fp_exp_N"] / c["Fc_exp_N"], c["Fp_pfem_N"] / c["Fc_pfem_N"]
             elif paper:

@@ -455,6 +455,10 @@ def test_thermal_cutting_pfem_spacing_order_through_three_spacings():
     assert fc["p"] == pytest.approx(2.0, rel=1e-6) and fc["f0"] == pytest.approx(400.0, rel=1e-9)
     assert fc["h"] == pytest.approx([20.0, 10.0, 1e2 / 15])
     assert rows[2, "T_RF [K]"]["p"] is None and rows[2, "T_RF [K]"]["f0"] is None
+    slow = mod.pfem_spacing_convergence(dict(runs={k: _resolution_record(400.0 + 1e3 * (1.0 / n) ** 0.3, n)
+                                                   for k, n in zip(keys, (5, 10, 15))}))
+    (fc,) = [r for r in slow if r["case"] == 2 and r["name"] == "Fc [N/mm]"]
+    assert fc["p"] == pytest.approx(0.3, rel=1e-6) and fc["f0"] is None          # below PFEM_ORDER_MIN: none
     assert rows[2, "T_RF [K]"]["exp"] == 730.0                                   # the measured value of case 2
     assert rows[3, None]["keys"] == [f"'{k}'" for k in mod.pfem_spacing_keys(3)]   # nothing of case 3 given
     runs["case 2 pfem"] = dict(status="failed")

@@ -1059,8 +1059,7 @@ def pfem_spacing_convergence(res: dict) -> list[dict]:
     f = f0 + C dx^p (``study.observed_order``; None where the changes differ in sign or grow) and the extrapolated
     f0 (``study.richardson``; None below PFEM_ORDER_MIN), beside the measured value and the paper's PFEM
     (``comparison``)."""
-    from refsph.paper_data import rla_cutting_case
-    out = []
+    paper_rows, out = {r["case"]: r for r in comparison(res, PFEM10)}, []   # its measured and paper columns only
     for n in sorted(dict(PFEM_FINE)):
         keys = pfem_spacing_keys(n)
         runs = [res["runs"].get(k) for k in keys]
@@ -1069,18 +1068,13 @@ def pfem_spacing_convergence(res: dict) -> list[dict]:
         if missing:
             out.append(dict(case=n, keys=missing, name=None))
             continue
-        vals, c = [_values(r) for r in runs], rla_cutting_case(n)
+        vals, c = [_values(r) for r in runs], paper_rows[n]
         h = [v["dx_um"] for v in vals]
         for name, q, spec, paper in PFEM_ORDER_QUANTITIES:
             f = [float(v[q]) for v in vals]
             p = study.observed_order(h, f)
             f0 = study.richardson(h, f, p) if p is not None and PFEM_ORDER_MIN <= p < math.inf else None
-            if paper == "ratio":
-                exp, pfem = c["Fp_exp_N"] / c["Fc_exp_N"], c["Fp_pfem_N"] / c["Fc_pfem_N"]
-            elif paper:
-                exp, pfem = c[f"{paper}_exp_K"], c[f"{paper}_pfem_K"]
-            else:
-                exp = pfem = None
+            exp, pfem = (c[f"{paper}_exp"], c[f"{paper}_pfem"]) if paper else (None, None)
             out.append(dict(case=n, keys=keys, name=name, spec=spec, h=h, f=f, p=p, f0=f0, exp=exp, pfem=pfem,
                             d1=_rel(f[1], f[0]), d2=_rel(f[2], f[1])))
     return out

@@ -36,6 +36,7 @@ import argparse
 import json
 import math
 import os
+import shutil
 import string
 import sys
 from pathlib import Path
@@ -325,6 +326,79 @@ def timed_in_subprocess(fn, *args):
     """``fn(*args)`` in a fresh process of its own (for one timing that no earlier work in this process may
     pollute); its result."""
     return run_all(fn, {"run": args}, jobs=1)[0]
+
+
+# ----------------------------------------------------------------------------- parked checkpoints
+CHECKPOINT = "restart.npz"          # a run folder's last checkpoint, in snapshots/ (refsph.simulate, refsph.pfem_run)
+
+
+def _same_arrays(path: Path, arrays: dict) -> bool:
+    import numpy as np
+    with np.load(path, allow_pickle=False) as z:
+        return z.files == list(arrays) and all(np.array_equal(z[k], v) for k, v in arrays.items())
+
+
+def park(folder: Path, parked: Path) -> bool:
+    """Keep a killed run's last checkpoint where git keeps it, in the folder ``parked``: ``folder``'s
+    ``snapshots/restart.npz`` (its arrays written again compressed, and read back before they replace an older
+    one), the state file it names where it is an SPH run's (the snapshot or timed state it continues from; a PFEM
+    checkpoint holds its whole state) and ``summary.json`` (the commits its earlier parts ran, how far it got).
+    ``runs/`` is not in git, and a new checkout starts without it: a run longer than a working session continues
+    in the next one from here (:func:`unpark`). False where ``folder`` has no checkpoint, or ``parked`` holds this
+    one already."""
+    import numpy as np
+    snaps, parked = Path(folder) / "snapshots", Path(parked)
+    if not (snaps / CHECKPOINT).exists():
+        return False
+    with np.load(snaps / CHECKPOINT, allow_pickle=False) as z:
+        arrays = {k: z[k] for k in z.files}
+    if (parked / CHECKPOINT).exists() and _same_arrays(parked / CHECKPOINT, arrays):
+        return False
+    state = None
+    if "run" in arrays and "nodes/t" not in arrays:                 # an SPH checkpoint: the state file it names
+        state = json.loads(str(arrays["run"])).get("snapshot")
+    parked.mkdir(parents=True, exist_ok=True)
+    tmp = parked / "restart.tmp.npz"
+    np.savez_compressed(tmp, **arrays)
+    if not _same_arrays(tmp, arrays):                               # read back: a parked checkpoint must restart
+        tmp.unlink()
+        raise OSError(f"{tmp}: the compressed checkpoint does not read back as written")
+    for old in parked.glob("*.npz"):                                # the state of an older checkpoint
+        if old.name not in (tmp.name, CHECKPOINT):
+            old.unlink()
+    if state:
+        shutil.copyfile(snaps / state, parked / state)
+    if (Path(folder) / "summary.json").exists():
+        shutil.copyfile(Path(folder) / "summary.json", parked / "summary.json")
+    os.replace(tmp, parked / CHECKPOINT)                            # last: a parked checkpoint is whole or absent
+    return True
+
+
+def unpark(parked: Path, folder: Path) -> bool:
+    """Put a parked checkpoint (:func:`park`) back into the run folder ``folder``, so that the run continues from
+    it (``refsph run --restart``); only where ``folder`` has no checkpoint of its own (a fresh checkout). True if it
+    did."""
+    parked, snaps = Path(parked), Path(folder) / "snapshots"
+    if (snaps / CHECKPOINT).exists() or not (parked / CHECKPOINT).exists():
+        return False
+    snaps.mkdir(parents=True, exist_ok=True)
+    for f in sorted(parked.glob("*.npz"), key=lambda f: f.name == CHECKPOINT):   # the checkpoint last
+        shutil.copyfile(f, snaps / f.name)
+    if (parked / "summary.json").exists() and not (Path(folder) / "summary.json").exists():
+        shutil.copyfile(parked / "summary.json", Path(folder) / "summary.json")
+    return True
+
+
+def prune_parked(parked_root: Path, keep) -> list[str]:
+    """Remove the parked checkpoints under ``parked_root`` whose folder name ``keep(name)`` rejects (their run is
+    recorded, or no longer a job); the names removed."""
+    gone = []
+    root = Path(parked_root)
+    for d in sorted(p for p in root.glob("*") if p.is_dir()) if root.exists() else ():
+        if not keep(d.name):
+            shutil.rmtree(d)
+            gone.append(d.name)
+    return gone
 
 
 # ----------------------------------------------------------------------------- convergence

@@ -26,7 +26,9 @@ t_u x 3 t_u and 4 t_u left uncut, one change at a time, at t_u/5 and t_u/10), ``
 frictional heat to the chip), ``refupdate`` (how often TLSPH's reference configuration is updated,
 :func:`reference_update_jobs`). Resumable twice over: a finished run is a record in
 ``benchmarks/thermal_cutting.json`` and is skipped; a run that was killed continues from its last checkpoint
-(``refsph run --restart``; one at every snapshot and every 10 minutes of wall time between them). A run that fails
+(``refsph run --restart``; one at every snapshot and every 10 minutes of wall time between them), and ``--park``
+keeps those checkpoints in git (``benchmarks/parked/thermal_cutting/``) for a new checkout to continue from (a run
+longer than a working session; ``runs/`` is not in git). A run that fails
 (non-finite state, lost chip) is a record with its status and error; it stays in the table until ``--redo`` runs it
 again, and a failed rerun never replaces a good record. A failed case of the t_u/10 tables is taken again by its
 retry (``retry_jobs``: SPH at half the step, PFEM with the Bossak rule) in the same call and in every later one. A
@@ -62,6 +64,7 @@ OUT_JSON = ROOT / "benchmarks" / "thermal_cutting.json"
 BEFORE_JSON = ROOT / "benchmarks" / "thermal_cutting_pinball_tu5.json"   # issue 19's sweep: pinball, t_u/5, 8 t_u
 REPORT = ROOT / "benchmarks" / "thermal_cutting_report.md"
 RUNS = ROOT / "runs" / "thermal_cutting"
+PARKED = ROOT / "benchmarks" / "parked" / "thermal_cutting"   # killed runs' checkpoints, in git (--park)
 FIG = ROOT / "figures"
 N_TU, TRAVEL = 10.0, 16.0                  # the sweep: dx = t_u / 10, 16 t_u of cut (means over the last quarter)
 UNCUT = 12.0                               # t_u of workpiece left uncut at the end (4 t_u: the Fc drift was 21 %)
@@ -441,6 +444,8 @@ def run_case(key: str, options: dict, numerics: dict, quick: bool = False) -> di
     sweep's, TOOL)."""
     from refsph.simulate import SimulationError, run, run_commits
     out = run_folder(key, quick)
+    if not quick and study.unpark(PARKED / out.name, out):           # a run parked by an earlier session (--park)
+        print(f"{key}: continues from its parked checkpoint ({PARKED.relative_to(ROOT) / out.name})", flush=True)
     restart = (out / "snapshots" / "restart.npz").exists()
     t0 = time.perf_counter()
     rec = dict(key=key, options=options, numerics=numerics, quick=quick)
@@ -1807,7 +1812,9 @@ def status_lines(records: dict, todo: dict, quick: bool = False) -> list[str]:
             s = json.loads(path.read_text())
         except (OSError, ValueError):                        # before its first snapshot: its heartbeat, if any
             beat = _heartbeat(path.parent, 0.0)
-            lines.append(f"{key:40s} {beat or 'to run'}")
+            t = None if quick else _checkpoint_time(PARKED / path.parent.name / "restart.npz")
+            parked = None if t is None else f"parked at t = {t * 1e3:.3f} ms (a rerun continues from there)"
+            lines.append(f"{key:40s} {beat or parked or 'to run'}")
             continue
         beat = _heartbeat(path.parent, path.stat().st_mtime) if s.get("status") == "running" else None
         if beat is not None:
@@ -1820,6 +1827,21 @@ def status_lines(records: dict, todo: dict, quick: bool = False) -> list[str]:
                      f"({100 * t / t_end:.0f} %), {s.get('n_steps')} steps, {wall / 60:.0f} min so far, "
                      f"about {left / 60:.0f} min to go; summary written {age:.0f} min ago")
     return lines
+
+
+def park(records: dict, todo: dict) -> list[str]:
+    """``--park``: the checkpoint of each job of ``todo`` that is not recorded, from its run folder, into PARKED
+    (:func:`study.park`); then the parked checkpoints of recorded jobs, or of no job at all, dropped (their run
+    folders are not touched). One line per change."""
+    lines = []
+    for key in todo:
+        if key not in records and study.park(run_folder(key), PARKED / run_folder(key).name):
+            t = _checkpoint_time(PARKED / run_folder(key).name / "restart.npz")
+            lines.append(f"parked {key}" + ("" if t is None else f" at t = {t * 1e3:.3f} ms"))
+    every = dict(jobs(), **retry_jobs(records), **todo)
+    wanted = {run_folder(k).name for k in every if k not in records}
+    lines += [f"dropped {name}" for name in study.prune_parked(PARKED, lambda name: name in wanted)]
+    return lines or ["nothing to park"]
 
 
 def _heartbeat(folder: Path, summary_written: float) -> str | None:
@@ -1837,7 +1859,7 @@ def _heartbeat(folder: Path, summary_written: float) -> str | None:
     t, t_end, t0, wall = b["t"], b["t_end"], b.get("t_begin", 0.0), b["wall_s"]
     age = (time.time() - b["written"]) / 60
     if gone:
-        ck = _checkpoint_time(folder)
+        ck = _checkpoint_time(folder / "snapshots" / "restart.npz")
         return (f"stopped: its process ({b['pid']}) is gone, last heard of {age:.0f} min ago at t = {t * 1e3:.3f} of "
                 f"{t_end * 1e3:.3f} ms ({100 * t / t_end:.0f} %); a rerun of the key continues from its last "
                 "checkpoint" + ("" if ck is None else f", at t = {ck * 1e3:.3f} ms"))
@@ -1846,12 +1868,13 @@ def _heartbeat(folder: Path, summary_written: float) -> str | None:
             f"this process {wall / 60:.0f} min, about {left / 60:.0f} min to go; heartbeat {age:.0f} min ago")
 
 
-def _checkpoint_time(folder: Path) -> float | None:
-    """The simulated time of a run folder's last checkpoint (an SPH run's ``snapshots/restart.npz`` names it);
-    None where there is none or it does not say (a PFEM run's, an older one's)."""
+def _checkpoint_time(path: Path) -> float | None:
+    """The simulated time of a checkpoint ``path`` (a run folder's ``snapshots/restart.npz``, or a parked one): an
+    SPH run's names it in its run record, a PFEM run's is its nodes' time; None where there is none or it does not
+    say (an older one's)."""
     try:
-        with np.load(folder / "snapshots" / "restart.npz") as z:
-            t = json.loads(str(z["run"])).get("t")
+        with np.load(path) as z:
+            t = float(z["nodes/t"]) if "nodes/t" in z.files else json.loads(str(z["run"])).get("t")
     except (OSError, ValueError, KeyError):
         return None
     return float(t) if isinstance(t, (int, float)) else None
@@ -1889,6 +1912,9 @@ def main(argv=None) -> int:
         todo = {k: todo[k] for k in args.keys}
     if args.status:
         print("\n".join(status_lines(store(args.json).records(), todo, args.quick)))
+        return 0
+    if args.park:
+        print("\n".join(park(store(args.json).records(), todo)))
         return 0
     if args.merge is not None:
         try:
@@ -1935,6 +1961,10 @@ def _parser():
                          "here, or good there and failed here (never the other way), then write the page")
     ap.add_argument("--status", action="store_true",
                     help="no runs: each job's record, or how far its run folder has got, or 'to run'")
+    ap.add_argument("--park", action="store_true",
+                    help="no runs: keep the last checkpoint of every unrecorded job's run folder in "
+                         "benchmarks/parked/thermal_cutting/ (to commit: a run longer than a session continues "
+                         "from there in a new checkout), and drop the parked ones whose job is recorded")
     return ap
 
 

@@ -132,7 +132,8 @@ WITHOUT_HEAT = GAP_CHANGES[2][0]                               # ... its key suf
 REFINED_NUMERICS = dict(ref_update_strain=REF_UPDATE, frequency_step=FREQUENCY_STEP)   # what 'refined' sets
 REFINED_RETRY = f" courant {COURANT:g}"      # a 'refined' case that failed: again at half the CFL part of its step
 RETRIES = {"": (RETRY,), PFEM10: (f" n_tu 10{BOSSAK}", DAMPED), REFINED: (REFINED_RETRY,)}
-PFEM_OPTIONS = ("case", "n_tu", "travel", "length", "gamma", "remesh_when_needed", "bossak", "eta")  # the PFEM's
+PFEM_OPTIONS = ("case", "n_tu", "travel", "length", "gamma", "remesh_when_needed", "bossak", "eta", "jitter",
+                "seed")  # the PFEM cut's options a key may set (the rest are the scene's SPH options)
 REMESH = " remesh when needed"              # the key suffix of a PFEM cut that remeshes only where the quality asks
 PAPER_CUT = (1.5e-3, 2.0e-3)   # m of tool travel: the last quarter of the paper's PFEM cut, 2/3 of its 3 mm workpiece
 TO_CHIP = " all friction heat to the chip"   # key suffix: chip_fraction 1 (the paper's SPH code's choice; scene 0.5)
@@ -142,6 +143,8 @@ MATERIAL_NAMES = ("AISI1045", "Ti6Al4V")   # the tables' materials, in their ord
 PFEM_FINE = ((1, 15.0), (2, 15.0), (3, 20.0), (5, 15.0), (8, 15.0), (6, 20.0), (9, 20.0))   # (case, nodes across
                                            # t_u) of the PFEM finer than t_u/10: the paper's 10 um near the tool
 PFEM_FINE_BOSSAK = (8, 9)                  # ... with the Bossak rule, as at t_u/10 (the trapezoidal rule stalled)
+PFEM_RERUN_CASES = (2, 5, 3, 6, 1)         # cases whose t_u/5 and t_u/10 PFEM records an earlier solver made: again
+#                                            with today's (key suffix RERUN) for the spacing study (pfem_spacing_keys)
 REMESH_RUNS = ((1, PFEM, 5.0), (5, PFEM, 5.0), (10, PFEM, 5.0), (1, PFEM10, 10.0))   # (case, suffix, n_tu) of those
 
 
@@ -285,6 +288,14 @@ def more_jobs() -> list[tuple[str, str, dict, dict]]:
     out += [("gap", f"case 10{COARSE}{REF_KEY}{REF_UPDATE:g} jitter {seed}",
              converged(10, n_tu=5.0, jitter=0.01, seed=seed), dict(ref_update_strain=REF_UPDATE)) for seed in (1, 2)]
     out += [("pfem", key, options, pfem) for key, options in time_rule_jobs() + remesh_jobs() + pfem_resolution_jobs()]
+    # the PFEM's run-to-run scatter (case 2 at t_u/5, today's solver, unperturbed and with its nodes jittered by 0.01
+    # of their spacing, three seeds), for the changes of the spacing study (pfem_spacing_convergence) to be read by
+    out += [("pfem", key, dict(converged(2, n_tu=5.0), **({} if seed == 0 else dict(jitter=0.01, seed=seed))), pfem)
+            for seed, key in enumerate(PFEM_SCATTER)]
+    # the coarse cuts of the spacing study whose records an earlier solver made (before the contact's changes of
+    # b294aaf and 248e7e0; the fine runs came after them), again with today's: t_u/5 (minutes), then t_u/10
+    out += [("pfem", f"case {n}{PFEM}{RERUN}", converged(n, n_tu=5.0), pfem) for n in PFEM_RERUN_CASES]
+    out += [("pfem", f"case {n}{PFEM10}{RERUN}", converged(n, n_tu=10.0), pfem) for n in PFEM_RERUN_CASES]
     out += [("pfem", f"case {n}{PFEM10}{TO_2MM}", to_2mm(n, n_tu=10.0), pfem) for n in TU_01]
     return out + [("cases", f"case {n}{TO_2MM}", to_2mm(n), sweep_numerics()) for n in TU_01]
 
@@ -821,6 +832,7 @@ def report(res: dict, before: dict | None = None) -> str:
     lines += ["", P("paper_spacing_errors")] + _same_cases_lines(spacing, ("AISI1045",))
     lines += ["", P("paper_spacing_2mm")] + _paper_length_errors(spacing, "PFEM", ("AISI1045",))
     lines += ["", P("pfem_spacing_orders")] + _pfem_spacing_lines(pfem_spacing_convergence(res))
+    lines += ["", pfem_scatter_line(res)]
     lines += ["", P("pfem_forces")] + [_pfem_force_line(r, res) for r in pfem]
     dof = dof_rows(res)
     lines += ["", P("dof", **dof_changes(dof))] + _dof_lines(dof)
@@ -1044,10 +1056,13 @@ def paper_spacing_rows(res: dict) -> list[dict]:
 def pfem_spacing_keys(n: int) -> tuple:
     """Case ``n``'s PFEM cuts at three node spacings near the tool, coarsest first: t_u/5 (PFEM), t_u/10 (PFEM10)
     and PFEM_FINE's (pfem_fine_key: 10 um, t_u/15 for case 1); a PFEM_FINE_BOSSAK case on the Bossak rule at
-    every spacing, so that only the spacing changes."""
+    every spacing, so that only the spacing changes; a PFEM_RERUN_CASES case's coarse cuts made again with today's
+    solver (key suffix RERUN), so that only the spacing changes, not the solver."""
     rule = BOSSAK if n in PFEM_FINE_BOSSAK else ""
     fine = dict(PFEM_FINE)[n]
-    return (f"case {n}{PFEM}{rule}", f"case {n}{PFEM10}" + (f" n_tu 10{rule}" if rule else ""), pfem_fine_key(n, fine))
+    again = RERUN if n in PFEM_RERUN_CASES else ""             # the coarse runs again with the fine runs' solver
+    return (f"case {n}{PFEM}{rule}{again}", f"case {n}{PFEM10}" + (f" n_tu 10{rule}" if rule else "") + again,
+            pfem_fine_key(n, fine))
 
 
 PFEM_ORDER_MIN = 0.5    # below this observed order the extrapolation of pfem_spacing_convergence is not made: its
@@ -1075,14 +1090,46 @@ def pfem_spacing_convergence(res: dict) -> list[dict]:
             continue
         vals, c = [_values(r) for r in runs], paper_rows[n]
         h = [v["dx_um"] for v in vals]
+        spread = _groups(res, PFEM_SCATTER) if n == PFEM_SCATTER_CASE else {}
         for name, q, spec, paper in PFEM_ORDER_QUANTITIES:
             f = [float(v[q]) for v in vals]
             p = study.observed_order(h, f)
             f0 = study.richardson(h, f, p) if p is not None and PFEM_ORDER_MIN <= p < math.inf else None
             exp, pfem = (c[f"{paper}_exp"], c[f"{paper}_pfem"]) if paper else (None, None)
+            g = spread.get(q, ())
+            sd = float(g.std(ddof=1) / abs(g.mean())) if len(g) >= 2 else math.nan   # relative, at every spacing
+            z1, z2 = (_z(b - a, sd * math.hypot(a, b)) for a, b in ((f[0], f[1]), (f[1], f[2])))
             out.append(dict(case=n, keys=keys, name=name, spec=spec, h=h, f=f, p=p, f0=f0, exp=exp, pfem=pfem,
-                            d1=_rel(f[1], f[0]), d2=_rel(f[2], f[1])))
+                            d1=_rel(f[1], f[0]), d2=_rel(f[2], f[1]), z1=z1, z2=z2))
     return out
+
+
+def pfem_scatter_line(res: dict) -> str:
+    """The PFEM's run-to-run scatter (PFEM_SCATTER: case 2 at t_u/5 with today's solver, unperturbed and jittered):
+    each quantity's sample standard deviation in percent of the mean, and how far the sweep's record of the same
+    cut, made by an earlier solver (the spacing table's t_u/5 column), lies from the mean in those units."""
+    g = _groups(res, PFEM_SCATTER)
+    n = min((len(v) for v in g.values()), default=0)
+    if n < 2:
+        return (f"The PFEM's run-to-run scatter (case {PFEM_SCATTER_CASE} at t_u/5, the table 'The PFEM's run-to-run "
+                f"scatter' below): {n} of {len(PFEM_SCATTER)} runs recorded, too few for a spread.")
+    old = res["runs"].get(f"case {PFEM_SCATTER_CASE}{PFEM}")
+    v_old = _values(old) if old is not None and old.get("status") == "ok" else {}
+    parts, away = [], []
+    for name, q, spec, _ in PFEM_ORDER_QUANTITIES:
+        x = g[q]
+        sd = float(x.std(ddof=1))
+        parts.append(f"{name.split(' [')[0]} {100 * sd / abs(x.mean()):.1f} %")
+        if q in v_old:
+            away.append(f"{name.split(' [')[0]} {_change_cell(_rel(v_old[q], x.mean()), _z(v_old[q] - x.mean(), sd))}")
+    return (f"The PFEM's run-to-run scatter (case {PFEM_SCATTER_CASE} at t_u/5, {n} runs of today's solver: "
+            "unperturbed and with the workpiece's nodes moved at random by up to 0.01 of their spacing; the table "
+            "'The PFEM's run-to-run scatter' below), sample standard deviation in percent of the mean: "
+            + ", ".join(parts) + ". Case 2's changes above carry their z in brackets: the change over its standard "
+            "deviation, sqrt(f_a^2 + f_b^2) times that relative spread (the spread at t_u/5 taken at every spacing, "
+            "an assumption: it is measured at t_u/5 only). The sweep's record of the same cut (the t_u/5 column, "
+            "made by an earlier solver) lies from these runs' mean by " + (", ".join(away) or "-")
+            + " (in brackets: in standard deviations of one run).")
 
 
 def _pfem_spacing_lines(rows: list) -> list[str]:
@@ -1098,8 +1145,8 @@ def _pfem_spacing_lines(rows: list) -> list[str]:
         order = ("changes differ in sign or grow" if r["p"] is None else
                  "above 20" if not math.isfinite(r["p"]) else f"{r['p']:.1f}")
         cells = [r["case"], r["name"], " / ".join(f"{x:.0f}" for x in r["h"])] + [_f(x, spec) for x in r["f"]] + [
-            _change_cell(r["d1"]), _change_cell(r["d2"]), order, _f(r["f0"], spec), _f(r["exp"], spec),
-            _f(r["pfem"], spec)]
+            _change_cell(r["d1"], r["z1"]), _change_cell(r["d2"], r["z2"]), order, _f(r["f0"], spec),
+            _f(r["exp"], spec), _f(r["pfem"], spec)]
         lines.append("| " + " | ".join(str(x) for x in cells) + " |")
     return lines
 
@@ -1193,6 +1240,9 @@ BASIC = (("Fc [N/mm]", "Fc", ".1f"), ("Fp [N/mm]", "Fp", ".1f"), ("Fp/Fc", "forc
          ("T_FCS [K]", "free_chip_surface_temperature_K", ".0f"), ("chip [mm]", "chip_thickness_mm", ".3f"),
          ("contact [mm]", "contact_length_mm", ".3f"))
 SCATTER_KEYS = ("case 1", "case 1 jitter 1", "case 1 jitter 2", "case 1 jitter 3")   # the scatter at t_u/10
+PFEM_SCATTER_CASE = 2
+PFEM_SCATTER = (f"case {PFEM_SCATTER_CASE}{PFEM}{RERUN}",) + tuple(f"case {PFEM_SCATTER_CASE}{PFEM} jitter {seed}"
+                                                      for seed in (1, 2, 3))   # the PFEM's scatter (more_jobs)
 SCATTER_T5 = tuple(k.replace("case 1", "case 1 n_tu 5") for k in SCATTER_KEYS)         # at t_u/5
 SCATTER_S2 = tuple(k.replace("n_tu 5", "n_tu 5 s/2") for k in SCATTER_T5)               # at t_u/5 and s/2
 SCATTER_TI10 = ("case 10", "case 10 jitter 1", "case 10 jitter 2")                     # Ti6Al4V at t_u/10
@@ -1292,6 +1342,15 @@ STUDIES = (
      "with each case's scatter at ref update 0.1 and t_u/5 (case 10's below, case 1's further down)", GAP_RUNS,
      BASIC + (("T_RF - T_FCS [K]", "gap", ".0f"), ("friction heat [% of work]", "friction_of_work", ".1f"),
               ("viscosity + damping heat [% of work]", "dissipation_of_work", ".1f"), ("CPU [min]", "cpu_min", ".1f"))),
+    ("The PFEM's run-to-run scatter (case 2 at t_u/5 with today's solver: unperturbed, and with the workpiece's "
+     "nodes moved at random by up to 0.01 of their spacing, three seeds; the sweep's record 'case 2 pfem n_tu 5', "
+     "made by an earlier solver, above them): what the spacing study's changes are read against",
+     (f"case {PFEM_SCATTER_CASE}{PFEM}",) + PFEM_SCATTER, BASIC),
+    ("What the PFEM's solver changes moved (the coarse cuts of the spacing study: each record made by an earlier "
+     "solver, before the contact's changes of b294aaf and 248e7e0, above the same cut with today's, key suffix "
+     "'rerun', which the spacing table takes)",
+     tuple(k for n in PFEM_RERUN_CASES for sfx in (PFEM, PFEM10) for k in (f"case {n}{sfx}", f"case {n}{sfx}{RERUN}")),
+     BASIC + (("steps", "n_steps", "d"), ("CPU [min]", "cpu_min", ".1f"))),
     ("The same in the PFEM (t_u/10, the sweep's runs): friction acting but making no heat (eta = 0); one run each, "
      "the PFEM being deterministic", PFEM_GAP_RUNS,
      BASIC + (("T_RF - T_FCS [K]", "gap", ".0f"), ("friction heat [% of work]", "friction_of_work", ".1f"),

@@ -87,7 +87,7 @@ def _options(options: dict, quick: bool) -> dict:
             out[name] = parse_bool(value, f"option {name}")  # its own message: true or false
             continue
         try:
-            if name == "case":
+            if name in ("case", "seed"):
                 out[name] = int(float(value))
             elif name == "length" and value in (None, "none"):
                 out[name] = None

@@ -446,7 +446,10 @@ def test_thermal_cutting_pfem_spacing_order_through_three_spacings():
     assert mod.pfem_spacing_keys(9) == ("case 9 pfem n_tu 5" + mod.BOSSAK, "case 9 pfem n_tu 10" + mod.BOSSAK,
                                         "case 9 pfem n_tu 20" + mod.BOSSAK)
     keys = mod.pfem_spacing_keys(2)
-    assert keys == ("case 2 pfem n_tu 5", "case 2 pfem", "case 2 pfem n_tu 15")
+    assert keys == ("case 2 pfem n_tu 5 rerun", "case 2 pfem rerun", "case 2 pfem n_tu 15")   # today's solver
+    assert mod.pfem_spacing_keys(8)[0] == "case 8 pfem n_tu 5" + mod.BOSSAK                   # made by it already
+    jobs = mod.jobs()
+    assert all(k in jobs for n in mod.PFEM_RERUN_CASES for k in mod.pfem_spacing_keys(n))
     runs = {k: _resolution_record(400.0 + 1e3 * (1.0 / n) ** 2, n) for k, n in zip(keys, (5, 10, 15))}
     for r, t in zip(runs.values(), (600.0, 620.0, 610.0)):
         r["metrics"]["rake_face_temperature_K"] = t
@@ -461,14 +464,60 @@ def test_thermal_cutting_pfem_spacing_order_through_three_spacings():
     assert fc["p"] == pytest.approx(0.3, rel=1e-6) and fc["f0"] is None          # below PFEM_ORDER_MIN: none
     assert rows[2, "T_RF [K]"]["exp"] == 730.0                                   # the measured value of case 2
     assert rows[3, None]["keys"] == [f"'{k}'" for k in mod.pfem_spacing_keys(3)]   # nothing of case 3 given
-    runs["case 2 pfem"] = dict(status="failed")
+    runs["case 2 pfem rerun"] = dict(status="failed")
     (row,) = [r for r in mod.pfem_spacing_convergence(dict(runs=runs)) if r["case"] == 2]
-    assert row["keys"] == ["'case 2 pfem' (failed)"]
+    assert row["keys"] == ["'case 2 pfem rerun' (failed)"]
     lines = mod._pfem_spacing_lines([row])
-    assert lines[-1].count("|") == lines[1].count("|") and "'case 2 pfem' (failed)" in lines[-1]
+    assert lines[-1].count("|") == lines[1].count("|") and "'case 2 pfem rerun' (failed)" in lines[-1]
     jobs = [k for k, _ in mod.pfem_resolution_jobs()]
     assert "case 9 pfem n_tu 5" + mod.BOSSAK in jobs and "case 8 pfem n_tu 5" + mod.BOSSAK not in jobs   # the
     assert "case 8 pfem n_tu 5" + mod.BOSSAK in [k for k, _ in mod.time_rule_jobs()]       # time rule's study's
+
+def test_thermal_cutting_pfem_spacing_changes_are_read_against_the_pfem_scatter():
+    """Case 2's spacing changes carry a z from the PFEM's scatter runs (PFEM_SCATTER: their relative spread taken at
+    every spacing), other cases none; pfem_scatter_line gives the spread and how far the sweep's older t_u/5 record
+    lies from the scatter runs' mean, and says so where too few runs are recorded."""
+    import math
+    mod = _script("thermal_cutting")
+    keys = mod.pfem_spacing_keys(2)
+    assert keys[0] == mod.PFEM_SCATTER[0]                  # the unperturbed scatter run is the spacing's t_u/5 run
+    runs = {k: _resolution_record(fc, n) for k, fc, n in zip(keys, (396.0, 440.0, 444.0), (5, 10, 15))}
+    assert math.isnan(mod.pfem_spacing_convergence(dict(runs=runs))[1]["z1"])
+    assert "1 of 4 runs recorded" in mod.pfem_scatter_line(dict(runs=runs))
+    for k, fc in zip(mod.PFEM_SCATTER[1:], (404.0, 396.0, 404.0)):         # mean 400, sd 4.62 (1.15 %)
+        runs[k] = _resolution_record(fc, 5)
+    rows = {(r["case"], r["name"]): r for r in mod.pfem_spacing_convergence(dict(runs=runs))}
+    fc = rows[2, "Fc [N/mm]"]
+    sd = float(np.std([396.0, 404.0, 396.0, 404.0], ddof=1)) / 400.0
+    assert fc["z1"] == pytest.approx(44.0 / (sd * math.hypot(396.0, 440.0)), rel=1e-12)
+    assert fc["z2"] == pytest.approx(4.0 / (sd * math.hypot(440.0, 444.0)), rel=1e-12)
+    assert math.isnan(rows[2, "T_RF [K]"]["z1"])                             # no spread: no z (0 / 0)
+    assert "+11.1 % (" in mod._pfem_spacing_lines([fc])[-1]
+    line = mod.pfem_scatter_line(dict(runs=runs))
+    assert "4 runs" in line and "Fc 1.2 %" in line and "mean by - (" in line  # no older record given
+    runs["case 2 pfem n_tu 5"] = _resolution_record(409.24, 5)               # two deviations above the mean
+    assert "Fc +2.3 % (+2.0)" in mod.pfem_scatter_line(dict(runs=runs))
+
+
+def test_pfem_cut_jitter_moves_only_free_nodes_by_at_most_their_spacing_fraction():
+    """pfem_cut(jitter=0.01, seed=k): each free node of the workpiece moved by at most 0.01 of its own spacing, the
+    held ones (bottom row, left column) and the tool where they were, the same seed the same nodes, another seed
+    others; jitter 0 the unperturbed cut to the bit; a jitter out of range refused."""
+    from refsph.pfem.cutting import pfem_cut
+    kw = dict(case=1, n_tu=5.0, travel=2.0, length=0.6e-3, conduction=False)
+    a, b, c, d = (pfem_cut(**kw, **extra) for extra in (dict(), dict(jitter=0.01, seed=1),
+                                                        dict(jitter=0.01, seed=1), dict(jitter=0.01, seed=2)))
+    held = a.fixed.any(axis=1)
+    move = np.abs(b.nodes.x - a.nodes.x)
+    assert np.all(move[held] == 0.0) and np.all(move[~held] > 0.0)
+    assert np.all(move <= 0.01 * a.h[:, None] * (1 + 1e-12))
+    assert np.array_equal(b.nodes.x, c.nodes.x) and not np.array_equal(b.nodes.x, d.nodes.x)
+    assert np.array_equal(b.X0, b.nodes.x) and np.array_equal(b.fixed, a.fixed)
+    assert np.array_equal(pfem_cut(**kw, jitter=0.0).nodes.x, a.nodes.x)
+    assert b.info["length_m"] == a.info["length_m"] and b.info["jitter"] == 0.01 and b.info["seed"] == 1
+    with pytest.raises(ValueError, match="jitter"):
+        pfem_cut(**kw, jitter=-0.1)
+
 
 def _resolution_record(fc, n):
     """A made-up 'ok' record of a cut at n particles across t_u with Fc = ``fc`` N/mm (the other quantities fixed)."""

@@ -108,6 +108,7 @@ from scipy.spatial import cKDTree
 from ..contact import CoulombFriction
 from ..paper_data import AISI1045_RLA, CONTACT_RLA, RLA_SURFACE_LOSS, TI6AL4V_RLA, TOOL_CARBIDE_RLA, rla_cutting_case
 from ..plasticity import JohnsonCook, ModifiedJohnsonCook
+from ..scenes.measure import jittered
 from ..scenes.thermal_cutting import (CLEARANCE_DEG, EDGE_RADIUS, RAKE_DEG, chip_measures, thermal_cutting_metrics,
                                       tool_particles, tool_shape)
 from ..thermal import SurfaceLoss
@@ -226,7 +227,7 @@ def pfem_cut(case: int, n_tu: float = 10.0, travel: float = 16.0, length: float 
              conduction: bool = True, chip_fraction: float = 0.5, refine: bool = True, r_min: float = 0.5,
              a_max: float = 2.5, gamma: float = 0.5, edge_nodes: bool = False,
              remesh_when_needed: bool = False, bossak: float = 0.0, edge_radius: float = EDGE_RADIUS,
-             eta: float = CONTACT_RLA["friction_work_to_heat"]) -> PFEMCut:
+             eta: float = CONTACT_RLA["friction_work_to_heat"], jitter: float = 0.0, seed: int = 0) -> PFEMCut:
     """The cut of row ``case`` of the paper's Appendix B: dx = t_u / n_tu, ``travel`` t_u of cut on a workpiece
     ``length`` [m] long (default (travel + 12) t_u), dt = courant dx / v_c, contact penalties ``penalty`` G / dx;
     ``conduction``: the heat step (module text; False: adiabatic), ``chip_fraction`` of the frictional heat into
@@ -240,7 +241,11 @@ def pfem_cut(case: int, n_tu: float = 10.0, travel: float = 16.0, length: float 
     ``remesh_quality`` (False: after every step as well, refsph's default; module text); ``edge_radius`` [m]: the
     tool's edge radius in the contact's outline (the paper's 10 um; the meshed tool of the heat step keeps it);
     ``eta``: the fraction of the frictional work that becomes heat (Eq. (7); the paper's 1; 0 keeps friction's
-    mechanics without its heat)."""
+    mechanics without its heat); ``jitter``: every node of the workpiece not held moved at random by up to that many
+    of its own spacings (:func:`refsph.scenes.measure.jittered`, random seed ``seed``; the tool where it was): a
+    perturbed run, for the run-to-run scatter of the metrics (the PFEM is deterministic, but its square lattice has
+    four nodes on a circle in every cell, so which diagonal Delaunay takes, and with it the path, turns on
+    round-off)."""
     row = rla_cutting_case(int(case))
     mat = MATERIALS[row["material"]]
     vc, tu = row["vc_m_per_min"] / 60.0, row["tu_mm"] * 1e-3
@@ -261,14 +266,16 @@ def pfem_cut(case: int, n_tu: float = 10.0, travel: float = 16.0, length: float 
     E, nu = mat["E_Pa"], mat["nu"]
     law = SolidLaw(rho0=mat["rho"], G=E / (2 * (1 + nu)), K=E / (3 * (1 - 2 * nu)), alpha_T=0.0, T_ref=T0,
                    strength=strength)
-    apex = np.array([x[:, 0].max() + 0.5 * dx, y0])
+    x_end = float(x[:, 0].max())
+    apex = np.array([x_end + 0.5 * dx, y0])
+    fixed = np.zeros((len(x), 2), bool)
+    fixed[(x[:, 1] < 1e-12) | (x[:, 0] < 1e-12)] = True
+    x = np.where(fixed, x, jittered(x, jitter, h[:, None], seed))      # a perturbed run (held nodes stay)
     xt, tool_held = tool_particles(dx, tu, apex, 10.0, 6.0)
     centroid = xt.mean(axis=0)
     shape = tool_shape(tu, apex, centroid, 10.0, 6.0, radius=edge_radius)
     mu = CoulombFriction(mu0=mat["mu0"], q=mat["q_friction"], T_room=T0, T_melt=mat["T_melt_K"]) if friction else None
     contact = ToolContact(k_normal=penalty * law.G / dx, k_tangent=penalty * law.G / dx, friction=mu)
-    fixed = np.zeros((len(x), 2), bool)
-    fixed[(x[:, 1] < 1e-12) | (x[:, 0] < 1e-12)] = True
     A_cell = np.where(h > dx * 1.5, 4 * dx * dx, dx * dx)
     nodes = make_nodes(x, mat["rho"] * A_cell, T0)
     heat = None
@@ -283,14 +290,14 @@ def pfem_cut(case: int, n_tu: float = 10.0, travel: float = 16.0, length: float 
                        T_fixed=T0, h_int=2.0 * k_w * k_t / (k_w + k_t) / dx,
                        loss=SurfaceLoss(**RLA_SURFACE_LOSS, T_ambient=T0), chip_fraction=float(chip_fraction),
                        eta=float(eta))
-    info = dict(case=int(case), material=row["material"], vc_m_s=vc, tu_m=tu, dx=dx, length_m=float(x[:, 0].max()),
+    info = dict(case=int(case), material=row["material"], vc_m_s=vc, tu_m=tu, dx=dx, length_m=x_end,
                 height_m=H, y0=y0, n_work=len(x), n_tool=len(xt), travel_m=travel * tu, mass_scale=1.0,
                 inertia_ratio=mat["rho"] * vc * vc / mat["A_Pa"], rake_deg=RAKE_DEG, clearance_deg=CLEARANCE_DEG,
                 edge_radius_m=float(edge_radius), apex0=apex.tolist(), measured=row, method="pfem", alpha=alpha,
                 courant=courant, penalty=penalty, conduction=bool(conduction), chip_fraction=float(chip_fraction),
                 h_int=None if heat is None else heat.h_int, refine=bool(refine), r_min=r_min, a_max=a_max,
                 newmark_gamma=float(newmark.gamma), edge_nodes=bool(edge_nodes),
-                remesh_when_needed=bool(remesh_when_needed), eta=float(eta),
+                remesh_when_needed=bool(remesh_when_needed), eta=float(eta), jitter=float(jitter), seed=int(seed),
                 **({"newmark_alpha_B": float(bossak)} if bossak else {}))
     return PFEMCut(nodes=nodes, h=h, fixed=fixed, law=law, shape=shape, shift0=centroid, v_tool=np.array([-vc, 0.0]),
                    contact=contact, alpha=alpha, dt=courant * dx / vc, t_end=travel * tu / vc, X0=x.copy(), info=info,

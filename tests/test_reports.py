@@ -783,6 +783,25 @@ def test_measured_cuts_takes_the_sweeps_retries():
     assert {s for _, s, *_ in CUT_SERIES + mod.REFINED_SERIES if s in mod.RETRIES} <= set(CUT_RETRIES)
 
 
+def test_a_case_made_again_by_todays_solver_is_taken_before_its_record():
+    """cut_record with ``redone``: the rerun where it ended well (before the record, ok or failed, and its retry),
+    else what it took before; the tables' REDONE is the figure's CUT_REDONE; comparison takes the rerun."""
+    from refsph.teaching.plots import CUT_REDONE, cut_record
+    mod = _script("thermal_cutting")
+    assert CUT_REDONE == mod.REDONE
+    ok, bad = dict(status="ok"), dict(status="failed")
+    runs = {"case 2 pfem": ok, "case 2 pfem rerun": dict(status="ok", tag=1), "case 3 pfem": bad,
+            "case 3 pfem n_tu 10 bossak -0.1": ok, "case 3 pfem rerun": bad}
+    assert cut_record(runs, "case 2 pfem", (), (" rerun",)) == ("case 2 pfem rerun", runs["case 2 pfem rerun"])
+    assert cut_record(runs, "case 2 pfem") == ("case 2 pfem", ok)
+    bossak = " n_tu 10 bossak -0.1"
+    assert cut_record(runs, "case 3 pfem", (bossak,), (" rerun",))[0] == "case 3 pfem" + bossak   # its rerun failed
+    rec = _resolution_record(420.0, 10)
+    rows = mod.comparison(dict(runs={"case 2 pfem": _resolution_record(400.0, 10), "case 2 pfem rerun": rec}),
+                          mod.PFEM10)
+    assert rows[1]["key"] == "case 2 pfem rerun" and rows[1]["Fc_N_per_mm"] == pytest.approx(420.0)
+
+
 def test_dof_changes_counts_the_moves_between_resolutions():
     mod = _script("thermal_cutting")
     base = {f"{q}_{m}": 10.0 for q, _ in mod.DOF_QUANTITIES for m in ("pfem", "sph")}

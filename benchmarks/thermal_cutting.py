@@ -1904,7 +1904,7 @@ def park(records: dict, todo: dict) -> list[str]:
         if key not in records and study.park(run_folder(key), PARKED / run_folder(key).name):
             t = _checkpoint_time(PARKED / run_folder(key).name / "restart.npz")
             lines.append(f"parked {key}" + ("" if t is None else f" at t = {t * 1e3:.3f} ms"))
-    every = dict(jobs(), **retry_jobs(records), **todo)
+    every = {**jobs(), **retry_jobs(records), **todo}
     wanted = {run_folder(k).name for k in every if k not in records}
     lines += [f"dropped {name}" for name in study.prune_parked(PARKED, lambda name: name in wanted)]
     return lines or ["nothing to park"]

@@ -97,9 +97,10 @@ def test_thermal_cutting_parks_unrecorded_jobs_and_drops_recorded_ones(tmp_path,
     snaps.mkdir(parents=True)
     np.savez(snaps / "restart.npz", **{"nodes/t": np.array(4e-4), "run": np.array(json.dumps({}))})
     (snaps.parent / "summary.json").write_text(json.dumps(dict(status="running")))
-    todo = {"case 1": None, "case 2": None, "case 3": None}
-    assert mod.park({"case 1": dict(status="ok")}, todo) == ["parked case 2 at t = 0.400 ms"]
-    assert mod.park({"case 1": dict(status="ok")}, todo) == ["nothing to park"]
+    todo = {"case 1": None, "case 2": None, "case 3": None, "case 9 courant 0.075": None}   # a retry job too
+    recorded = {"case 1": dict(status="ok"), "case 9": dict(status="error")}
+    assert mod.park(recorded, todo) == ["parked case 2 at t = 0.400 ms"]
+    assert mod.park(recorded, todo) == ["nothing to park"]
     (tmp_path / "runs" / "case_2" / "summary.json").unlink()
     line = mod.status_lines({}, {"case 2": None})[0]
     assert line.endswith("parked at t = 0.400 ms (a rerun continues from there)")

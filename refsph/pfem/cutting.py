@@ -241,11 +241,9 @@ def pfem_cut(case: int, n_tu: float = 10.0, travel: float = 16.0, length: float 
     ``remesh_quality`` (False: after every step as well, refsph's default; module text); ``edge_radius`` [m]: the
     tool's edge radius in the contact's outline (the paper's 10 um; the meshed tool of the heat step keeps it);
     ``eta``: the fraction of the frictional work that becomes heat (Eq. (7); the paper's 1; 0 keeps friction's
-    mechanics without its heat); ``jitter``: every node of the workpiece not held moved at random by up to that many
-    of its own spacings (:func:`refsph.scenes.measure.jittered`, random seed ``seed``; the tool where it was): a
-    perturbed run, for the run-to-run scatter of the metrics (the PFEM is deterministic, but its square lattice has
-    four nodes on a circle in every cell, so which diagonal Delaunay takes, and with it the path, turns on
-    round-off)."""
+    mechanics without its heat); ``jitter``: the free nodes of the workpiece moved at random by up to that many of
+    their own spacings (:func:`refsph.scenes.measure.jittered`, seed ``seed``): a perturbed run, for the run-to-run
+    scatter (on the square lattice Delaunay's choice of diagonal, and with it the path, turns on round-off)."""
     row = rla_cutting_case(int(case))
     mat = MATERIALS[row["material"]]
     vc, tu = row["vc_m_per_min"] / 60.0, row["tu_mm"] * 1e-3
@@ -268,8 +266,7 @@ def pfem_cut(case: int, n_tu: float = 10.0, travel: float = 16.0, length: float 
                    strength=strength)
     x_end = float(x[:, 0].max())
     apex = np.array([x_end + 0.5 * dx, y0])
-    fixed = np.zeros((len(x), 2), bool)
-    fixed[(x[:, 1] < 1e-12) | (x[:, 0] < 1e-12)] = True
+    fixed = np.repeat(((x[:, 1] < 1e-12) | (x[:, 0] < 1e-12))[:, None], 2, axis=1)
     x = np.where(fixed, x, jittered(x, jitter, h[:, None], seed))      # a perturbed run (held nodes stay)
     xt, tool_held = tool_particles(dx, tu, apex, 10.0, 6.0)
     centroid = xt.mean(axis=0)

@@ -11,7 +11,6 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-import refsph.simulate as sim
 from refsph import load_run, load_snapshot
 from refsph.cli import main
 from refsph.io import load_reactions
@@ -21,6 +20,7 @@ from refsph.simulate import run
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / "benchmarks"))
 import study  # noqa: E402
+from test_restart import _killed  # noqa: E402  (tests/ is on sys.path: pytest's default import mode)
 
 SPH = dict(quick=True, t_end=2e-5, numerics=dict(threads=1, contact="penalty", heat_every=7),
            options=dict(case=1, length=0.5e-3, travel=1.0))
@@ -38,18 +38,7 @@ def test_a_parked_sph_run_continues_in_a_new_folder_to_the_same_bits(tmp_path, m
     restart ends as the whole run; parking the same checkpoint again writes nothing; a second park after the run
     went on replaces the old state file."""
     whole = run("thermal_cutting", "tlsph", out=tmp_path / "whole", progress=False, checkpoint_every=None, **SPH)
-    original = sim.simulate
-
-    def killed(*args, **k):
-        def hook(state, solver):
-            if state.t > 0.45 * SPH["t_end"]:
-                raise KeyboardInterrupt
-        return original(*args, **dict(k, hook=hook))
-
-    monkeypatch.setattr(sim, "simulate", killed)
-    with pytest.raises(KeyboardInterrupt):
-        run("thermal_cutting", "tlsph", out=tmp_path / "cut", progress=False, checkpoint_every=0.0, **SPH)
-    monkeypatch.setattr(sim, "simulate", original)
+    _killed(monkeypatch, "thermal_cutting", "tlsph", tmp_path / "cut", dict(SPH, checkpoint_every=0.0))
     parked = tmp_path / "parked" / "cut"
     assert study.park(tmp_path / "cut", parked) and not study.park(tmp_path / "cut", parked)
     state = json.loads(str(np.load(parked / "restart.npz")["run"]))["snapshot"]

@@ -338,51 +338,89 @@ def _same_arrays(path: Path, arrays: dict) -> bool:
         return z.files == list(arrays) and all(np.array_equal(z[k], v) for k, v in arrays.items())
 
 
-def park(folder: Path, parked: Path) -> bool:
+def checkpoint_time(arrays: dict) -> float:
+    """How far a checkpoint's run has got: a PFEM checkpoint's nodes' time, an SPH one's time (its run record's t,
+    else its step count, in a checkpoint from before the record kept t); -inf where it says neither."""
+    if "nodes/t" in arrays:
+        return float(arrays["nodes/t"])
+    run = json.loads(str(arrays["run"])) if "run" in arrays else {}
+    t = run.get("t", run.get("n_steps"))
+    return float(t) if isinstance(t, (int, float)) else -math.inf
+
+
+def _job(job) -> str | None:
+    """A job's (options, numerics) as the JSON text park keeps, so that a parked checkpoint is continued only by the
+    job that made it."""
+    return None if job is None else json.dumps(job, sort_keys=True, default=str)
+
+
+def park(folder: Path, parked: Path, job=None) -> bool:
     """Keep a killed run's last checkpoint where git keeps it, in the folder ``parked``: ``folder``'s
     ``snapshots/restart.npz`` (its arrays written again compressed, and read back before they replace an older
     one), the state file it names where it is an SPH run's (the snapshot or timed state it continues from; a PFEM
-    checkpoint holds its whole state) and ``summary.json`` (the commits its earlier parts ran, how far it got).
-    ``runs/`` is not in git, and a new checkout starts without it: a run longer than a working session continues
-    in the next one from here (:func:`unpark`). False where ``folder`` has no checkpoint, or ``parked`` holds this
-    one already."""
+    checkpoint holds its whole state), ``summary.json`` (the commits its earlier parts ran, how far it got) and,
+    given, ``job`` (the run's options and numerics, ``job.json``: :func:`unpark` then gives it only to the same
+    job). ``runs/`` is not in git, and a new checkout starts without it: a run longer than a working session
+    continues in the next one from here. False where ``folder`` has no checkpoint, or ``parked`` holds this one
+    already or one as far on (another checkout's, that got further: never replaced by an older one)."""
     import numpy as np
     snaps, parked = Path(folder) / "snapshots", Path(parked)
     if not (snaps / CHECKPOINT).exists():
         return False
     with np.load(snaps / CHECKPOINT, allow_pickle=False) as z:
         arrays = {k: z[k] for k in z.files}
-    if (parked / CHECKPOINT).exists() and _same_arrays(parked / CHECKPOINT, arrays):
-        return False
+    if (parked / CHECKPOINT).exists():
+        with np.load(parked / CHECKPOINT, allow_pickle=False) as z:
+            if checkpoint_time({k: z[k] for k in z.files if k in ("nodes/t", "run")}) >= checkpoint_time(arrays):
+                if job is not None and not (parked / "job.json").exists():      # parked before jobs were kept
+                    (parked / "job.json").write_text(_job(job))
+                return False
     state = None
     if "run" in arrays and "nodes/t" not in arrays:                 # an SPH checkpoint: the state file it names
         state = json.loads(str(arrays["run"])).get("snapshot")
     parked.mkdir(parents=True, exist_ok=True)
     tmp = parked / "restart.tmp.npz"
-    np.savez_compressed(tmp, **arrays)
-    if not _same_arrays(tmp, arrays):                               # read back: a parked checkpoint must restart
-        tmp.unlink()
-        raise OSError(f"{tmp}: the compressed checkpoint does not read back as written")
-    for old in parked.glob("*.npz"):                                # the state of an older checkpoint
-        if old.name not in (tmp.name, CHECKPOINT):
+    try:
+        np.savez_compressed(tmp, **arrays)
+        if not _same_arrays(tmp, arrays):                           # read back: a parked checkpoint must restart
+            raise OSError(f"{tmp}: the compressed checkpoint does not read back as written")
+        if state:                                                   # its state, then the checkpoint that names it
+            shutil.copyfile(snaps / state, parked / (state + ".tmp"))
+            os.replace(parked / (state + ".tmp"), parked / state)
+        for name, text in (("summary.json", (Path(folder) / "summary.json").read_text()
+                            if (Path(folder) / "summary.json").exists() else None), ("job.json", _job(job))):
+            if text is not None:
+                (parked / (name + ".tmp")).write_text(text)
+                os.replace(parked / (name + ".tmp"), parked / name)
+        os.replace(tmp, parked / CHECKPOINT)
+    finally:
+        tmp.unlink(missing_ok=True)
+    for old in parked.glob("*.npz"):                                # the state of the checkpoint replaced
+        if old.name not in (CHECKPOINT, state):
             old.unlink()
-    if state:
-        shutil.copyfile(snaps / state, parked / state)
-    if (Path(folder) / "summary.json").exists():
-        shutil.copyfile(Path(folder) / "summary.json", parked / "summary.json")
-    os.replace(tmp, parked / CHECKPOINT)                            # last: a parked checkpoint is whole or absent
     return True
 
 
-def unpark(parked: Path, folder: Path) -> bool:
+def parked_job_differs(parked: Path, job) -> bool:
+    """Whether the checkpoint parked in ``parked`` was made by another job than ``job`` (its job.json; False where
+    it kept none)."""
+    path = Path(parked) / "job.json"
+    return path.exists() and path.read_text() != _job(job)
+
+
+def unpark(parked: Path, folder: Path, job=None) -> bool:
     """Put a parked checkpoint (:func:`park`) back into the run folder ``folder``, so that the run continues from
-    it (``refsph run --restart``); only where ``folder`` has no checkpoint of its own (a fresh checkout). True if it
+    it (``refsph run --restart``); only where ``folder`` has no checkpoint of its own (a fresh checkout), and,
+    with ``job``, only where the checkpoint was parked by the same job (:func:`parked_job_differs`). True if it
     did."""
     parked, snaps = Path(parked), Path(folder) / "snapshots"
     if (snaps / CHECKPOINT).exists() or not (parked / CHECKPOINT).exists():
         return False
+    if job is not None and parked_job_differs(parked, job):
+        return False
     snaps.mkdir(parents=True, exist_ok=True)
-    for f in sorted(parked.glob("*.npz"), key=lambda f: f.name == CHECKPOINT):   # the checkpoint last
+    states = [f for f in parked.glob("*.npz") if f.name != CHECKPOINT and not f.name.endswith(".tmp.npz")]
+    for f in states + [parked / CHECKPOINT]:                        # the checkpoint last
         shutil.copyfile(f, snaps / f.name)
     if (parked / "summary.json").exists() and not (Path(folder) / "summary.json").exists():
         shutil.copyfile(parked / "summary.json", Path(folder) / "summary.json")

@@ -459,8 +459,10 @@ def run_case(key: str, options: dict, numerics: dict, quick: bool = False) -> di
     sweep's, TOOL)."""
     from refsph.simulate import SimulationError, run, run_commits
     out = run_folder(key, quick)
-    if not quick and study.unpark(PARKED / out.name, out):           # a run parked by an earlier session (--park)
+    if not quick and study.unpark(PARKED / out.name, out, (options, numerics)):   # parked by an earlier session
         print(f"{key}: continues from its parked checkpoint ({PARKED.relative_to(ROOT) / out.name})", flush=True)
+    elif not quick and study.parked_job_differs(PARKED / out.name, (options, numerics)):
+        print(f"{key}: its parked checkpoint was made with other options or numerics: not continued", flush=True)
     restart = (out / "snapshots" / "restart.npz").exists()
     t0 = time.perf_counter()
     rec = dict(key=key, options=options, numerics=numerics, quick=quick)
@@ -995,7 +997,8 @@ def method_gaps(res: dict) -> list[dict]:
                      Fc=100.0 * (c["Fc_pfem_N"] / c["Fc_sph_N"] - 1.0),
                      ratio=100.0 * (a["ratio_pfem"] / a["ratio_sph"] - 1.0))
         out.append(dict(case=a["case"], material=a["material"], ours=ours, paper=paper,
-                        retried=a["key"] != f"case {a['case']}" or b["key"] != f"case {a['case']}{PFEM10}"))
+                        retried=a["key"] != f"case {a['case']}"
+                        or b["key"] not in (f"case {a['case']}{PFEM10}", f"case {a['case']}{PFEM10}{RERUN}")))
     return out
 
 
@@ -1084,7 +1087,8 @@ def pfem_spacing_convergence(res: dict) -> list[dict]:
     values f at dx = t_u/5, t_u/10 and the fine spacing, the changes in percent, the observed order p of
     f = f0 + C dx^p (``study.observed_order``; None where the changes differ in sign or grow) and the extrapolated
     f0 (``study.richardson``; None below PFEM_ORDER_MIN), beside the measured value and the paper's PFEM
-    (``comparison``)."""
+    (``comparison``); z1, z2: each change over its standard deviation, from the relative spread of PFEM_SCATTER
+    (PFEM_SCATTER_CASE only, its spread at t_u/5 taken at every spacing; NaN elsewhere)."""
     paper_rows, out = {r["case"]: r for r in comparison(res, PFEM10)}, []   # its measured and paper columns only
     for n in sorted(dict(PFEM_FINE)):
         keys = pfem_spacing_keys(n)
@@ -1112,8 +1116,8 @@ def pfem_spacing_convergence(res: dict) -> list[dict]:
 
 def pfem_scatter_line(res: dict) -> str:
     """The PFEM's run-to-run scatter (PFEM_SCATTER: case 2 at t_u/5 with today's solver, unperturbed and jittered):
-    each quantity's sample standard deviation in percent of the mean, and how far the sweep's record of the same
-    cut, made by an earlier solver (the spacing table's t_u/5 column), lies from the mean in those units."""
+    each quantity's sample standard deviation in percent of the mean, and how far the sweep's first record of the
+    same cut, made by an earlier solver, lies from the mean in those units."""
     g = _groups(res, PFEM_SCATTER)
     n = min((len(v) for v in g.values()), default=0)
     if n < 2:
@@ -1123,18 +1127,22 @@ def pfem_scatter_line(res: dict) -> str:
     v_old = _values(old) if old is not None and old.get("status") == "ok" else {}
     parts, away = [], []
     for name, q, spec, _ in PFEM_ORDER_QUANTITIES:
-        x = g[q]
+        x = g[q][np.isfinite(g[q])]
+        if len(x) < 2:
+            continue
         sd = float(x.std(ddof=1))
         parts.append(f"{name.split(' [')[0]} {100 * sd / abs(x.mean()):.1f} %")
         if q in v_old:
             away.append(f"{name.split(' [')[0]} {_change_cell(_rel(v_old[q], x.mean()), _z(v_old[q] - x.mean(), sd))}")
     return (f"The PFEM's run-to-run scatter (case {PFEM_SCATTER_CASE} at t_u/5, {n} runs of today's solver: "
-            "unperturbed and with the workpiece's nodes moved at random by up to 0.01 of their spacing; the table "
+            "unperturbed and with each coordinate of the workpiece's nodes moved at random by up to 0.01 of their "
+            "spacing; the table "
             "'The PFEM's run-to-run scatter' below), sample standard deviation in percent of the mean: "
             + ", ".join(parts) + ". Case 2's changes above carry their z in brackets: the change over its standard "
             "deviation, sqrt(f_a^2 + f_b^2) times that relative spread (the spread at t_u/5 taken at every spacing, "
-            "an assumption: it is measured at t_u/5 only). The sweep's record of the same cut (the t_u/5 column, "
-            "made by an earlier solver) lies from these runs' mean by " + (", ".join(away) or "-")
+            "an assumption: it is measured at t_u/5 only). The sweep's first record of the same cut ('case "
+            f"{PFEM_SCATTER_CASE}{PFEM}', made by an earlier solver; the table takes its rerun, the first of these "
+            "runs) lies from these runs' mean by " + (", ".join(away) or "-")
             + " (in brackets: in standard deviations of one run).")
 
 
@@ -1188,7 +1196,8 @@ def _case_line(r: dict) -> str:
     """A case's row of the temperatures and force ratio."""
     status = r["status"] + (f" (courant {RETRY_COURANT:g})" if r["key"].endswith(RETRY) else
                             f" (gamma {DAMPED_GAMMA:g})" if r["key"].endswith(DAMPED) else
-                            f" (Bossak {BOSSAK_ALPHA:g})" if r["key"].endswith(BOSSAK) else "")
+                            f" (Bossak {BOSSAK_ALPHA:g})" if r["key"].endswith(BOSSAK) else
+                            " (rerun)" if r["key"].endswith(RERUN) else "")
     return (f"| {r['case']} | {r['material']} | {r['vc']:.0f} | {r['tu']:.2f} | {status} | "
             f"{_f(r['TRF'], '.0f')} ({_f(r['TRF_err'], '.0f')} %) | {_f(r['TRFmax'], '.0f')} | {r['TRF_exp']:.0f} | "
             f"{r['TRF_sph']:.0f} ({r['TRF_sph_err']:.0f} %) | {r['TRF_pfem']:.0f} ({r['TRF_pfem_err']:.0f} %) | "
@@ -1350,8 +1359,9 @@ STUDIES = (
               ("viscosity + damping heat [% of work]", "dissipation_of_work", ".1f"), ("CPU [min]", "cpu_min", ".1f"))),
     ("The PFEM's run-to-run scatter (case 2 at t_u/5 with today's solver: unperturbed, and with the workpiece's "
      "nodes moved at random by up to 0.01 of their spacing, three seeds; the sweep's record 'case 2 pfem n_tu 5', "
-     "made by an earlier solver, above them): what the spacing study's changes are read against",
-     (f"case {PFEM_SCATTER_CASE}{PFEM}",) + PFEM_SCATTER, BASIC),
+     "made by an earlier solver, against their spread below them): what the spacing study's changes are read "
+     "against",
+     PFEM_SCATTER, BASIC),
     ("What the PFEM's solver changes moved (the coarse cuts of the spacing study: each record made by an earlier "
      "solver, before the contact's changes of b294aaf and 248e7e0, above the same cut with today's, key suffix "
      "'rerun', which the spacing table takes)",
@@ -1672,6 +1682,7 @@ def _change_cell(d: float, z: float = math.nan) -> str:
 COMPARED = {SCATTER_S2: SCATTER_T5, REF_SCATTER: SCATTER_T5, SELF_SCATTER: SCATTER_T5, SCATTER_TI10_S2: SCATTER_TI10,
             SCATTER_TI10_REF: SCATTER_TI10, SCATTER_TI10_REF_S2: SCATTER_TI10_REF, SCATTER_REF: SCATTER_KEYS}
 SINGLES = {SCATTER_KEYS: ("case 1 s/2", "case 1 heat every 8"), SCATTER_TI10: ("case 10 s/2",),   # one run each
+           PFEM_SCATTER: (f"case {PFEM_SCATTER_CASE}{PFEM}",),
            SCATTER_TI10_REF: (f"case 10 n_tu 15{REFINED}", f"case 10{REFINED}{TO_CHIP}",
                               f"case 10{REFINED}{WITHOUT_HEAT}"),
            SCATTER_REF: (f"case 1 n_tu 15{REFINED}", f"case 1{REFINED}{TO_CHIP}", f"case 1{REFINED}{WITHOUT_HEAT}",
@@ -1897,16 +1908,18 @@ def status_lines(records: dict, todo: dict, quick: bool = False) -> list[str]:
 
 def park(records: dict, todo: dict) -> list[str]:
     """``--park``: the checkpoint of each job of ``todo`` that is not recorded, from its run folder, into PARKED
-    (:func:`study.park`); then the parked checkpoints of recorded jobs, or of no job at all, dropped (their run
-    folders are not touched). One line per change."""
+    (:func:`study.park`, with the job's options and numerics); then the parked checkpoints of recorded jobs, of no
+    job at all, or of a job whose options or numerics have changed since, dropped (their run folders are not
+    touched). One line per change."""
     lines = []
     for key in todo:
-        if key not in records and study.park(run_folder(key), PARKED / run_folder(key).name):
+        if key not in records and study.park(run_folder(key), PARKED / run_folder(key).name, todo[key]):
             t = _checkpoint_time(PARKED / run_folder(key).name / "restart.npz")
             lines.append(f"parked {key}" + ("" if t is None else f" at t = {t * 1e3:.3f} ms"))
     every = {**jobs(), **retry_jobs(records), **todo}
-    wanted = {run_folder(k).name for k in every if k not in records}
-    lines += [f"dropped {name}" for name in study.prune_parked(PARKED, lambda name: name in wanted)]
+    wanted = {run_folder(k).name: job for k, job in every.items() if k not in records}
+    lines += [f"dropped {name}" for name in study.prune_parked(
+        PARKED, lambda name: name in wanted and not study.parked_job_differs(PARKED / name, wanted[name]))]
     return lines or ["nothing to park"]
 
 

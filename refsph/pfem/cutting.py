@@ -241,9 +241,9 @@ def pfem_cut(case: int, n_tu: float = 10.0, travel: float = 16.0, length: float 
     ``remesh_quality`` (False: after every step as well, refsph's default; module text); ``edge_radius`` [m]: the
     tool's edge radius in the contact's outline (the paper's 10 um; the meshed tool of the heat step keeps it);
     ``eta``: the fraction of the frictional work that becomes heat (Eq. (7); the paper's 1; 0 keeps friction's
-    mechanics without its heat); ``jitter``: the free nodes of the workpiece moved at random by up to that many of
-    their own spacings (:func:`refsph.scenes.measure.jittered`, seed ``seed``): a perturbed run, for the run-to-run
-    scatter (on the square lattice Delaunay's choice of diagonal, and with it the path, turns on round-off)."""
+    mechanics without its heat); ``jitter``: each coordinate of the workpiece's free nodes moved at random by up to
+    that many of their spacings (:func:`refsph.scenes.measure.jittered`, seed ``seed``): a perturbed run, for the
+    run-to-run scatter (on the square lattice, Delaunay's choice of diagonal, and so the path, turns on rounding)."""
     row = rla_cutting_case(int(case))
     mat = MATERIALS[row["material"]]
     vc, tu = row["vc_m_per_min"] / 60.0, row["tu_mm"] * 1e-3

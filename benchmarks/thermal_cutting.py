@@ -132,8 +132,8 @@ WITHOUT_HEAT = GAP_CHANGES[2][0]                               # ... its key suf
 REFINED_NUMERICS = dict(ref_update_strain=REF_UPDATE, frequency_step=FREQUENCY_STEP)   # what 'refined' sets
 REFINED_RETRY = f" courant {COURANT:g}"      # a 'refined' case that failed: again at half the CFL part of its step
 RETRIES = {"": (RETRY,), PFEM10: (f" n_tu 10{BOSSAK}", DAMPED), REFINED: (REFINED_RETRY,)}
-REDONE = {PFEM10: (RERUN,)}                 # a table's case made again by today's solver (RERUN): taken before its
-#                                            record (refsph.teaching.plots.cut_record; PFEM10_RERUN_CASES)
+REDONE = {PFEM10: (RERUN,), PFEM: (RERUN,)}   # a table's case made again by today's solver (RERUN): taken before its
+#                                            record (refsph.teaching.plots.cut_record; PFEM*_RERUN_CASES)
 PFEM_OPTIONS = ("case", "n_tu", "travel", "length", "gamma", "remesh_when_needed", "bossak", "eta", "jitter",
                 "seed")  # the PFEM cut's options a key may set (the rest are the scene's SPH options)
 REMESH = " remesh when needed"              # the key suffix of a PFEM cut that remeshes only where the quality asks
@@ -149,6 +149,8 @@ PFEM_RERUN_CASES = (2, 5, 3, 6, 1)         # cases whose t_u/5 and t_u/10 PFEM r
 #                                            with today's (key suffix RERUN) for the spacing study (pfem_spacing_keys)
 PFEM10_RERUN_CASES = PFEM_RERUN_CASES + (4, 7)   # ... at t_u/10 also for the 18-case table (REDONE): AISI 1045's
 #                                            cases 1-7 were cut before the contact's changes of b294aaf and 248e7e0
+PFEM5_RERUN_CASES = PFEM10_RERUN_CASES + tuple(range(8, 19))   # ... at t_u/5 all 18 (REDONE): that table was cut
+#                                            on 2026-11-25, before those changes and the Newton's of later days
 REMESH_RUNS = ((1, PFEM, 5.0), (5, PFEM, 5.0), (10, PFEM, 5.0), (1, PFEM10, 10.0))   # (case, suffix, n_tu) of those
 
 
@@ -298,7 +300,7 @@ def more_jobs() -> list[tuple[str, str, dict, dict]]:
             for seed, key in enumerate(PFEM_SCATTER)]
     # the coarse cuts of the spacing study whose records an earlier solver made (before the contact's changes of
     # b294aaf and 248e7e0; the fine runs came after them), again with today's: t_u/5 (minutes), then t_u/10
-    out += [("pfem", f"case {n}{PFEM}{RERUN}", converged(n, n_tu=5.0), pfem) for n in PFEM_RERUN_CASES]
+    out += [("pfem", f"case {n}{PFEM}{RERUN}", converged(n, n_tu=5.0), pfem) for n in PFEM5_RERUN_CASES]
     out += [("pfem", f"case {n}{PFEM10}{RERUN}", converged(n, n_tu=10.0), pfem) for n in PFEM10_RERUN_CASES]
     out += [("pfem", f"case {n}{PFEM10}{TO_2MM}", to_2mm(n, n_tu=10.0), pfem) for n in TU_01]
     return out + [("cases", f"case {n}{TO_2MM}", to_2mm(n), sweep_numerics()) for n in TU_01]
@@ -1362,11 +1364,11 @@ STUDIES = (
      "made by an earlier solver, against their spread below them): what the spacing study's changes are read "
      "against",
      PFEM_SCATTER, BASIC),
-    ("What the PFEM's solver changes moved (the coarse cuts of the spacing study: each record made by an earlier "
-     "solver, before the contact's changes of b294aaf and 248e7e0, above the same cut with today's, key suffix "
-     "'rerun', which the spacing table takes)",
-     tuple(k for n in PFEM10_RERUN_CASES for sfx in (PFEM, PFEM10) if n in PFEM_RERUN_CASES or sfx == PFEM10
-           for k in (f"case {n}{sfx}", f"case {n}{sfx}{RERUN}")),
+    ("What the PFEM's solver changes moved (each record made by an earlier solver, before the contact's changes of "
+     "b294aaf and 248e7e0, above the same cut with today's, key suffix 'rerun', which the t_u/5 and t_u/10 tables "
+     "and the spacing table take; at t_u/5 all 18, at t_u/10 AISI 1045's cases 1-7)",
+     tuple(k for n in PFEM5_RERUN_CASES for sfx, cases in ((PFEM, PFEM5_RERUN_CASES), (PFEM10, PFEM10_RERUN_CASES))
+           if n in cases for k in (f"case {n}{sfx}", f"case {n}{sfx}{RERUN}")),
      BASIC + (("steps", "n_steps", "d"), ("CPU [min]", "cpu_min", ".1f"))),
     ("The same in the PFEM (t_u/10, the sweep's runs): friction acting but making no heat (eta = 0); one run each, "
      "the PFEM being deterministic", PFEM_GAP_RUNS,

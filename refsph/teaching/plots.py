@@ -148,7 +148,7 @@ CUT_RETRIES = {"": (" courant 0.075",), " pfem": (" n_tu 10 bossak -0.1", " n_tu
 # a series' case made again by a later version of the solver, under 'case N' + suffix + one of these: taken before
 # the record itself where it ended well (benchmarks/thermal_cutting.py's REDONE; the PFEM's cuts that an earlier
 # contact made, again with today's)
-CUT_REDONE = {" pfem": (" rerun",)}
+CUT_REDONE = {" pfem": (" rerun",), " pfem n_tu 5": (" rerun",)}
 
 
 def cut_record(runs: dict, key: str, retries=(), redone=()) -> tuple[str, dict | None]:

@@ -1116,6 +1116,49 @@ def pfem_spacing_convergence(res: dict) -> list[dict]:
     return out
 
 
+def solver_changes(res: dict) -> dict:
+    """Per quantity of PFEM_ORDER_QUANTITIES, over the (record, rerun) pairs of SOLVER_CHANGES both recorded ok: the
+    changes 100 (rerun - record) / record, and each change's z against the PFEM's run-to-run scatter (PFEM_SCATTER),
+    the change over sqrt(2) times one run's relative standard deviation (two single runs). {name: [(key, change,
+    z)]}; z NaN where the scatter is not recorded."""
+    g = _groups(res, PFEM_SCATTER)
+    out = {}
+    for name, q, _, _ in PFEM_ORDER_QUANTITIES:
+        x = g[q][np.isfinite(g[q])]
+        sd = 100 * float(x.std(ddof=1)) / abs(float(x.mean())) if len(x) >= 2 else math.nan
+        out[name] = []
+        for old, new in zip(SOLVER_CHANGES[::2], SOLVER_CHANGES[1::2]):
+            a, b = res["runs"].get(old), res["runs"].get(new)
+            if a is None or b is None or a.get("status") != "ok" or b.get("status") != "ok":
+                continue
+            d = _rel(_values(b)[q], _values(a)[q])
+            out[name].append((new, d, _z(d, math.sqrt(2) * sd)))
+    return out
+
+
+def solver_changes_line(res: dict) -> str:
+    """What :func:`solver_changes` says: per quantity, the pairs recorded, the mean and the largest |change|, and how
+    many changes lie beyond twice their standard deviation from the PFEM's run-to-run scatter."""
+    ch = solver_changes(res)
+    parts = []
+    for name, rows in ch.items():
+        if not rows:
+            continue
+        d = np.array([r[1] for r in rows])
+        z = np.array([r[2] for r in rows])
+        big = max(rows, key=lambda r: abs(r[1]))
+        beyond = (f", {int(np.sum(np.abs(z) > 2))} beyond 2 sd" if np.all(np.isfinite(z)) else "")
+        parts.append(f"{name.split(' [')[0]} mean |change| {np.mean(np.abs(d)):.1f} %, largest {big[1]:+.1f} % "
+                     f"('{big[0]}'){beyond}")
+    n = max((len(r) for r in ch.values()), default=0)
+    if n == 0:
+        return "No record and its rerun both recorded yet."
+    return (f"Over the {n} pairs recorded, rerun against record: " + "; ".join(parts) + ". The standard deviation of "
+            "a change between two single runs is sqrt(2) times one run's from the PFEM's run-to-run scatter (case 2 "
+            "at t_u/5, taken at every case and spacing: an assumption); a change within 2 sd is not told from the "
+            "scatter.")
+
+
 def pfem_scatter_line(res: dict) -> str:
     """The PFEM's run-to-run scatter (PFEM_SCATTER: case 2 at t_u/5 with today's solver, unperturbed and jittered):
     each quantity's sample standard deviation in percent of the mean, and how far the sweep's first record of the
@@ -1283,6 +1326,9 @@ REFINED_RUNS = tuple(f"case {n}{REFINED}" for n in range(1, 19))
 GAP_SINGLES = tuple((group, tuple(group[0] + sfx for sfx, _ in GAP_CHANGES))
                     for group in (REF_SCATTER_TI, REF_SCATTER))
 GAP_RUNS = tuple(k for group, singles in GAP_SINGLES for k in (group[0], *singles))
+SOLVER_CHANGES = tuple(k for n in PFEM5_RERUN_CASES for sfx, cases in ((PFEM, PFEM5_RERUN_CASES),
+                                                                        (PFEM10, PFEM10_RERUN_CASES))
+                       if n in cases for k in (f"case {n}{sfx}", f"case {n}{sfx}{RERUN}"))   # (record, rerun) pairs
 PFEM_GAP_RUNS = tuple(f"case {n}{PFEM10}{sfx}" for n in (1, 10) for sfx in ("", WITHOUT_HEAT))   # ... the PFEM's
 REFINED_SERIES = (("refsph SPH, t_u/10,\nref update 0.5,\ncourant 0.15", "", "D", "C1"),   # the figure's series
                   (f"refsph SPH, t_u/10,\nref update {REF_UPDATE:g},\nfrequency step", REFINED, "o", "C3"))
@@ -1367,9 +1413,7 @@ STUDIES = (
     ("What the PFEM's solver changes moved (each record made by an earlier solver, before the contact's changes of "
      "b294aaf and 248e7e0, above the same cut with today's, key suffix 'rerun', which the t_u/5 and t_u/10 tables "
      "and the spacing table take; at t_u/5 all 18, at t_u/10 AISI 1045's cases 1-7)",
-     tuple(k for n in PFEM5_RERUN_CASES for sfx, cases in ((PFEM, PFEM5_RERUN_CASES), (PFEM10, PFEM10_RERUN_CASES))
-           if n in cases for k in (f"case {n}{sfx}", f"case {n}{sfx}{RERUN}")),
-     BASIC + (("steps", "n_steps", "d"), ("CPU [min]", "cpu_min", ".1f"))),
+     SOLVER_CHANGES, BASIC + (("steps", "n_steps", "d"), ("CPU [min]", "cpu_min", ".1f"))),
     ("The same in the PFEM (t_u/10, the sweep's runs): friction acting but making no heat (eta = 0); one run each, "
      "the PFEM being deterministic", PFEM_GAP_RUNS,
      BASIC + (("T_RF - T_FCS [K]", "gap", ".0f"), ("friction heat [% of work]", "friction_of_work", ".1f"),
@@ -1518,6 +1562,8 @@ def _study_lines(res: dict) -> list[str]:
             if other is not None:
                 lines += ["", _difference_line(res, keys, other)]
             lines += [_single_run_line(res, k, keys) for k in SINGLES.get(keys, ())]
+        if keys == SOLVER_CHANGES:
+            lines += ["", solver_changes_line(res)]
         if keys == RESOLUTION_RUNS:
             lines += _resolution_lines(res)
         if keys == REFINED_RESOLUTION:

@@ -499,6 +499,37 @@ def test_thermal_cutting_pfem_spacing_changes_are_read_against_the_pfem_scatter(
     assert "Fc +2.3 % (+2.0)" in mod.pfem_scatter_line(dict(runs=runs))
 
 
+def test_thermal_cutting_solver_changes_are_read_against_the_pfem_scatter():
+    """solver_changes pairs each record with its rerun (SOLVER_CHANGES: both t_u/5 and t_u/10 tables), only where
+    both ended well, and reads each change against sqrt(2) times one run's spread from PFEM_SCATTER; the line counts
+    the changes beyond 2 sd, and says nothing of z without the scatter runs."""
+    import math
+    mod = _script("thermal_cutting")
+    pairs = list(zip(mod.SOLVER_CHANGES[::2], mod.SOLVER_CHANGES[1::2]))
+    assert all(new == old + mod.RERUN for old, new in pairs)
+    assert ("case 12 pfem n_tu 5", "case 12 pfem n_tu 5 rerun") in pairs
+    assert ("case 4 pfem", "case 4 pfem rerun") in pairs
+    assert "case 12 pfem" not in mod.SOLVER_CHANGES                     # t_u/10: AISI 1045's cases 1-7 only
+    assert mod.REDONE[mod.PFEM] == mod.REDONE[mod.PFEM10] == (mod.RERUN,)
+    runs = {"case 4 pfem": _resolution_record(400.0, 10), "case 4 pfem rerun": _resolution_record(440.0, 10),
+            "case 7 pfem": _resolution_record(400.0, 10), "case 7 pfem rerun": _resolution_record(404.0, 10),
+            "case 12 pfem n_tu 5": _resolution_record(400.0, 5), "case 12 pfem n_tu 5 rerun": dict(status="failed")}
+    rows = mod.solver_changes(dict(runs=runs))["Fc [N/mm]"]
+    assert [r[0] for r in rows] == ["case 4 pfem rerun", "case 7 pfem rerun"]   # the failed rerun left out
+    assert rows[0][1] == pytest.approx(10.0) and math.isnan(rows[0][2])       # no scatter runs: no z
+    assert "beyond" not in mod.solver_changes_line(dict(runs=runs))
+    for k, fc in zip(mod.PFEM_SCATTER, (396.0, 404.0, 396.0, 404.0)):        # sd 1.155 % of the mean
+        runs[k] = _resolution_record(fc, 5)
+    rows = mod.solver_changes(dict(runs=runs))["Fc [N/mm]"]
+    sd = 100 * float(np.std([396.0, 404.0, 396.0, 404.0], ddof=1)) / 400.0
+    assert rows[0][2] == pytest.approx(10.0 / (math.sqrt(2) * sd), rel=1e-12)   # 6.1 sd: beyond
+    assert rows[1][2] == pytest.approx(1.0 / (math.sqrt(2) * sd), rel=1e-12)    # 0.6 sd: within
+    line = mod.solver_changes_line(dict(runs=runs))
+    assert "Over the 2 pairs" in line
+    assert "Fc mean |change| 5.5 %, largest +10.0 % ('case 4 pfem rerun'), 1 beyond" in line
+    assert mod.solver_changes_line(dict(runs={})).startswith("No record and its rerun")
+
+
 def test_pfem_cut_jitter_moves_only_free_nodes_by_at_most_their_spacing_fraction():
     """pfem_cut(jitter=0.01, seed=k): each free node of the workpiece moved by at most 0.01 of its own spacing, the
     held ones (bottom row, left column) and the tool where they were, the same seed the same nodes, another seed

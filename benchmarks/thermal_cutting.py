@@ -393,9 +393,9 @@ def bossak_cut(n: int, n_tu: float) -> dict:
 def retry_jobs(records: dict, studies=STUDY_NAMES) -> dict:
     """The retries (RETRIES) of the t_u/10 tables' cases whose record failed and whose retry is not in jobs(): an
     SPH case 'case N' again at RETRY_COURANT, a PFEM case 'case N pfem' with the Bossak-Newmark rule (key + the
-    first of RETRIES[PFEM10]), a PFEM cut to 2 mm 'case N pfem 2 mm' with it too (key + BOSSAK), a 'refined' case
-    at courant COURANT under the same frequency step (key + REFINED_RETRY); the sweep adds them, so that a failed
-    case is taken again without a new line in jobs()."""
+    first of RETRIES[PFEM10]; also where its rerun by today's solver failed), a PFEM cut to 2 mm 'case N pfem 2 mm'
+    with it too (key + BOSSAK), a 'refined' case at courant COURANT under the same frequency step (key +
+    REFINED_RETRY); the sweep adds them, so that a failed case is taken again without a new line in jobs()."""
     out = {}
     for n in TU_01:
         key = f"case {n}{PFEM10}{TO_2MM}"
@@ -405,8 +405,8 @@ def retry_jobs(records: dict, studies=STUDY_NAMES) -> dict:
         sph, pfem = f"case {n}", f"case {n}{PFEM10}"
         if "cases" in studies and records.get(sph, {}).get("status", "ok") != "ok":
             out[sph + RETRY] = (converged(n), sweep_numerics(courant=RETRY_COURANT))
-        if "pfem" in studies and records.get(pfem, {}).get("status", "ok") != "ok":
-            out[pfem + RETRIES[PFEM10][0]] = (bossak_cut(n, 10.0), dict(method="pfem"))
+        if "pfem" in studies and any(records.get(k, {}).get("status", "ok") != "ok" for k in (pfem, pfem + RERUN)):
+            out[pfem + RETRIES[PFEM10][0]] = (bossak_cut(n, 10.0), dict(method="pfem"))   # failed, or its rerun
         if "refined" in studies and records.get(f"case {n}{REFINED}", {}).get("status", "ok") != "ok":
             out[f"case {n}{REFINED}{REFINED_RETRY}"] = (converged(n), dict(REFINED_NUMERICS, courant=COURANT))
     return out

@@ -153,13 +153,18 @@ CUT_REDONE = {" pfem": (" rerun",), " pfem n_tu 5": (" rerun",)}
 
 def cut_record(runs: dict, key: str, retries=(), redone=()) -> tuple[str, dict | None]:
     """(key, record) that the sweep's tables and :func:`measured_cuts` take for ``key``: its run made again by a later
-    solver, ``key + suffix`` (``redone``: the suffixes, in order), where one is recorded 'ok'; else the run itself
-    (None if not recorded), or where it failed, its first retry ``key + suffix`` (``retries``: the suffixes, in
-    order) recorded 'ok', else the failed run."""
+    solver, ``key + suffix`` (``redone``: the suffixes, in order), where one is recorded 'ok'; where that run failed,
+    the first retry below recorded 'ok', else the record itself; else the run itself (None if not recorded), or
+    where it failed, its first retry ``key + suffix`` (``retries``: the suffixes, in order) recorded 'ok', else the
+    failed run."""
     again = next(((key + t, runs[key + t]) for t in redone if runs.get(key + t, {}).get("status") == "ok"), None)
     if again is not None:
         return again
     r = runs.get(key)
+    failed_again = any(runs.get(key + t, {}).get("status", "ok") != "ok" for t in redone)
+    if failed_again:      # made again by today's solver and failed: its retry where one ended well, else the record
+        return next(((key + t, runs[key + t]) for t in retries if runs.get(key + t, {}).get("status") == "ok"),
+                    (key, r))
     if r is None or r.get("status") == "ok":
         return key, r
     return next(((key + t, runs[key + t]) for t in retries if runs.get(key + t, {}).get("status") == "ok"), (key, r))

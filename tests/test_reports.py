@@ -827,6 +827,14 @@ def test_a_case_made_again_by_todays_solver_is_taken_before_its_record():
     assert cut_record(runs, "case 2 pfem") == ("case 2 pfem", ok)
     bossak = " n_tu 10 bossak -0.1"
     assert cut_record(runs, "case 3 pfem", (bossak,), (" rerun",))[0] == "case 3 pfem" + bossak   # its rerun failed
+    runs.update({"case 6 pfem": dict(status="ok", tag=6), "case 6 pfem rerun": bad})   # an ok record, a failed rerun
+    assert cut_record(runs, "case 6 pfem", (bossak,), (" rerun",)) == ("case 6 pfem", runs["case 6 pfem"])
+    runs["case 6 pfem" + bossak] = dict(status="ok", tag=7)                            # ... then its retry: taken
+    retried = ("case 6 pfem" + bossak, runs["case 6 pfem" + bossak])
+    assert cut_record(runs, "case 6 pfem", (bossak,), (" rerun",)) == retried
+    assert cut_record(runs, "case 6 pfem", (bossak,)) == ("case 6 pfem", runs["case 6 pfem"])   # no redone asked
+    assert "case 6 pfem" + bossak in mod.retry_jobs({"case 6 pfem": ok, "case 6 pfem rerun": bad})
+    assert "case 6 pfem" + bossak not in mod.retry_jobs({"case 6 pfem": ok, "case 6 pfem rerun": ok})
     rec = _resolution_record(420.0, 10)
     rows = mod.comparison(dict(runs={"case 2 pfem": _resolution_record(400.0, 10), "case 2 pfem rerun": rec}),
                           mod.PFEM10)

@@ -1102,14 +1102,13 @@ def pfem_spacing_convergence(res: dict) -> list[dict]:
             continue
         vals, c = [_values(r) for r in runs], paper_rows[n]
         h = [v["dx_um"] for v in vals]
-        spread = _groups(res, PFEM_SCATTER) if n == PFEM_SCATTER_CASE else {}
+        spread = scatter(res, PFEM_SCATTER) if n == PFEM_SCATTER_CASE else {}
         for name, q, spec, paper in PFEM_ORDER_QUANTITIES:
             f = [float(v[q]) for v in vals]
             p = study.observed_order(h, f)
             f0 = study.richardson(h, f, p) if p is not None and PFEM_ORDER_MIN <= p < math.inf else None
             exp, pfem = (c[f"{paper}_exp"], c[f"{paper}_pfem"]) if paper else (None, None)
-            g = spread.get(q, ())
-            sd = float(g.std(ddof=1) / abs(g.mean())) if len(g) >= 2 else math.nan   # relative, at every spacing
+            sd = spread[q]["std_pct"] / 100 if q in spread else math.nan   # relative, taken at every spacing
             z1, z2 = (_z(b - a, sd * math.hypot(a, b)) for a, b in ((f[0], f[1]), (f[1], f[2])))
             out.append(dict(case=n, keys=keys, name=name, spec=spec, h=h, f=f, p=p, f0=f0, exp=exp, pfem=pfem,
                             d1=_rel(f[1], f[0]), d2=_rel(f[2], f[1]), z1=z1, z2=z2))
@@ -1121,11 +1120,10 @@ def solver_changes(res: dict) -> dict:
     changes 100 (rerun - record) / record, and each change's z against the PFEM's run-to-run scatter (PFEM_SCATTER),
     the change over sqrt(2) times one run's relative standard deviation (two single runs). {name: [(key, change,
     z)]}; z NaN where the scatter is not recorded."""
-    g = _groups(res, PFEM_SCATTER)
+    sc = scatter(res, PFEM_SCATTER)
     out = {}
     for name, q, _, _ in PFEM_ORDER_QUANTITIES:
-        x = g[q][np.isfinite(g[q])]
-        sd = 100 * float(x.std(ddof=1)) / abs(float(x.mean())) if len(x) >= 2 else math.nan
+        sd = sc[q]["std_pct"] if q in sc else math.nan
         out[name] = []
         for old, new in zip(SOLVER_CHANGES[::2], SOLVER_CHANGES[1::2]):
             a, b = res["runs"].get(old), res["runs"].get(new)

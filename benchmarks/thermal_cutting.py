@@ -298,6 +298,10 @@ def more_jobs() -> list[tuple[str, str, dict, dict]]:
     # of their spacing, three seeds), for the changes of the spacing study (pfem_spacing_convergence) to be read by
     out += [("pfem", key, dict(converged(2, n_tu=5.0), **({} if seed == 0 else dict(jitter=0.01, seed=seed))), pfem)
             for seed, key in enumerate(PFEM_SCATTER)]
+    # ... and at t_u/10, the resolution of the 18-case table (case 2's rerun is the unperturbed run), so that the
+    # t_u/10 changes are read against the scatter at their own resolution instead of the one at t_u/5
+    out += [("pfem", key, dict(converged(PFEM_SCATTER_CASE, n_tu=10.0), jitter=0.01, seed=seed), pfem)
+            for seed, key in enumerate(PFEM_SCATTER10) if seed]
     # the coarse cuts of the spacing study whose records an earlier solver made (before the contact's changes of
     # b294aaf and 248e7e0; the fine runs came after them), again with today's: t_u/5 (minutes), then t_u/10
     out += [("pfem", f"case {n}{PFEM}{RERUN}", converged(n, n_tu=5.0), pfem) for n in PFEM5_RERUN_CASES]
@@ -1301,6 +1305,8 @@ SCATTER_KEYS = ("case 1", "case 1 jitter 1", "case 1 jitter 2", "case 1 jitter 3
 PFEM_SCATTER_CASE = 2
 PFEM_SCATTER = (f"case {PFEM_SCATTER_CASE}{PFEM}{RERUN}",) + tuple(f"case {PFEM_SCATTER_CASE}{PFEM} jitter {seed}"
                                                       for seed in (1, 2, 3))   # the PFEM's scatter (more_jobs)
+PFEM_SCATTER10 = (f"case {PFEM_SCATTER_CASE}{PFEM10}{RERUN}",) + tuple(
+    f"case {PFEM_SCATTER_CASE}{PFEM10} jitter {seed}" for seed in (1, 2, 3))   # ... at t_u/10 (more_jobs)
 SCATTER_T5 = tuple(k.replace("case 1", "case 1 n_tu 5") for k in SCATTER_KEYS)         # at t_u/5
 SCATTER_S2 = tuple(k.replace("n_tu 5", "n_tu 5 s/2") for k in SCATTER_T5)               # at t_u/5 and s/2
 SCATTER_TI10 = ("case 10", "case 10 jitter 1", "case 10 jitter 2")                     # Ti6Al4V at t_u/10

@@ -868,6 +868,7 @@ def report(res: dict, before: dict | None = None) -> str:
              (("AISI1045", SCATTER_REF), ("Ti6Al4V", SCATTER_TI10_REF))}
     noise.update({("SPH, t_u/10", m): scatter(res, keys) for m, keys in (("AISI1045", SCATTER_KEYS),
                                                                           ("Ti6Al4V", SCATTER_TI10))})
+    noise[("PFEM, t_u/10", "AISI1045")] = scatter(res, PFEM_SCATTER10)   # case 2's, taken for the other cases
     lines += ["", P("trend_steps")] + _trend_step_lines(
         {"SPH, t_u/10": rows, f"SPH, t_u/10, ref update {REF_UPDATE:g}": refined, "PFEM, t_u/10": pfem10}, noise)
     lines += ["", P("rake_ceiling")] + _ceiling_lines(rows)
@@ -1093,8 +1094,8 @@ def pfem_spacing_convergence(res: dict) -> list[dict]:
     values f at dx = t_u/5, t_u/10 and the fine spacing, the changes in percent, the observed order p of
     f = f0 + C dx^p (``study.observed_order``; None where the changes differ in sign or grow) and the extrapolated
     f0 (``study.richardson``; None below PFEM_ORDER_MIN), beside the measured value and the paper's PFEM
-    (``comparison``); z1, z2: each change over its standard deviation, from the relative spread of PFEM_SCATTER
-    (PFEM_SCATTER_CASE only, its spread at t_u/5 taken at every spacing; NaN elsewhere)."""
+    (``comparison``); z1, z2: each change over its standard deviation, from the relative spread at each spacing
+    (:func:`pfem_scatter_of`; PFEM_SCATTER_CASE only, NaN elsewhere)."""
     paper_rows, out = {r["case"]: r for r in comparison(res, PFEM10)}, []   # its measured and paper columns only
     for n in sorted(dict(PFEM_FINE)):
         keys = pfem_spacing_keys(n)
@@ -1106,14 +1107,14 @@ def pfem_spacing_convergence(res: dict) -> list[dict]:
             continue
         vals, c = [_values(r) for r in runs], paper_rows[n]
         h = [v["dx_um"] for v in vals]
-        spread = scatter(res, PFEM_SCATTER) if n == PFEM_SCATTER_CASE else {}
+        spreads = [pfem_scatter_of(res, k) if n == PFEM_SCATTER_CASE else {} for k in keys]
         for name, q, spec, paper in PFEM_ORDER_QUANTITIES:
             f = [float(v[q]) for v in vals]
             p = study.observed_order(h, f)
             f0 = study.richardson(h, f, p) if p is not None and PFEM_ORDER_MIN <= p < math.inf else None
             exp, pfem = (c[f"{paper}_exp"], c[f"{paper}_pfem"]) if paper else (None, None)
-            sd = spread[q]["std_pct"] / 100 if q in spread else math.nan   # relative, taken at every spacing
-            z1, z2 = (_z(b - a, sd * math.hypot(a, b)) for a, b in ((f[0], f[1]), (f[1], f[2])))
+            s = [sp[q]["std_pct"] / 100 if q in sp else math.nan for sp in spreads]   # relative, per spacing
+            z1, z2 = (_z(f[i + 1] - f[i], math.hypot(s[i] * f[i], s[i + 1] * f[i + 1])) for i in (0, 1))
             out.append(dict(case=n, keys=keys, name=name, spec=spec, h=h, f=f, p=p, f0=f0, exp=exp, pfem=pfem,
                             d1=_rel(f[1], f[0]), d2=_rel(f[2], f[1]), z1=z1, z2=z2))
     return out
@@ -1121,18 +1122,18 @@ def pfem_spacing_convergence(res: dict) -> list[dict]:
 
 def solver_changes(res: dict) -> dict:
     """Per quantity of PFEM_ORDER_QUANTITIES, over the (record, rerun) pairs of SOLVER_CHANGES both recorded ok: the
-    changes 100 (rerun - record) / record, and each change's z against the PFEM's run-to-run scatter (PFEM_SCATTER),
-    the change over sqrt(2) times one run's relative standard deviation (two single runs). {name: [(key, change,
-    z)]}; z NaN where the scatter is not recorded."""
-    sc = scatter(res, PFEM_SCATTER)
+    changes 100 (rerun - record) / record, and each change's z against the PFEM's run-to-run scatter at the pair's
+    spacing (:func:`pfem_scatter_of`), the change over sqrt(2) times one run's relative standard deviation (two
+    single runs). {name: [(key, change, z)]}; z NaN where the scatter is not recorded."""
     out = {}
     for name, q, _, _ in PFEM_ORDER_QUANTITIES:
-        sd = sc[q]["std_pct"] if q in sc else math.nan
         out[name] = []
         for old, new in zip(SOLVER_CHANGES[::2], SOLVER_CHANGES[1::2]):
             a, b = res["runs"].get(old), res["runs"].get(new)
             if a is None or b is None or a.get("status") != "ok" or b.get("status") != "ok":
                 continue
+            sc = pfem_scatter_of(res, new)
+            sd = sc[q]["std_pct"] if q in sc else math.nan
             d = _rel(_values(b)[q], _values(a)[q])
             out[name].append((new, d, _z(d, math.sqrt(2) * sd)))
     return out
@@ -1156,41 +1157,55 @@ def solver_changes_line(res: dict) -> str:
     if n == 0:
         return "No record and its rerun both recorded yet."
     return (f"Over the {n} pairs recorded, rerun against record: " + "; ".join(parts) + ". The standard deviation of "
-            "a change between two single runs is sqrt(2) times one run's from the PFEM's run-to-run scatter (case 2 "
-            "at t_u/5, taken at every case and spacing: an assumption); a change within 2 sd is not told from the "
-            "scatter.")
+            "a change between two single runs is sqrt(2) times one run's from the PFEM's run-to-run scatter at the "
+            "pair's spacing (case 2's at t_u/5 or at t_u/10, taken at every case: an assumption); a change within 2 sd "
+            "is not told from the scatter.")
+
+
+def pfem_scatter_of(res: dict, key: str) -> dict:
+    """The PFEM's run-to-run scatter (:func:`scatter`) at the node spacing of the run ``key``: PFEM_SCATTER's (case 2
+    at t_u/5) for a t_u/5 run (key suffix PFEM), PFEM_SCATTER10's (case 2 at t_u/10) for any other, the finer
+    spacings included (an assumption there: the scatter is measured at t_u/5 and t_u/10 only)."""
+    return scatter(res, PFEM_SCATTER if PFEM in key else PFEM_SCATTER10)
+
+
+def _pfem_scatter_sentence(res: dict, keys: tuple, where: str, old_key: str) -> str:
+    """One scatter group of the PFEM (``keys``, case 2 at the spacing ``where``): each quantity's sample standard
+    deviation in percent of the mean, and how far ``old_key``, the same cut by an earlier solver, lies from that
+    mean, in percent and (in brackets) in standard deviations of one run."""
+    sc = scatter(res, keys)
+    n = min((v["n"] for v in sc.values()), default=0)
+    if n < 2:
+        n = len([k for k in keys if res["runs"].get(k, {}).get("status") == "ok"])
+        return f"At {where}: {n} of {len(keys)} runs recorded, too few for a spread."
+    old = res["runs"].get(old_key)
+    v_old = _values(old) if old is not None and old.get("status") == "ok" else {}
+    parts, away = [], []
+    for name, q, _, _ in PFEM_ORDER_QUANTITIES:
+        if q not in sc:
+            continue
+        short, mean, sd = name.split(" [")[0], sc[q]["mean"], sc[q]["std_pct"] / 100 * abs(sc[q]["mean"])
+        parts.append(f"{short} {sc[q]['std_pct']:.1f} %")
+        if q in v_old:
+            away.append(f"{short} {_change_cell(_rel(v_old[q], mean), _z(v_old[q] - mean, sd))}")
+    return (f"At {where}, {n} runs: " + ", ".join(parts) + f"; the sweep's first record of the same cut ('{old_key}', "
+            "made by an earlier solver; the tables take its rerun, the first of these runs) lies from their mean by "
+            + (", ".join(away) or "-") + ".")
 
 
 def pfem_scatter_line(res: dict) -> str:
-    """The PFEM's run-to-run scatter (PFEM_SCATTER: case 2 at t_u/5 with today's solver, unperturbed and jittered):
-    each quantity's sample standard deviation in percent of the mean, and how far the sweep's first record of the
-    same cut, made by an earlier solver, lies from the mean in those units."""
-    g = _groups(res, PFEM_SCATTER)
-    n = min((len(v) for v in g.values()), default=0)
-    if n < 2:
-        return (f"The PFEM's run-to-run scatter (case {PFEM_SCATTER_CASE} at t_u/5, the table 'The PFEM's run-to-run "
-                f"scatter' below): {n} of {len(PFEM_SCATTER)} runs recorded, too few for a spread.")
-    old = res["runs"].get(f"case {PFEM_SCATTER_CASE}{PFEM}")
-    v_old = _values(old) if old is not None and old.get("status") == "ok" else {}
-    parts, away = [], []
-    for name, q, spec, _ in PFEM_ORDER_QUANTITIES:
-        x = g[q][np.isfinite(g[q])]
-        if len(x) < 2:
-            continue
-        sd = float(x.std(ddof=1))
-        parts.append(f"{name.split(' [')[0]} {100 * sd / abs(x.mean()):.1f} %")
-        if q in v_old:
-            away.append(f"{name.split(' [')[0]} {_change_cell(_rel(v_old[q], x.mean()), _z(v_old[q] - x.mean(), sd))}")
-    return (f"The PFEM's run-to-run scatter (case {PFEM_SCATTER_CASE} at t_u/5, {n} runs of today's solver: "
-            "unperturbed and with each coordinate of the workpiece's nodes moved at random by up to 0.01 of their "
-            "spacing; the table "
-            "'The PFEM's run-to-run scatter' below), sample standard deviation in percent of the mean: "
-            + ", ".join(parts) + ". Case 2's changes above carry their z in brackets: the change over its standard "
-            "deviation, sqrt(f_a^2 + f_b^2) times that relative spread (the spread at t_u/5 taken at every spacing, "
-            "an assumption: it is measured at t_u/5 only). The sweep's first record of the same cut ('case "
-            f"{PFEM_SCATTER_CASE}{PFEM}', made by an earlier solver; the table takes its rerun, the first of these "
-            "runs) lies from these runs' mean by " + (", ".join(away) or "-")
-            + " (in brackets: in standard deviations of one run).")
+    """The PFEM's run-to-run scatter, case 2 with today's solver, unperturbed and jittered, at t_u/5 (PFEM_SCATTER)
+    and at t_u/10 (PFEM_SCATTER10): each quantity's sample standard deviation in percent of the mean, and how far
+    the sweep's first record of the same cut, made by an earlier solver, lies from the mean in those units."""
+    return (f"The PFEM's run-to-run scatter (case {PFEM_SCATTER_CASE}, today's solver, unperturbed and with each "
+            "coordinate of the workpiece's nodes moved at random by up to 0.01 of their spacing; the tables 'The "
+            "PFEM's run-to-run scatter' below), sample standard deviation in percent of the mean (in brackets after "
+            "a change: the change in standard deviations of one run). "
+            + _pfem_scatter_sentence(res, PFEM_SCATTER, "t_u/5", f"case {PFEM_SCATTER_CASE}{PFEM}") + " "
+            + _pfem_scatter_sentence(res, PFEM_SCATTER10, "t_u/10", f"case {PFEM_SCATTER_CASE}{PFEM10}")
+            + " Case 2's spacing changes above carry their z in brackets: the change over its standard deviation, "
+            "sqrt((s_a f_a)^2 + (s_b f_b)^2) with s each spacing's relative spread (t_u/10's taken at the finer "
+            "spacing, an assumption: it is measured at t_u/5 and t_u/10 only).")
 
 
 def _pfem_spacing_lines(rows: list) -> list[str]:
@@ -1414,6 +1429,11 @@ STUDIES = (
      "made by an earlier solver, against their spread below them): what the spacing study's changes are read "
      "against",
      PFEM_SCATTER, BASIC),
+    ("The PFEM's run-to-run scatter at t_u/10 (case 2 as above at the 18-case table's resolution: its rerun and three "
+     "jittered runs; the sweep's record 'case 2 pfem', made by an earlier solver, against their spread below them, "
+     "and their mean against the t_u/5 runs'): what the t_u/10 changes (the solver's, the trends' steps, the "
+     "spacing study's last step) are read against",
+     PFEM_SCATTER10, BASIC),
     ("What the PFEM's solver changes moved (each record made by an earlier solver, before the contact's changes of "
      "b294aaf and 248e7e0, above the same cut with today's, key suffix 'rerun', which the t_u/5 and t_u/10 tables "
      "and the spacing table take; at t_u/5 all 18, at t_u/10 AISI 1045's cases 1-7)",
@@ -1732,9 +1752,10 @@ def _change_cell(d: float, z: float = math.nan) -> str:
 
 # a scatter group -> the group it is compared with (_difference_line)
 COMPARED = {SCATTER_S2: SCATTER_T5, REF_SCATTER: SCATTER_T5, SELF_SCATTER: SCATTER_T5, SCATTER_TI10_S2: SCATTER_TI10,
-            SCATTER_TI10_REF: SCATTER_TI10, SCATTER_TI10_REF_S2: SCATTER_TI10_REF, SCATTER_REF: SCATTER_KEYS}
+            SCATTER_TI10_REF: SCATTER_TI10, SCATTER_TI10_REF_S2: SCATTER_TI10_REF, SCATTER_REF: SCATTER_KEYS,
+            PFEM_SCATTER10: PFEM_SCATTER}
 SINGLES = {SCATTER_KEYS: ("case 1 s/2", "case 1 heat every 8"), SCATTER_TI10: ("case 10 s/2",),   # one run each
-           PFEM_SCATTER: (f"case {PFEM_SCATTER_CASE}{PFEM}",),
+           PFEM_SCATTER: (f"case {PFEM_SCATTER_CASE}{PFEM}",), PFEM_SCATTER10: (f"case {PFEM_SCATTER_CASE}{PFEM10}",),
            SCATTER_TI10_REF: (f"case 10 n_tu 15{REFINED}", f"case 10{REFINED}{TO_CHIP}",
                               f"case 10{REFINED}{WITHOUT_HEAT}"),
            SCATTER_REF: (f"case 1 n_tu 15{REFINED}", f"case 1{REFINED}{TO_CHIP}", f"case 1{REFINED}{WITHOUT_HEAT}",

@@ -474,29 +474,38 @@ def test_thermal_cutting_pfem_spacing_order_through_three_spacings():
     assert "case 8 pfem n_tu 5" + mod.BOSSAK in [k for k, _ in mod.time_rule_jobs()]       # time rule's study's
 
 def test_thermal_cutting_pfem_spacing_changes_are_read_against_the_pfem_scatter():
-    """Case 2's spacing changes carry a z from the PFEM's scatter runs (PFEM_SCATTER: their relative spread taken at
-    every spacing), other cases none; pfem_scatter_line gives the spread and how far the sweep's older t_u/5 record
-    lies from the scatter runs' mean, and says so where too few runs are recorded."""
+    """Case 2's spacing changes carry a z from the PFEM's scatter runs at each spacing (PFEM_SCATTER at t_u/5,
+    PFEM_SCATTER10 at t_u/10 and taken at the finer spacing), other cases none; pfem_scatter_line gives both spreads
+    and how far the sweep's older records lie from each group's mean, and says so where too few runs are recorded."""
     import math
     mod = _script("thermal_cutting")
     keys = mod.pfem_spacing_keys(2)
     assert keys[0] == mod.PFEM_SCATTER[0]                  # the unperturbed scatter run is the spacing's t_u/5 run
+    assert keys[1] == mod.PFEM_SCATTER10[0]                # ... and its t_u/10 run
     runs = {k: _resolution_record(fc, n) for k, fc, n in zip(keys, (396.0, 440.0, 444.0), (5, 10, 15))}
     assert math.isnan(mod.pfem_spacing_convergence(dict(runs=runs))[1]["z1"])
-    assert "1 of 4 runs recorded" in mod.pfem_scatter_line(dict(runs=runs))
+    assert "At t_u/5: 1 of 4 runs recorded" in mod.pfem_scatter_line(dict(runs=runs))
     for k, fc in zip(mod.PFEM_SCATTER[1:], (404.0, 396.0, 404.0)):         # mean 400, sd 4.62 (1.15 %)
         runs[k] = _resolution_record(fc, 5)
+    fc = {(r["case"], r["name"]): r for r in mod.pfem_spacing_convergence(dict(runs=runs))}[2, "Fc [N/mm]"]
+    assert math.isnan(fc["z1"]) and math.isnan(fc["z2"])                   # no spread at t_u/10 yet: no z
+    for k, fc in zip(mod.PFEM_SCATTER10[1:], (436.0, 444.0, 440.0)):       # mean 440, sd 3.27 (0.74 %)
+        runs[k] = _resolution_record(fc, 10)
     rows = {(r["case"], r["name"]): r for r in mod.pfem_spacing_convergence(dict(runs=runs))}
     fc = rows[2, "Fc [N/mm]"]
-    sd = float(np.std([396.0, 404.0, 396.0, 404.0], ddof=1)) / 400.0
-    assert fc["z1"] == pytest.approx(44.0 / (sd * math.hypot(396.0, 440.0)), rel=1e-12)
-    assert fc["z2"] == pytest.approx(4.0 / (sd * math.hypot(440.0, 444.0)), rel=1e-12)
+    s5 = float(np.std([396.0, 404.0, 396.0, 404.0], ddof=1)) / 400.0
+    s10 = float(np.std([440.0, 436.0, 444.0, 440.0], ddof=1)) / 440.0
+    assert fc["z1"] == pytest.approx(44.0 / math.hypot(s5 * 396.0, s10 * 440.0), rel=1e-12)
+    assert fc["z2"] == pytest.approx(4.0 / (s10 * math.hypot(440.0, 444.0)), rel=1e-12)
     assert math.isnan(rows[2, "T_RF [K]"]["z1"])                             # no spread: no z (0 / 0)
     assert "+11.1 % (" in mod._pfem_spacing_lines([fc])[-1]
     line = mod.pfem_scatter_line(dict(runs=runs))
-    assert "4 runs" in line and "Fc 1.2 %" in line and "mean by - (" in line  # no older record given
+    assert "At t_u/5, 4 runs: " in line and "Fc 1.2 %" in line and "mean by -." in line  # no older record given
+    assert "At t_u/10, 4 runs: " in line and "Fc 0.7 %" in line
     runs["case 2 pfem n_tu 5"] = _resolution_record(409.24, 5)               # two deviations above the mean
     assert "Fc +2.3 % (+2.0)" in mod.pfem_scatter_line(dict(runs=runs))
+    runs["case 2 pfem"] = _resolution_record(440.0 - 3 * 3.266, 10)         # three below the t_u/10 mean
+    assert "Fc -2.2 % (-3.0)" in mod.pfem_scatter_line(dict(runs=runs))
 
 
 def test_thermal_cutting_solver_changes_are_read_against_the_pfem_scatter():
@@ -518,8 +527,15 @@ def test_thermal_cutting_solver_changes_are_read_against_the_pfem_scatter():
     assert [r[0] for r in rows] == ["case 4 pfem rerun", "case 7 pfem rerun"]   # the failed rerun left out
     assert rows[0][1] == pytest.approx(10.0) and math.isnan(rows[0][2])       # no scatter runs: no z
     assert "beyond" not in mod.solver_changes_line(dict(runs=runs))
-    for k, fc in zip(mod.PFEM_SCATTER, (396.0, 404.0, 396.0, 404.0)):        # sd 1.155 % of the mean
+    for k, fc in zip(mod.PFEM_SCATTER, (392.0, 408.0, 392.0, 408.0)):        # sd 2.31 % of the mean at t_u/5
         runs[k] = _resolution_record(fc, 5)
+    assert math.isnan(mod.solver_changes(dict(runs=runs))["Fc [N/mm]"][0][2])   # t_u/10 pairs: t_u/10's scatter
+    for k, fc in zip(mod.PFEM_SCATTER10, (396.0, 404.0, 396.0, 404.0)):      # ... and half of it at t_u/10
+        runs[k] = _resolution_record(fc, 10)
+    runs["case 12 pfem n_tu 5 rerun"] = _resolution_record(408.0, 5)         # a t_u/5 pair reads t_u/5's scatter
+    rows = mod.solver_changes(dict(runs=runs))["Fc [N/mm]"]
+    assert rows[2][0] == "case 12 pfem n_tu 5 rerun" and rows[2][2] == pytest.approx(rows[0][2] * 0.1, rel=1e-12)
+    runs.pop("case 12 pfem n_tu 5 rerun")
     rows = mod.solver_changes(dict(runs=runs))["Fc [N/mm]"]
     sd = 100 * float(np.std([396.0, 404.0, 396.0, 404.0], ddof=1)) / 400.0
     assert rows[0][2] == pytest.approx(10.0 / (math.sqrt(2) * sd), rel=1e-12)   # 6.1 sd: beyond

@@ -684,7 +684,9 @@ def trend_steps(rows) -> dict:
 def _trend_step_lines(sets: dict, noise: dict) -> list[str]:
     """The step-by-step trends table: per refsph set ({label: comparison rows}) and material, each TREND_STEPS
     entry's 'same of steps', and the steps of opposite sign as 'refsph / measured %' at the line's fixed value, with
-    the run-to-run scatter of that quantity ({material: scatter()} where measured; sd in percent)."""
+    the run-to-run scatter of that quantity ({material: scatter()} where measured; sd in percent) and each such
+    step's z, refsph's step over its standard deviation sqrt(2) sd (two single runs): how far its sign is told from
+    the scatter."""
     lines = []
     for label, rows in sets.items():
         for mat, t in trend_steps(rows).items():
@@ -692,8 +694,10 @@ def _trend_step_lines(sets: dict, noise: dict) -> list[str]:
             for name, _, _, along, sd_key in TREND_STEPS:
                 n, same, other = t[name]
                 unit = "mm" if along == "vc" else "m/min"
-                off = "; ".join(f"{d:+.1f} / {de:+.1f} at {x:g} {unit}" for x, d, de in other)
                 sd = noise.get((label, mat), {}).get(sd_key)
+                off = "; ".join(f"{d:+.1f} / {de:+.1f} at {x:g} {unit}"
+                                + (f" (z {_z(d, math.sqrt(2) * sd['std_pct']):+.1f})" if sd else "")
+                                for x, d, de in other)
                 cells.append(f"{same} of {n}" + (f" ({off})" if off else "")
                              + (f", sd {sd['std_pct']:.1f} %" if off and sd else ""))
             lines.append(f"| {label} | {mat} | " + " | ".join(cells) + " |")

@@ -76,7 +76,8 @@ def test_pfem_alpha_report_is_generated_from_the_json():
 def test_thermal_cutting_trend_steps_compare_each_step_sign():
     """thermal_cutting.trend_steps: two steps on each line; a step counts as the measured's when the two changes have
     one sign, and one of opposite sign is listed with both changes in percent at the line's fixed value; a missing
-    case drops its steps; the table's cell names the scatter only where a step went the other way."""
+    case drops its steps; the table's cell names the scatter, and each such step's z, only where a step went the
+    other way."""
     mod = _script("thermal_cutting")
     rows = [dict(material="AISI1045", vc=vc, tu=tu, Fc_N_per_mm=100 * tu, Fc_exp=tu, Fp_N_per_mm=tu, Fp_exp=tu,
                  TRF=vc + tu, TRF_exp=vc) for vc in (60, 120, 180) for tu in (0.1, 0.15, 0.2)]
@@ -89,7 +90,7 @@ def test_thermal_cutting_trend_steps_compare_each_step_sign():
     rows[4]["Fp_N_per_mm"] = None                    # vc 120, tu 0.15 not recorded: its two Fp steps drop
     assert mod.trend_steps(rows)["AISI1045"]["Fp with t_u"][0] == 4
     cells = mod._trend_step_lines({"x": rows}, {("x", "AISI1045"): {"Fc": dict(std_pct=6.0)}})[0].split(" | ")
-    assert cells[2] == "5 of 6 (-50.0 / +50.0 at 60 m/min), sd 6.0 %"
+    assert cells[2] == "5 of 6 (-50.0 / +50.0 at 60 m/min (z -5.9)), sd 6.0 %"   # -50 / (sqrt(2) 6)
     assert cells[3] == "4 of 4"
 
 

@@ -302,6 +302,9 @@ def more_jobs() -> list[tuple[str, str, dict, dict]]:
     # t_u/10 changes are read against the scatter at their own resolution instead of the one at t_u/5
     out += [("pfem", key, dict(converged(PFEM_SCATTER_CASE, n_tu=10.0), jitter=0.01, seed=seed), pfem)
             for seed, key in enumerate(PFEM_SCATTER10) if seed]
+    # ... and of a Ti6Al4V case at t_u/10 (case 10: its record postdates the contact's changes), three runs
+    out += [("pfem", key, dict(converged(10, n_tu=10.0), jitter=0.01, seed=seed), pfem)
+            for seed, key in enumerate(PFEM_SCATTER10_TI) if seed]
     # the coarse cuts of the spacing study whose records an earlier solver made (before the contact's changes of
     # b294aaf and 248e7e0; the fine runs came after them), again with today's: t_u/5 (minutes), then t_u/10
     out += [("pfem", f"case {n}{PFEM}{RERUN}", converged(n, n_tu=5.0), pfem) for n in PFEM5_RERUN_CASES]
@@ -872,7 +875,8 @@ def report(res: dict, before: dict | None = None) -> str:
              (("AISI1045", SCATTER_REF), ("Ti6Al4V", SCATTER_TI10_REF))}
     noise.update({("SPH, t_u/10", m): scatter(res, keys) for m, keys in (("AISI1045", SCATTER_KEYS),
                                                                           ("Ti6Al4V", SCATTER_TI10))})
-    noise[("PFEM, t_u/10", "AISI1045")] = scatter(res, PFEM_SCATTER10)   # case 2's, taken for the other cases
+    noise.update({("PFEM, t_u/10", m): scatter(res, keys) for m, keys in (("AISI1045", PFEM_SCATTER10),   # case 2's
+                                                                          ("Ti6Al4V", PFEM_SCATTER10_TI))})  # 10's
     lines += ["", P("trend_steps")] + _trend_step_lines(
         {"SPH, t_u/10": rows, f"SPH, t_u/10, ref update {REF_UPDATE:g}": refined, "PFEM, t_u/10": pfem10}, noise)
     lines += ["", P("rake_ceiling")] + _ceiling_lines(rows)
@@ -1167,21 +1171,24 @@ def solver_changes_line(res: dict) -> str:
 
 
 def pfem_scatter_of(res: dict, key: str) -> dict:
-    """The PFEM's run-to-run scatter (:func:`scatter`) at the node spacing of the run ``key``: PFEM_SCATTER's (case 2
-    at t_u/5) for a t_u/5 run (key suffix PFEM), PFEM_SCATTER10's (case 2 at t_u/10) for any other, the finer
-    spacings included (an assumption there: the scatter is measured at t_u/5 and t_u/10 only)."""
-    return scatter(res, PFEM_SCATTER if PFEM in key else PFEM_SCATTER10)
+    """The PFEM's run-to-run scatter (:func:`scatter`) at the node spacing and of the material of the run ``key``
+    ('case N ...'): PFEM_SCATTER's (case 2 at t_u/5) for a t_u/5 run (key suffix PFEM) of either material; for any
+    other, the finer spacings included, PFEM_SCATTER10's (case 2 at t_u/10) for AISI 1045 and PFEM_SCATTER10_TI's
+    (case 10 at t_u/10) for Ti6Al4V (cases 10-18). An assumption wherever it is not the measured case and spacing."""
+    if PFEM in key:
+        return scatter(res, PFEM_SCATTER)
+    return scatter(res, PFEM_SCATTER10_TI if int(key.split()[1]) >= 10 else PFEM_SCATTER10)
 
 
 def _pfem_scatter_sentence(res: dict, keys: tuple, where: str, old_key: str) -> str:
-    """One scatter group of the PFEM (``keys``, case 2 at the spacing ``where``): each quantity's sample standard
-    deviation in percent of the mean, and how far ``old_key``, the same cut by an earlier solver, lies from that
-    mean, in percent and (in brackets) in standard deviations of one run."""
+    """One scatter group of the PFEM (``keys``, named by ``where``, the sentence's opening): each quantity's sample
+    standard deviation in percent of the mean, and how far ``old_key`` (where given), the same cut by an earlier
+    solver, lies from that mean, in percent and (in brackets) in standard deviations of one run."""
     sc = scatter(res, keys)
     n = min((v["n"] for v in sc.values()), default=0)
     if n < 2:
         n = len([k for k in keys if res["runs"].get(k, {}).get("status") == "ok"])
-        return f"At {where}: {n} of {len(keys)} runs recorded, too few for a spread."
+        return f"{where}: {n} of {len(keys)} runs recorded, too few for a spread."
     old = res["runs"].get(old_key)
     v_old = _values(old) if old is not None and old.get("status") == "ok" else {}
     parts, away = [], []
@@ -1192,21 +1199,26 @@ def _pfem_scatter_sentence(res: dict, keys: tuple, where: str, old_key: str) -> 
         parts.append(f"{short} {sc[q]['std_pct']:.1f} %")
         if q in v_old:
             away.append(f"{short} {_change_cell(_rel(v_old[q], mean), _z(v_old[q] - mean, sd))}")
-    return (f"At {where}, {n} runs: " + ", ".join(parts) + f"; the sweep's first record of the same cut ('{old_key}', "
+    if not old_key:
+        return f"{where}, {n} runs: " + ", ".join(parts) + "."
+    return (f"{where}, {n} runs: " + ", ".join(parts) + f"; the sweep's first record of the same cut ('{old_key}', "
             "made by an earlier solver; the tables take its rerun, the first of these runs) lies from their mean by "
             + (", ".join(away) or "-") + ".")
 
 
 def pfem_scatter_line(res: dict) -> str:
-    """The PFEM's run-to-run scatter, case 2 with today's solver, unperturbed and jittered, at t_u/5 (PFEM_SCATTER)
-    and at t_u/10 (PFEM_SCATTER10): each quantity's sample standard deviation in percent of the mean, and how far
-    the sweep's first record of the same cut, made by an earlier solver, lies from the mean in those units."""
-    return (f"The PFEM's run-to-run scatter (case {PFEM_SCATTER_CASE}, today's solver, unperturbed and with each "
-            "coordinate of the workpiece's nodes moved at random by up to 0.01 of their spacing; the tables 'The "
-            "PFEM's run-to-run scatter' below), sample standard deviation in percent of the mean (in brackets after "
-            "a change: the change in standard deviations of one run). "
-            + _pfem_scatter_sentence(res, PFEM_SCATTER, "t_u/5", f"case {PFEM_SCATTER_CASE}{PFEM}") + " "
-            + _pfem_scatter_sentence(res, PFEM_SCATTER10, "t_u/10", f"case {PFEM_SCATTER_CASE}{PFEM10}")
+    """The PFEM's run-to-run scatter, today's solver, unperturbed and jittered: case 2 at t_u/5 (PFEM_SCATTER) and
+    at t_u/10 (PFEM_SCATTER10), case 10 at t_u/10 (PFEM_SCATTER10_TI). Each quantity's sample standard deviation in
+    percent of the mean, and how far the sweep's first record of case 2's cut, made by an earlier solver, lies from
+    the mean in those units."""
+    return ("The PFEM's run-to-run scatter (today's solver, unperturbed and with each coordinate of the workpiece's "
+            "nodes moved at random by up to 0.01 of their spacing; the tables 'The PFEM's run-to-run scatter' "
+            "below), sample standard deviation in percent of the mean (in brackets after a change: the change in "
+            "standard deviations of one run). "
+            + _pfem_scatter_sentence(res, PFEM_SCATTER, f"Case {PFEM_SCATTER_CASE} at t_u/5",
+                                     f"case {PFEM_SCATTER_CASE}{PFEM}")
+            + " " + _pfem_scatter_sentence(res, PFEM_SCATTER10, "At t_u/10", f"case {PFEM_SCATTER_CASE}{PFEM10}")
+            + " " + _pfem_scatter_sentence(res, PFEM_SCATTER10_TI, "Case 10 (Ti6Al4V) at t_u/10", "")
             + " Case 2's spacing changes above carry their z in brackets: the change over its standard deviation, "
             "sqrt((s_a f_a)^2 + (s_b f_b)^2) with s each spacing's relative spread (t_u/10's taken at the finer "
             "spacing, an assumption: it is measured at t_u/5 and t_u/10 only).")
@@ -1326,6 +1338,7 @@ PFEM_SCATTER = (f"case {PFEM_SCATTER_CASE}{PFEM}{RERUN}",) + tuple(f"case {PFEM_
                                                       for seed in (1, 2, 3))   # the PFEM's scatter (more_jobs)
 PFEM_SCATTER10 = (f"case {PFEM_SCATTER_CASE}{PFEM10}{RERUN}",) + tuple(
     f"case {PFEM_SCATTER_CASE}{PFEM10} jitter {seed}" for seed in (1, 2, 3))   # ... at t_u/10 (more_jobs)
+PFEM_SCATTER10_TI = (f"case 10{PFEM10}",) + tuple(f"case 10{PFEM10} jitter {seed}" for seed in (1, 2))  # Ti6Al4V
 SCATTER_T5 = tuple(k.replace("case 1", "case 1 n_tu 5") for k in SCATTER_KEYS)         # at t_u/5
 SCATTER_S2 = tuple(k.replace("n_tu 5", "n_tu 5 s/2") for k in SCATTER_T5)               # at t_u/5 and s/2
 SCATTER_TI10 = ("case 10", "case 10 jitter 1", "case 10 jitter 2")                     # Ti6Al4V at t_u/10
@@ -1438,6 +1451,9 @@ STUDIES = (
      "and their mean against the t_u/5 runs'): what the t_u/10 changes (the solver's, the trends' steps, the "
      "spacing study's last step) are read against",
      PFEM_SCATTER10, BASIC),
+    ("The PFEM's run-to-run scatter of Ti6Al4V at t_u/10 (case 10: its record and two jittered runs): what the "
+     "Ti6Al4V changes at t_u/10 and finer are read against",
+     PFEM_SCATTER10_TI, BASIC),
     ("What the PFEM's solver changes moved (each record made by an earlier solver, before the contact's changes of "
      "b294aaf and 248e7e0, above the same cut with today's, key suffix 'rerun', which the t_u/5 and t_u/10 tables "
      "and the spacing table take; at t_u/5 all 18, at t_u/10 AISI 1045's cases 1-7)",

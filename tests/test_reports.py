@@ -485,7 +485,7 @@ def test_thermal_cutting_pfem_spacing_changes_are_read_against_the_pfem_scatter(
     assert keys[1] == mod.PFEM_SCATTER10[0]                # ... and its t_u/10 run
     runs = {k: _resolution_record(fc, n) for k, fc, n in zip(keys, (396.0, 440.0, 444.0), (5, 10, 15))}
     assert math.isnan(mod.pfem_spacing_convergence(dict(runs=runs))[1]["z1"])
-    assert "At t_u/5: 1 of 4 runs recorded" in mod.pfem_scatter_line(dict(runs=runs))
+    assert "Case 2 at t_u/5: 1 of 4 runs recorded" in mod.pfem_scatter_line(dict(runs=runs))
     for k, fc in zip(mod.PFEM_SCATTER[1:], (404.0, 396.0, 404.0)):         # mean 400, sd 4.62 (1.15 %)
         runs[k] = _resolution_record(fc, 5)
     fc = {(r["case"], r["name"]): r for r in mod.pfem_spacing_convergence(dict(runs=runs))}[2, "Fc [N/mm]"]
@@ -501,12 +501,21 @@ def test_thermal_cutting_pfem_spacing_changes_are_read_against_the_pfem_scatter(
     assert math.isnan(rows[2, "T_RF [K]"]["z1"])                             # no spread: no z (0 / 0)
     assert "+11.1 % (" in mod._pfem_spacing_lines([fc])[-1]
     line = mod.pfem_scatter_line(dict(runs=runs))
-    assert "At t_u/5, 4 runs: " in line and "Fc 1.2 %" in line and "mean by -." in line  # no older record given
+    assert "Case 2 at t_u/5, 4 runs: " in line and "Fc 1.2 %" in line and "mean by -." in line  # no older record given
     assert "At t_u/10, 4 runs: " in line and "Fc 0.7 %" in line
+    assert "Case 10 (Ti6Al4V) at t_u/10: 0 of 3 runs recorded" in line
     runs["case 2 pfem n_tu 5"] = _resolution_record(409.24, 5)               # two deviations above the mean
     assert "Fc +2.3 % (+2.0)" in mod.pfem_scatter_line(dict(runs=runs))
     runs["case 2 pfem"] = _resolution_record(440.0 - 3 * 3.266, 10)         # three below the t_u/10 mean
     assert "Fc -2.2 % (-3.0)" in mod.pfem_scatter_line(dict(runs=runs))
+    for k, fc in zip(mod.PFEM_SCATTER10_TI, (300.0, 310.0, 320.0)):          # Ti6Al4V at t_u/10: sd 3.2 %
+        runs[k] = _resolution_record(fc, 10)
+    assert "Case 10 (Ti6Al4V) at t_u/10, 3 runs: " in mod.pfem_scatter_line(dict(runs=runs))
+    of = {k: mod.pfem_scatter_of(dict(runs=runs), k)["Fc"]["std_pct"]
+          for k in ("case 14 pfem n_tu 5", "case 2 pfem", "case 5 pfem n_tu 15", "case 14 pfem", "case 16 pfem 2 mm")}
+    assert of["case 14 pfem n_tu 5"] == pytest.approx(100 * s5)               # t_u/5: case 2's, either material
+    assert of["case 2 pfem"] == of["case 5 pfem n_tu 15"] == pytest.approx(100 * s10)   # steel, t_u/10 and finer
+    assert of["case 14 pfem"] == of["case 16 pfem 2 mm"] == pytest.approx(100 * 10.0 / 310.0)   # Ti6Al4V's
 
 
 def test_thermal_cutting_solver_changes_are_read_against_the_pfem_scatter():

@@ -688,8 +688,7 @@ def _trend_step_lines(sets: dict, noise: dict) -> list[str]:
     """The step-by-step trends table: per refsph set ({label: comparison rows}) and material, each TREND_STEPS
     entry's 'same of steps', and the steps of opposite sign as 'refsph / measured %' at the line's fixed value, with
     the run-to-run scatter of that quantity ({material: scatter()} where measured; sd in percent) and each such
-    step's z, refsph's step over its standard deviation sqrt(2) sd (two single runs): how far its sign is told from
-    the scatter."""
+    step's z (:func:`change_z`, two single runs): how far its sign is told from the scatter."""
     lines = []
     for label, rows in sets.items():
         for mat, t in trend_steps(rows).items():
@@ -699,7 +698,7 @@ def _trend_step_lines(sets: dict, noise: dict) -> list[str]:
                 unit = "mm" if along == "vc" else "m/min"
                 sd = noise.get((label, mat), {}).get(sd_key)
                 off = "; ".join(f"{d:+.1f} / {de:+.1f} at {x:g} {unit}"
-                                + (f" (z {_z(d, math.sqrt(2) * sd['std_pct']):+.1f})" if sd else "")
+                                + (f" (z {change_z(d, sd['std_pct']):+.1f})" if sd else "")
                                 for x, d, de in other)
                 cells.append(f"{same} of {n}" + (f" ({off})" if off else "")
                              + (f", sd {sd['std_pct']:.1f} %" if off and sd else ""))
@@ -1131,8 +1130,8 @@ def pfem_spacing_convergence(res: dict) -> list[dict]:
 def solver_changes(res: dict) -> dict:
     """Per quantity of PFEM_ORDER_QUANTITIES, over the (record, rerun) pairs of SOLVER_CHANGES both recorded ok: the
     changes 100 (rerun - record) / record, and each change's z against the PFEM's run-to-run scatter at the pair's
-    spacing (:func:`pfem_scatter_of`), the change over sqrt(2) times one run's relative standard deviation (two
-    single runs). {name: [(key, change, z)]}; z NaN where the scatter is not recorded."""
+    spacing (:func:`pfem_scatter_of`), the change over its standard deviation as a change between two single runs
+    (:func:`change_z`). {name: [(key, change, z)]}; z NaN where the scatter is not recorded."""
     out = {}
     for name, q, _, _ in PFEM_ORDER_QUANTITIES:
         out[name] = []
@@ -1143,7 +1142,7 @@ def solver_changes(res: dict) -> dict:
             sc = pfem_scatter_of(res, new)
             sd = sc[q]["std_pct"] if q in sc else math.nan
             d = _rel(_values(b)[q], _values(a)[q])
-            out[name].append((new, d, _z(d, math.sqrt(2) * sd)))
+            out[name].append((new, d, change_z(d, sd)))
     return out
 
 
@@ -1158,26 +1157,42 @@ def solver_changes_line(res: dict) -> str:
         d = np.array([r[1] for r in rows])
         z = np.array([r[2] for r in rows])
         big = max(rows, key=lambda r: abs(r[1]))
-        beyond = (f", {int(np.sum(np.abs(z) > 2))} beyond 2 sd" if np.all(np.isfinite(z)) else "")
+        known = np.isfinite(z)
+        beyond = "" if not known.any() else (f", {int(np.sum(np.abs(z[known]) > 2))} of {int(known.sum())} beyond 2 "
+                                             "sd" + (f" ({int((~known).sum())} without a scatter yet)"
+                                                     if not known.all() else ""))
         parts.append(f"{name.split(' [')[0]} mean |change| {np.mean(np.abs(d)):.1f} %, largest {big[1]:+.1f} % "
                      f"('{big[0]}'){beyond}")
     n = max((len(r) for r in ch.values()), default=0)
     if n == 0:
         return "No record and its rerun both recorded yet."
     return (f"Over the {n} pairs recorded, rerun against record: " + "; ".join(parts) + ". The standard deviation of "
-            "a change between two single runs is sqrt(2) times one run's from the PFEM's run-to-run scatter at the "
-            "pair's spacing (case 2's at t_u/5 or at t_u/10, taken at every case: an assumption); a change within 2 sd "
-            "is not told from the scatter.")
+            "a change between two single runs is the hypot of the two runs' own, each the PFEM's run-to-run scatter "
+            "at the pair's spacing (case 2's at t_u/5 or at t_u/10, taken at every case of its material: an "
+            "assumption); with the spread from 3-4 runs, a change within about 2 sd is not told from the scatter.")
 
 
 def pfem_scatter_of(res: dict, key: str) -> dict:
-    """The PFEM's run-to-run scatter (:func:`scatter`) at the node spacing and of the material of the run ``key``
-    ('case N ...'): PFEM_SCATTER's (case 2 at t_u/5) for a t_u/5 run (key suffix PFEM) of either material; for any
-    other, the finer spacings included, PFEM_SCATTER10's (case 2 at t_u/10) for AISI 1045 and PFEM_SCATTER10_TI's
-    (case 10 at t_u/10) for Ti6Al4V (cases 10-18). An assumption wherever it is not the measured case and spacing."""
-    if PFEM in key:
+    """The PFEM's run-to-run scatter (:func:`scatter`) at the node spacing and of the material of the PFEM run
+    ``key`` (its record's n_tu, or t_u / dx, and case; a run not recorded: from its key, suffix PFEM at t_u/5, else
+    t_u/10): PFEM_SCATTER's (case 2 at t_u/5) for a run at t_u/5 or coarser, of either material; for a finer one
+    PFEM_SCATTER10's (case 2 at t_u/10) for AISI 1045 and PFEM_SCATTER10_TI's (case 10 at t_u/10) for Ti6Al4V. An
+    assumption wherever it is not the measured case and spacing."""
+    from refsph.paper_data import rla_cutting_case
+    if " pfem" not in key:
+        raise ValueError(f"not a PFEM run: {key!r}")
+    r = res["runs"].get(key) or {}
+    opts = r.get("options") or {}
+    if "n_tu" in opts:
+        n_tu = float(opts["n_tu"])
+    elif r.get("dp") and r.get("scene_info", {}).get("tu_m"):
+        n_tu = r["scene_info"]["tu_m"] / r["dp"]
+    else:
+        n_tu = 5.0 if PFEM in key else 10.0
+    if n_tu < 7.5:
         return scatter(res, PFEM_SCATTER)
-    return scatter(res, PFEM_SCATTER10_TI if int(key.split()[1]) >= 10 else PFEM_SCATTER10)
+    ti = rla_cutting_case(int(opts.get("case", key.split()[1])))["material"] == "Ti6Al4V"
+    return scatter(res, PFEM_SCATTER10_TI if ti else PFEM_SCATTER10)
 
 
 def _pfem_scatter_sentence(res: dict, keys: tuple, where: str, old_key: str) -> str:
@@ -1443,23 +1458,23 @@ STUDIES = (
               ("viscosity + damping heat [% of work]", "dissipation_of_work", ".1f"), ("CPU [min]", "cpu_min", ".1f"))),
     ("The PFEM's run-to-run scatter (case 2 at t_u/5 with today's solver: unperturbed, and with the workpiece's "
      "nodes moved at random by up to 0.01 of their spacing, three seeds; the sweep's record 'case 2 pfem n_tu 5', "
-     "made by an earlier solver, against their spread below them): what the spacing study's changes are read "
-     "against",
+     "made by an earlier solver, against their spread below them): what the t_u/5 changes (the solver's t_u/5 "
+     "pairs, the spacing study's first step at its t_u/5 end) are read against",
      PFEM_SCATTER, BASIC),
     ("The PFEM's run-to-run scatter at t_u/10 (case 2 as above at the 18-case table's resolution: its rerun and three "
      "jittered runs; the sweep's record 'case 2 pfem', made by an earlier solver, against their spread below them, "
-     "and their mean against the t_u/5 runs'): what the t_u/10 changes (the solver's, the trends' steps, the "
-     "spacing study's last step) are read against",
+     "and their mean against the t_u/5 runs'): what AISI 1045's t_u/10 changes (the solver's t_u/10 pairs, "
+     "the trends' steps, both steps of the spacing study at their t_u/10 and finer ends) are read against",
      PFEM_SCATTER10, BASIC),
-    ("The PFEM's run-to-run scatter of Ti6Al4V at t_u/10 (case 10: its record and two jittered runs): what the "
-     "Ti6Al4V changes at t_u/10 and finer are read against",
+    ("The PFEM's run-to-run scatter of Ti6Al4V at t_u/10 (case 10: its record and two jittered runs): what "
+     "Ti6Al4V's t_u/10 changes (the trends' steps) are read against",
      PFEM_SCATTER10_TI, BASIC),
     ("What the PFEM's solver changes moved (each record made by an earlier solver, before the contact's changes of "
      "b294aaf and 248e7e0, above the same cut with today's, key suffix 'rerun', which the t_u/5 and t_u/10 tables "
      "and the spacing table take; at t_u/5 all 18, at t_u/10 AISI 1045's cases 1-7)",
      SOLVER_CHANGES, BASIC + (("steps", "n_steps", "d"), ("CPU [min]", "cpu_min", ".1f"))),
     ("The same in the PFEM (t_u/10, the sweep's runs): friction acting but making no heat (eta = 0); one run each, "
-     "the PFEM being deterministic", PFEM_GAP_RUNS,
+     "to be read against the PFEM's scatter at t_u/10 (case 2's and case 10's tables above)", PFEM_GAP_RUNS,
      BASIC + (("T_RF - T_FCS [K]", "gap", ".0f"), ("friction heat [% of work]", "friction_of_work", ".1f"),
               ("CPU [min]", "cpu_min", ".1f"))),
     ("Run-to-run scatter of Ti6Al4V at t_u/5 at reference update 0.1 (case 10 and two runs with the perturbations "
@@ -1723,6 +1738,13 @@ def _order_range(h: list, f: list, s1: float, s2: float) -> tuple:
     ps = [study.observed_order(h, [f[0] + a, f[1], f[2] + b]) for a in (-s1, s1) for b in (-s2, s2)]
     ps = [0.0 if x is None else x for x in ps]
     return min(ps), max(ps)
+
+
+def change_z(d: float, sd_pct: float) -> float:
+    """The z of a relative change d = 100 (f_b - f_a) / f_a [%] between two single runs, each with a relative
+    standard deviation of sd_pct [%]: d over its standard deviation sd_pct sqrt(1 + (f_b / f_a)^2) (the hypot of the
+    two runs' deviations, in percent of f_a; sqrt(2) sd_pct for a small change). NaN without a spread."""
+    return _z(d, sd_pct * math.hypot(1.0, 1.0 + d / 100.0))
 
 
 def _z(d: float, sd: float) -> float:

@@ -90,7 +90,7 @@ def test_thermal_cutting_trend_steps_compare_each_step_sign():
     rows[4]["Fp_N_per_mm"] = None                    # vc 120, tu 0.15 not recorded: its two Fp steps drop
     assert mod.trend_steps(rows)["AISI1045"]["Fp with t_u"][0] == 4
     cells = mod._trend_step_lines({"x": rows}, {("x", "AISI1045"): {"Fc": dict(std_pct=6.0)}})[0].split(" | ")
-    assert cells[2] == "5 of 6 (-50.0 / +50.0 at 60 m/min (z -5.9)), sd 6.0 %"   # -50 / (sqrt(2) 6)
+    assert cells[2] == "5 of 6 (-50.0 / +50.0 at 60 m/min (z -7.5)), sd 6.0 %"   # -50 / (6 hypot(1, 0.5))
     assert cells[3] == "4 of 4"
 
 
@@ -520,8 +520,9 @@ def test_thermal_cutting_pfem_spacing_changes_are_read_against_the_pfem_scatter(
 
 def test_thermal_cutting_solver_changes_are_read_against_the_pfem_scatter():
     """solver_changes pairs each record with its rerun (SOLVER_CHANGES: both t_u/5 and t_u/10 tables), only where
-    both ended well, and reads each change against sqrt(2) times one run's spread from PFEM_SCATTER; the line counts
-    the changes beyond 2 sd, and says nothing of z without the scatter runs."""
+    both ended well, and reads each change against the scatter at the pair's spacing (pfem_scatter_of) as a change
+    between two single runs (change_z); the line counts the changes beyond 2 sd among those with a scatter, names
+    those without one, and says nothing of z where none has one."""
     import math
     mod = _script("thermal_cutting")
     pairs = list(zip(mod.SOLVER_CHANGES[::2], mod.SOLVER_CHANGES[1::2]))
@@ -539,21 +540,48 @@ def test_thermal_cutting_solver_changes_are_read_against_the_pfem_scatter():
     assert "beyond" not in mod.solver_changes_line(dict(runs=runs))
     for k, fc in zip(mod.PFEM_SCATTER, (392.0, 408.0, 392.0, 408.0)):        # sd 2.31 % of the mean at t_u/5
         runs[k] = _resolution_record(fc, 5)
-    assert math.isnan(mod.solver_changes(dict(runs=runs))["Fc [N/mm]"][0][2])   # t_u/10 pairs: t_u/10's scatter
-    for k, fc in zip(mod.PFEM_SCATTER10, (396.0, 404.0, 396.0, 404.0)):      # ... and half of it at t_u/10
-        runs[k] = _resolution_record(fc, 10)
-    runs["case 12 pfem n_tu 5 rerun"] = _resolution_record(408.0, 5)         # a t_u/5 pair reads t_u/5's scatter
+    runs["case 12 pfem n_tu 5 rerun"] = _resolution_record(480.0, 5)         # a t_u/5 pair reads t_u/5's scatter
     rows = mod.solver_changes(dict(runs=runs))["Fc [N/mm]"]
-    assert rows[2][0] == "case 12 pfem n_tu 5 rerun" and rows[2][2] == pytest.approx(rows[0][2] * 0.1, rel=1e-12)
+    assert math.isnan(rows[0][2])                                            # t_u/10 pairs: t_u/10's scatter, none
+    s5 = 100 * float(np.std([392.0, 408.0, 392.0, 408.0], ddof=1)) / 400.0
+    assert rows[2][0] == "case 12 pfem n_tu 5 rerun"
+    assert rows[2][2] == pytest.approx(20.0 / (s5 * math.hypot(400.0, 480.0) / 400.0), rel=1e-12)   # 5.6 sd
+    assert "Fc mean |change| 10.3 %, largest +20.0 % ('case 12 pfem n_tu 5 rerun'), 1 of 1 beyond 2 sd (2 without " \
+        "a scatter yet)" in mod.solver_changes_line(dict(runs=runs))
     runs.pop("case 12 pfem n_tu 5 rerun")
+    for k, fc in zip(mod.PFEM_SCATTER10, (396.0, 404.0, 396.0, 404.0)):      # half of it at t_u/10
+        runs[k] = _resolution_record(fc, 10)
     rows = mod.solver_changes(dict(runs=runs))["Fc [N/mm]"]
     sd = 100 * float(np.std([396.0, 404.0, 396.0, 404.0], ddof=1)) / 400.0
-    assert rows[0][2] == pytest.approx(10.0 / (math.sqrt(2) * sd), rel=1e-12)   # 6.1 sd: beyond
-    assert rows[1][2] == pytest.approx(1.0 / (math.sqrt(2) * sd), rel=1e-12)    # 0.6 sd: within
+    assert rows[0][2] == pytest.approx(10.0 / (sd * math.hypot(1.0, 1.1)), rel=1e-12)    # 5.8 sd: beyond
+    assert rows[1][2] == pytest.approx(1.0 / (sd * math.hypot(1.0, 1.01)), rel=1e-12)    # 0.6 sd: within
+    assert mod.change_z(-50.0, 10.0) == pytest.approx(-50.0 / (10.0 * math.hypot(1.0, 0.5)), rel=1e-12)
     line = mod.solver_changes_line(dict(runs=runs))
     assert "Over the 2 pairs" in line
-    assert "Fc mean |change| 5.5 %, largest +10.0 % ('case 4 pfem rerun'), 1 beyond" in line
+    assert "Fc mean |change| 5.5 %, largest +10.0 % ('case 4 pfem rerun'), 1 of 2 beyond 2 sd;" in line
     assert mod.solver_changes_line(dict(runs={})).startswith("No record and its rerun")
+
+
+def test_thermal_cutting_pfem_scatter_of_reads_the_spacing_and_material_of_the_run():
+    """pfem_scatter_of: a run at t_u/5 reads case 2's t_u/5 scatter whatever its material or key; a finer one case
+    2's t_u/10 scatter for AISI 1045 (cases 1-9) and case 10's for Ti6Al4V (10-18); the spacing from the record's
+    options where recorded (a key without 'n_tu 5' cut at t_u/5 is still t_u/5), else from the key; a key that is
+    not the PFEM's refused."""
+    mod = _script("thermal_cutting")
+    runs = {}
+    for keys, fcs, n in ((mod.PFEM_SCATTER, (390.0, 410.0), 5), (mod.PFEM_SCATTER10, (380.0, 420.0), 10),
+                         (mod.PFEM_SCATTER10_TI, (360.0, 440.0), 10)):
+        runs.update({k: _resolution_record(fc, n) for k, fc in zip(keys, fcs)})
+    sd = {n: 100 * float(np.std(f, ddof=1)) / 400.0 for n, f in ((5, (390.0, 410.0)), (10, (380.0, 420.0)),
+                                                                   ("ti", (360.0, 440.0)))}
+    runs["case 16 pfem gamma 0.6"] = dict(_resolution_record(300.0, 5), options=dict(case=16, n_tu=5.0))
+    want = {"case 2 pfem n_tu 5 rerun": 5, "case 14 pfem n_tu 5": 5, "case 16 pfem gamma 0.6": 5,
+            "case 2 pfem": 10, "case 9 pfem": 10, "case 1 pfem n_tu 15": 10, "case 8 pfem n_tu 15 bossak -0.1": 10,
+            "case 10 pfem": "ti", "case 14 pfem": "ti", "case 16 pfem 2 mm": "ti"}
+    got = {k: mod.pfem_scatter_of(dict(runs=runs), k)["Fc"]["std_pct"] for k in want}
+    assert got == {k: pytest.approx(sd[w], rel=1e-12) for k, w in want.items()}
+    with pytest.raises(ValueError, match="not a PFEM run"):
+        mod.pfem_scatter_of(dict(runs=runs), "case 10 n_tu 15")
 
 
 def test_pfem_cut_jitter_moves_only_free_nodes_by_at_most_their_spacing_fraction():

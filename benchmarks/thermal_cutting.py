@@ -1102,7 +1102,7 @@ def pfem_spacing_convergence(res: dict) -> list[dict]:
     f = f0 + C dx^p (``study.observed_order``; None where the changes differ in sign or grow) and the extrapolated
     f0 (``study.richardson``; None below PFEM_ORDER_MIN), beside the measured value and the paper's PFEM
     (``comparison``); z1, z2: each change over its standard deviation, from the relative spread at each spacing
-    (:func:`pfem_scatter_of`; PFEM_SCATTER_CASE only, NaN elsewhere)."""
+    (:func:`pfem_scatter_of`: measured on case 2, taken for the other cases; NaN where not recorded)."""
     paper_rows, out = {r["case"]: r for r in comparison(res, PFEM10)}, []   # its measured and paper columns only
     for n in sorted(dict(PFEM_FINE)):
         keys = pfem_spacing_keys(n)
@@ -1114,7 +1114,7 @@ def pfem_spacing_convergence(res: dict) -> list[dict]:
             continue
         vals, c = [_values(r) for r in runs], paper_rows[n]
         h = [v["dx_um"] for v in vals]
-        spreads = [pfem_scatter_of(res, k) if n == PFEM_SCATTER_CASE else {} for k in keys]
+        spreads = [pfem_scatter_of(res, k) for k in keys]    # case 2's (or case 10's) for every case: an assumption
         for name, q, spec, paper in PFEM_ORDER_QUANTITIES:
             f = [float(v[q]) for v in vals]
             p = study.observed_order(h, f)
@@ -1234,9 +1234,10 @@ def pfem_scatter_line(res: dict) -> str:
                                      f"case {PFEM_SCATTER_CASE}{PFEM}")
             + " " + _pfem_scatter_sentence(res, PFEM_SCATTER10, "At t_u/10", f"case {PFEM_SCATTER_CASE}{PFEM10}")
             + " " + _pfem_scatter_sentence(res, PFEM_SCATTER10_TI, "Case 10 (Ti6Al4V) at t_u/10", "")
-            + " Case 2's spacing changes above carry their z in brackets: the change over its standard deviation, "
-            "sqrt((s_a f_a)^2 + (s_b f_b)^2) with s each spacing's relative spread (t_u/10's taken at the finer "
-            "spacing, an assumption: it is measured at t_u/5 and t_u/10 only).")
+            + " The spacing changes above carry their z in brackets: the change over its standard deviation, "
+            "sqrt((s_a f_a)^2 + (s_b f_b)^2) with s each spacing's relative spread (case 2's, taken for every case, "
+            "and t_u/10's taken at the finer spacing: assumptions, the scatter being measured on case 2 at t_u/5 and "
+            "t_u/10 only).")
 
 
 def _pfem_spacing_lines(rows: list) -> list[str]:

@@ -617,7 +617,7 @@ for case in (1, 10):
 
 # %% [markdown]
 # **Fails:** Fp/Fc 0.08-0.40 at t_u/10 (measured 0.45-0.83; μ0 allows 0.55 / 0.31; the paper's above in 13 of 18),
-# unconverged at 10 µm (case 2: 0.24 → 0.33 → 0.35, run-to-run sd 9 %; ceiling 0.42); the trapezoidal rule rings.
+# unconverged at 10 µm (case 2: 0.24 → 0.33 → 0.35, scatter 9 / 3 % at t_u/5 / 10; ceiling 0.42); the time rule rings.
 
 # %% [markdown]
 # ## Your turn

@@ -302,7 +302,7 @@ def more_jobs() -> list[tuple[str, str, dict, dict]]:
     # t_u/10 changes are read against the scatter at their own resolution instead of the one at t_u/5
     out += [("pfem", key, dict(converged(PFEM_SCATTER_CASE, n_tu=10.0), jitter=0.01, seed=seed), pfem)
             for seed, key in enumerate(PFEM_SCATTER10) if seed]
-    # ... and of a Ti6Al4V case at t_u/10 (case 10: its record postdates the contact's changes), three runs
+    # ... and of a Ti6Al4V case at t_u/10 (case 10: its record postdates the contact's changes), four runs
     out += [("pfem", key, dict(converged(10, n_tu=10.0), jitter=0.01, seed=seed), pfem)
             for seed, key in enumerate(PFEM_SCATTER10_TI) if seed]
     # the coarse cuts of the spacing study whose records an earlier solver made (before the contact's changes of
@@ -1354,7 +1354,7 @@ PFEM_SCATTER = (f"case {PFEM_SCATTER_CASE}{PFEM}{RERUN}",) + tuple(f"case {PFEM_
                                                       for seed in (1, 2, 3))   # the PFEM's scatter (more_jobs)
 PFEM_SCATTER10 = (f"case {PFEM_SCATTER_CASE}{PFEM10}{RERUN}",) + tuple(
     f"case {PFEM_SCATTER_CASE}{PFEM10} jitter {seed}" for seed in (1, 2, 3))   # ... at t_u/10 (more_jobs)
-PFEM_SCATTER10_TI = (f"case 10{PFEM10}",) + tuple(f"case 10{PFEM10} jitter {seed}" for seed in (1, 2))  # Ti6Al4V
+PFEM_SCATTER10_TI = (f"case 10{PFEM10}",) + tuple(f"case 10{PFEM10} jitter {seed}" for seed in (1, 2, 3))  # Ti6Al4V
 SCATTER_T5 = tuple(k.replace("case 1", "case 1 n_tu 5") for k in SCATTER_KEYS)         # at t_u/5
 SCATTER_S2 = tuple(k.replace("n_tu 5", "n_tu 5 s/2") for k in SCATTER_T5)               # at t_u/5 and s/2
 SCATTER_TI10 = ("case 10", "case 10 jitter 1", "case 10 jitter 2")                     # Ti6Al4V at t_u/10
@@ -1467,7 +1467,7 @@ STUDIES = (
      "and their mean against the t_u/5 runs'): what AISI 1045's t_u/10 changes (the solver's t_u/10 pairs, "
      "the trends' steps, both steps of the spacing study at their t_u/10 and finer ends) are read against",
      PFEM_SCATTER10, BASIC),
-    ("The PFEM's run-to-run scatter of Ti6Al4V at t_u/10 (case 10: its record and two jittered runs): what "
+    ("The PFEM's run-to-run scatter of Ti6Al4V at t_u/10 (case 10: its record and three jittered runs): what "
      "Ti6Al4V's t_u/10 changes (the trends' steps) are read against",
      PFEM_SCATTER10_TI, BASIC),
     ("What the PFEM's solver changes moved (each record made by an earlier solver, before the contact's changes of "

@@ -503,7 +503,7 @@ def test_thermal_cutting_pfem_spacing_changes_are_read_against_the_pfem_scatter(
     line = mod.pfem_scatter_line(dict(runs=runs))
     assert "Case 2 at t_u/5, 4 runs: " in line and "Fc 1.2 %" in line and "mean by -." in line  # no older record given
     assert "At t_u/10, 4 runs: " in line and "Fc 0.7 %" in line
-    assert "Case 10 (Ti6Al4V) at t_u/10: 0 of 3 runs recorded" in line
+    assert f"Case 10 (Ti6Al4V) at t_u/10: 0 of {len(mod.PFEM_SCATTER10_TI)} runs recorded" in line
     runs["case 2 pfem n_tu 5"] = _resolution_record(409.24, 5)               # two deviations above the mean
     assert "Fc +2.3 % (+2.0)" in mod.pfem_scatter_line(dict(runs=runs))
     runs["case 2 pfem"] = _resolution_record(440.0 - 3 * 3.266, 10)         # three below the t_u/10 mean

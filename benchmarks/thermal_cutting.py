@@ -1132,17 +1132,15 @@ def solver_changes(res: dict) -> dict:
     changes 100 (rerun - record) / record, and each change's z against the PFEM's run-to-run scatter at the pair's
     spacing (:func:`pfem_scatter_of`), the change over its standard deviation as a change between two single runs
     (:func:`change_z`). {name: [(key, change, z)]}; z NaN where the scatter is not recorded."""
+    pairs = [(new, _values(res["runs"][old]), _values(res["runs"][new]), pfem_scatter_of(res, new))
+             for old, new in zip(SOLVER_CHANGES[::2], SOLVER_CHANGES[1::2])
+             if all(res["runs"].get(k, {}).get("status") == "ok" for k in (old, new))]   # each pair's scatter once
     out = {}
     for name, q, _, _ in PFEM_ORDER_QUANTITIES:
         out[name] = []
-        for old, new in zip(SOLVER_CHANGES[::2], SOLVER_CHANGES[1::2]):
-            a, b = res["runs"].get(old), res["runs"].get(new)
-            if a is None or b is None or a.get("status") != "ok" or b.get("status") != "ok":
-                continue
-            sc = pfem_scatter_of(res, new)
-            sd = sc[q]["std_pct"] if q in sc else math.nan
-            d = _rel(_values(b)[q], _values(a)[q])
-            out[name].append((new, d, change_z(d, sd)))
+        for new, va, vb, sc in pairs:
+            d = _rel(vb[q], va[q])
+            out[name].append((new, d, change_z(d, sc[q]["std_pct"] if q in sc else math.nan)))
     return out
 
 

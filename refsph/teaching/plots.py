@@ -161,13 +161,12 @@ def cut_record(runs: dict, key: str, retries=(), redone=()) -> tuple[str, dict |
     if again is not None:
         return again
     r = runs.get(key)
-    failed_again = any(runs.get(key + t, {}).get("status", "ok") != "ok" for t in redone)
-    if failed_again:      # made again by today's solver and failed: its retry where one ended well, else the record
-        return next(((key + t, runs[key + t]) for t in retries if runs.get(key + t, {}).get("status") == "ok"),
-                    (key, r))
+    retry = next(((key + t, runs[key + t]) for t in retries if runs.get(key + t, {}).get("status") == "ok"), (key, r))
+    if any(runs.get(key + t, {}).get("status", "ok") != "ok" for t in redone):
+        return retry      # made again by today's solver and failed: its retry where one ended well, else the record
     if r is None or r.get("status") == "ok":
         return key, r
-    return next(((key + t, runs[key + t]) for t in retries if runs.get(key + t, {}).get("status") == "ok"), (key, r))
+    return retry
 
 
 def measured_cuts(axes, runs: dict, series=CUT_SERIES, retries: dict | None = None) -> dict:

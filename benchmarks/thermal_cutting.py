@@ -594,7 +594,8 @@ def comparison(res: dict, suffix: str = "", keys: dict | None = None) -> list[di
             row[f"ratio{src}_err"] = _err(row[f"ratio{src}"], row["ratio_exp"])
         row["Fc_N_per_mm"] = 1e-3 * m["cutting_force_N_per_m"] if ok else None
         row["Fp_N_per_mm"] = 1e-3 * m["passive_force_N_per_m"] if ok else None
-        row["Fc_exp"], row["Fp_exp"] = c["Fc_exp_N"], c["Fp_exp_N"]
+        for src in ("exp", "sph", "pfem"):                     # the paper's forces, in N as printed
+            row[f"Fc_{src}"], row[f"Fp_{src}"] = c[f"Fc_{src}_N"], c[f"Fp_{src}_N"]
         row["width_mm"] = m.get("width_matching_Fc_mm") if ok else None
         row["chip_mm"], row["contact_mm"] = (m.get("chip_thickness_mm"), m.get("contact_length_mm")) if ok else (None,
                                                                                                             None)
@@ -778,6 +779,77 @@ def _own_ceiling_lines(rows: list, pfem10: list) -> list[str]:
                                        for k in sets) + " |" for mat in MATERIAL_NAMES]
 
 
+def force_slopes(sets: dict, noise: dict | None = None) -> list[dict]:
+    """Albrecht's separation of each speed line's forces (P. Albrecht, J. Eng. Ind. 82 (1960) 348-357): through the
+    line's three cuts (t_u = 0.10, 0.15, 0.20 mm at one v_c) the least-squares lines Fc = Fc0 + c t_u and Fp = Fp0 + p
+    t_u. The slope ratio p / c is the Fp/Fc of the force that grows with the chip (the rake face's, if the chip's forces
+    are proportional to t_u); the thinnest cut's Fp/Fc splits into Fp0 / Fc, the thrust that does not grow with t_u
+    (Albrecht's edge, or ploughing, force, extrapolated to t_u = 0), and p t_u / Fc, the thrust that does. All are
+    ratios of forces at one width of cut, so the paper's forces in N and refsph's in N/mm compare directly. ``sets``:
+    {label: (rows, Fc key, Fp key)} of :func:`comparison`'s rows; ``noise``: {(label, material): (sd of Fc, sd of Fp)}
+    in percent of one run (:func:`scatter`), which gives the slope ratio's standard deviation by propagation (each cut's
+    forces independent: Fc and Fp scatter together in a run, so this overstates it). Per material and speed: Merchant's
+    ceiling at mu0 and at mu(T) of the line's mean measured T_RF (:func:`rake_face_ceiling`), and per label (slope
+    ratio, its sd or None, Fp0 / Fc, p t_u / Fc at the thinnest cut), or None where the line lacks a cut."""
+    out = []
+    for mat in MATERIAL_NAMES:
+        _, at_mu0, ceiling = _ceiling_law(mat)
+        for vc in sorted({r["vc"] for rows, _, _ in sets.values() for r in rows if r["material"] == mat}):
+            first = [r for r in next(iter(sets.values()))[0] if r["material"] == mat and r["vc"] == vc]
+            fits = {label: _slope_fit([r for r in rows if r["material"] == mat and r["vc"] == vc], fc, fp,
+                                      (noise or {}).get((label, mat)))
+                    for label, (rows, fc, fp) in sets.items()}
+            out.append(dict(material=mat, vc=vc, ceiling_mu0=at_mu0,
+                            ceiling_T=ceiling(float(np.mean([r["TRF_exp"] for r in first]))), fits=fits))
+    return out
+
+
+def _slope_fit(line: list, fc: str, fp: str, sd_pct) -> tuple | None:
+    """(p / c, its sd or None, Fp0 / Fc and p t_u / Fc at the thinnest cut) of one speed line (:func:`force_slopes`)."""
+    line = sorted(line, key=lambda r: r["tu"])
+    if len(line) < 3 or any(r[fc] is None or r[fp] is None for r in line):
+        return None
+    tu = np.array([r["tu"] for r in line])
+    Fc, Fp = (np.array([r[k] for r in line], dtype=float) for k in (fc, fp))
+    (c, _), (p, p0) = np.polyfit(tu, Fc, 1), np.polyfit(tu, Fp, 1)
+    sd = None
+    if sd_pct is not None:
+        w = (tu - tu.mean()) / np.sum((tu - tu.mean()) ** 2)                     # slope = sum(w_i F_i)
+        s_c, s_p = (float(np.sqrt(np.sum((w * F * pct / 100.0) ** 2))) for F, pct in zip((Fc, Fp), sd_pct))
+        sd = float(np.hypot(s_p / c, p * s_c / c ** 2))
+    return float(p / c), sd, float(p0 / Fc[0]), float(p * tu[0] / Fc[0])
+
+
+def _sum_text(a: float, b: float) -> str:
+    """'a + b' or 'a - b' to two decimals (a minus sign, not '+ -')."""
+    return f"{round(a, 2) + 0.0:.2f} {'+' if b >= 0 else '-'} {abs(b):.2f}"
+
+
+def _slope_lines(slopes: list[dict]) -> list[str]:
+    """The table of :func:`force_slopes`, then per material and label the mean slope ratio, the mean of the thinnest
+    cut's Fp/Fc split into its two parts, and the speed lines whose slope ratio lies above the ceiling at mu0."""
+    labels = list(slopes[0]["fits"])
+    cell = lambda f: "-" if f is None else (f"{f[0]:.2f}" + ("" if f[1] is None else f" ± {f[1]:.2f}")  # noqa: E731
+                                            + f" ({_sum_text(f[2], f[3])})")
+    lines = ["| material | v_c [m/min] | ceiling at mu0 / at mu(T_RF measured) | " + " | ".join(labels) + " |",
+             "|---" * (len(labels) + 3) + "|"]
+    lines += [f"| {s['material']} | {s['vc']:.0f} | {s['ceiling_mu0']:.2f} / {s['ceiling_T']:.2f} | "
+              + " | ".join(cell(s["fits"][k]) for k in labels) + " |" for s in slopes]
+    for mat in MATERIAL_NAMES:
+        sel = [s for s in slopes if s["material"] == mat]
+        parts = []
+        for k in labels:
+            got = [(s["fits"][k], s["ceiling_mu0"]) for s in sel if s["fits"][k] is not None]
+            if got:
+                m = [np.mean([f[i] for f, _ in got]) for i in (0, 2, 3)]
+                parts.append(f"{k} {m[0]:.2f} ({_sum_text(m[1], m[2])}), "
+                             f"{sum(f[0] > c for f, c in got)} of {len(got)}")
+        lines.append(f"\n{mat}, the mean slope ratio (the thinnest cut's Fp/Fc as the mean thrust that does not grow "
+                     "with t_u + the mean that does) and the speed lines whose slope ratio lies above the ceiling at "
+                     "mu0: " + "; ".join(parts) + ".")
+    return lines
+
+
 def rake_gaps(rows: list, groups: dict) -> list[dict]:
     """Per case, how much hotter the rake face is than the free chip surface, T_RF - T_FCS [K]: measured, the
     paper's SPH and PFEM (``rows``: :func:`comparison`'s) and refsph's ``groups`` ({label: comparison rows}; None
@@ -814,6 +886,11 @@ def _ceiling_lines(rows: list) -> list[str]:
             f"{c['error_T']:.1f} | " + " / ".join(str(c["above"][k]) for k in ("_exp", "_sph", "_pfem"))
             + f" / {c['above']['']} of {c['recorded']} |"
             for c in rake_face_ceiling(rows)]
+
+
+def _force_sd(sc: dict):
+    """(sd of Fc, sd of Fp) in percent from :func:`scatter`'s output, or None without both."""
+    return (sc["Fc"]["std_pct"], sc["Fp"]["std_pct"]) if "Fc" in sc and "Fp" in sc else None
 
 
 def _f(v, fmt: str) -> str:
@@ -880,6 +957,16 @@ def report(res: dict, before: dict | None = None) -> str:
         {"SPH, t_u/10": rows, f"SPH, t_u/10, ref update {REF_UPDATE:g}": refined, "PFEM, t_u/10": pfem10}, noise)
     lines += ["", P("rake_ceiling")] + _ceiling_lines(rows)
     lines += ["", P("own_ceiling")] + _own_ceiling_lines(rows, pfem10)
+    lines += ["", P("force_slopes"), ""] + _slope_lines(force_slopes(
+        {"measured": (rows, "Fc_exp", "Fp_exp"), "paper SPH": (rows, "Fc_sph", "Fp_sph"),
+         "paper PFEM": (rows, "Fc_pfem", "Fp_pfem"), "refsph SPH": (rows, "Fc_N_per_mm", "Fp_N_per_mm"),
+         f"refsph SPH, ref update {REF_UPDATE:g}": (refined, "Fc_N_per_mm", "Fp_N_per_mm"),
+         "refsph PFEM": (pfem10, "Fc_N_per_mm", "Fp_N_per_mm")},
+        {(label, m): _force_sd(scatter(res, keys)) for label, m, keys in
+         (("refsph SPH", "AISI1045", SCATTER_KEYS), ("refsph SPH", "Ti6Al4V", SCATTER_TI10),
+          (f"refsph SPH, ref update {REF_UPDATE:g}", "AISI1045", SCATTER_REF),
+          (f"refsph SPH, ref update {REF_UPDATE:g}", "Ti6Al4V", SCATTER_TI10_REF),
+          ("refsph PFEM", "AISI1045", PFEM_SCATTER10), ("refsph PFEM", "Ti6Al4V", PFEM_SCATTER10_TI))}))
     gaps = rake_gaps(rows, {"refsph SPH": rows, f"refsph SPH, ref update {REF_UPDATE:g}": refined,
                             "refsph PFEM": pfem10})
     lines += ["", P("rake_gap"), ""] + _rake_gap_lines(gaps)

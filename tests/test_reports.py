@@ -1024,3 +1024,29 @@ def test_thermal_cutting_every_key_the_page_reads_is_a_run_the_sweep_makes():
         read |= {k for groups in noise.values() for g in groups for k in g}
     read |= {k for keys in mod.REFINED_RESOLUTION_KEYS.values() for k in keys}
     assert not sorted(read - made)
+
+
+def test_thermal_cutting_force_slopes_separate_the_growing_thrust_from_the_intercept():
+    """force_slopes: forces exactly linear in t_u (Fc = 100 + 2000 t_u, Fp = 50 + 600 t_u) give the slope ratio 0.3
+    and the thinnest cut's Fp/Fc 110 / 300 as 50 / 300 + 60 / 300; a scatter of Fp alone gives the sd of p / c as
+    the least-squares slope's over c; a line that lacks a cut has no fit; the summary counts the lines above
+    Merchant's ceiling at mu0."""
+    mod = _script("thermal_cutting")
+    rows = [dict(material=m, vc=v, tu=t, TRF_exp=700.0, Fc=100 + 2000 * t, Fp=50 + 600 * t)
+            for m in mod.MATERIAL_NAMES for v in (60.0, 120.0) for t in (0.10, 0.15, 0.20)]
+    steep = [dict(r, Fp=0.9 * r["Fc"]) for r in rows]                       # p / c = 0.9: above either ceiling
+    gap = [dict(r, Fp=None) if r["vc"] == 120.0 and r["tu"] == 0.15 else r for r in rows]
+    slopes = mod.force_slopes({"a": (rows, "Fc", "Fp"), "b": (steep, "Fc", "Fp"), "c": (gap, "Fc", "Fp")},
+                              {("a", "AISI1045"): (0.0, 10.0)})
+    assert [(s["material"], s["vc"]) for s in slopes] == [(m, v) for m in mod.MATERIAL_NAMES for v in (60.0, 120.0)]
+    first = slopes[0]["fits"]
+    assert first["a"][0] == pytest.approx(0.3, rel=1e-9)
+    assert first["a"][2:] == pytest.approx((50 / 300, 60 / 300), rel=1e-9)
+    w = np.array([-10.0, 0.0, 10.0])                                   # (t - mean) / sum((t - mean)^2), 1/mm
+    fp = 50 + 600 * np.array([0.10, 0.15, 0.20])
+    assert first["a"][1] == pytest.approx(np.sqrt(np.sum((w * 0.1 * fp) ** 2)) / 2000.0, rel=1e-9)
+    assert first["b"][1] is None and slopes[2]["fits"]["a"][1] is None               # no scatter for Ti6Al4V
+    assert slopes[1]["fits"]["c"] is None and slopes[0]["fits"]["c"] is not None
+    text = "\n".join(mod._slope_lines(slopes))
+    assert "b 0.90 (0.30 + 0.60), 2 of 2" in text and "a 0.30 (0.17 + 0.20), 0 of 2" in text
+    assert "c 0.30 (0.17 + 0.20), 0 of 1" in text

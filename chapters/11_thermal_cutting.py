@@ -321,6 +321,15 @@ split_page = (repository_root() / "benchmarks" / "force_split_report.md").read_t
 display(Markdown(split_page.split("\n\n", 1)[1]))             # the page without its title
 
 # %% [markdown]
+# * **What grows with the chip.** Albrecht's separation (`force_slopes`, below): at each speed, straight lines through
+#   the three cuts' forces against $t_u$. About half of a measured thin cut's $F_p/F_c$ does not grow with $t_u$ (a
+#   force of the edge's kind), the rest does; refsph's SPH has about half of each part, its PFEM almost none of the
+#   second.
+
+# %% mystnb={"markdown_format": "gfm"}
+display(Markdown(page.split("## The thrust that grows with the chip")[1].split("\n## ")[0].split("\n\n", 2)[2]))
+
+# %% [markdown]
 # * **The pinball carries friction only while a pair approaches** (Eq. (34) makes the normal force zero while the
 #   particles separate): on chapter 5's (continued) tilted plane its block slides at 0.07–0.46 of the closed-form
 #   acceleration, and a frictionless pinball plane still drags. The penalty contact gives the law's $\mu$ and the

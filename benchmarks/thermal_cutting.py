@@ -820,6 +820,39 @@ def _slope_fit(line: list, fc: str, fp: str, sd_pct) -> tuple | None:
     return float(p / c), sd, float(p0 / Fc[0]), float(p * tu[0] / Fc[0])
 
 
+def ratio_parts(rows: list, fc: str, fp: str) -> dict:
+    """{case: (Fp0 / Fc, Fp / Fc - Fp0 / Fc, Fp / Fc)} of every case on a speed line with all three cuts: its Fp/Fc
+    split into the thrust that does not grow with t_u (the line's intercept Fp0 of :func:`force_slopes`) and the
+    rest, what grows with it (and what the line's straight fit leaves over)."""
+    out = {}
+    for mat, vc in {(r["material"], r["vc"]) for r in rows}:
+        line = sorted((r for r in rows if r["material"] == mat and r["vc"] == vc), key=lambda r: r["tu"])
+        if len(line) < 3 or any(r[fc] is None or r[fp] is None for r in line):
+            continue
+        _, p0 = np.polyfit([r["tu"] for r in line], [r[fp] for r in line], 1)
+        out.update({r["case"]: (p0 / r[fc], (r[fp] - p0) / r[fc], r[fp] / r[fc]) for r in line})
+    return out
+
+
+def ratio_part_errors(sets: dict, measured: str = "measured") -> dict:
+    """Per (material, label) of ``sets`` (:func:`force_slopes`'): the mean error of Fp/Fc against ``measured``'s over
+    the cases both have, and what it would be with the measured intercept's part (the error left is the growing
+    part's, |grow - grow_measured| / ratio_measured) or with the measured growing part (the intercept's), so that a
+    reader sees which part of the thrust a prediction misses. Returns {(material, label): (n, error, with the
+    measured intercept, with the measured growing part)} in percent."""
+    parts = {k: ratio_parts(*v) for k, v in sets.items()}
+    mat = {r["case"]: r["material"] for r in sets[measured][0]}
+    out = {}
+    for m in MATERIAL_NAMES:
+        for label, got in parts.items():
+            both = [(got[c], parts[measured][c]) for c in got if c in parts[measured] and mat[c] == m]
+            if label != measured and both:
+                out[(m, label)] = (len(both),) + tuple(
+                    100 * float(np.mean([abs(f(a) - f(e)) / e[2] for a, e in both]))
+                    for f in (lambda x: x[2], lambda x: x[1], lambda x: x[0]))
+    return out
+
+
 def _sum_text(a: float, b: float) -> str:
     """'a + b' or 'a - b' to two decimals (a minus sign, not '+ -')."""
     return f"{round(a, 2) + 0.0:.2f} {'+' if b >= 0 else '-'} {abs(b):.2f}"
@@ -957,16 +990,21 @@ def report(res: dict, before: dict | None = None) -> str:
         {"SPH, t_u/10": rows, f"SPH, t_u/10, ref update {REF_UPDATE:g}": refined, "PFEM, t_u/10": pfem10}, noise)
     lines += ["", P("rake_ceiling")] + _ceiling_lines(rows)
     lines += ["", P("own_ceiling")] + _own_ceiling_lines(rows, pfem10)
+    force_sets = {"measured": (rows, "Fc_exp", "Fp_exp"), "paper SPH": (rows, "Fc_sph", "Fp_sph"),
+                  "paper PFEM": (rows, "Fc_pfem", "Fp_pfem"), "refsph SPH": (rows, "Fc_N_per_mm", "Fp_N_per_mm"),
+                  f"refsph SPH, ref update {REF_UPDATE:g}": (refined, "Fc_N_per_mm", "Fp_N_per_mm"),
+                  "refsph PFEM": (pfem10, "Fc_N_per_mm", "Fp_N_per_mm")}
     lines += ["", P("force_slopes"), ""] + _slope_lines(force_slopes(
-        {"measured": (rows, "Fc_exp", "Fp_exp"), "paper SPH": (rows, "Fc_sph", "Fp_sph"),
-         "paper PFEM": (rows, "Fc_pfem", "Fp_pfem"), "refsph SPH": (rows, "Fc_N_per_mm", "Fp_N_per_mm"),
-         f"refsph SPH, ref update {REF_UPDATE:g}": (refined, "Fc_N_per_mm", "Fp_N_per_mm"),
-         "refsph PFEM": (pfem10, "Fc_N_per_mm", "Fp_N_per_mm")},
+        force_sets,
         {(label, m): _force_sd(scatter(res, keys)) for label, m, keys in
          (("refsph SPH", "AISI1045", SCATTER_KEYS), ("refsph SPH", "Ti6Al4V", SCATTER_TI10),
           (f"refsph SPH, ref update {REF_UPDATE:g}", "AISI1045", SCATTER_REF),
           (f"refsph SPH, ref update {REF_UPDATE:g}", "Ti6Al4V", SCATTER_TI10_REF),
           ("refsph PFEM", "AISI1045", PFEM_SCATTER10), ("refsph PFEM", "Ti6Al4V", PFEM_SCATTER10_TI))}))
+    lines += ["", P("ratio_parts"), "", "| material | prediction | cases | Fp/Fc error [%] | with the measured "
+              "intercept | with the measured growing part |", "|---|---|---|---|---|---|"]
+    lines += [f"| {m} | {label} | {v[0]} | {v[1]:.1f} | {v[2]:.1f} | {v[3]:.1f} |"
+              for (m, label), v in ratio_part_errors(force_sets).items()]
     gaps = rake_gaps(rows, {"refsph SPH": rows, f"refsph SPH, ref update {REF_UPDATE:g}": refined,
                             "refsph PFEM": pfem10})
     lines += ["", P("rake_gap"), ""] + _rake_gap_lines(gaps)

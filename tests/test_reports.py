@@ -1050,3 +1050,18 @@ def test_thermal_cutting_force_slopes_separate_the_growing_thrust_from_the_inter
     text = "\n".join(mod._slope_lines(slopes))
     assert "b 0.90 (0.30 + 0.60), 2 of 2" in text and "a 0.30 (0.17 + 0.20), 0 of 2" in text
     assert "c 0.30 (0.17 + 0.20), 0 of 1" in text
+
+
+def test_thermal_cutting_ratio_part_errors_tell_which_part_of_the_thrust_is_missed():
+    """ratio_part_errors: a prediction with the measured slope and a smaller intercept (Fp = 20 + 600 t_u against
+    50 + 600 t_u, the same Fc) misses only the intercept: with the measured intercept its error is 0, with the
+    measured growing part it stays the full error, mean(30 / Fp_measured)."""
+    mod = _script("thermal_cutting")
+    meas = [dict(case=3 * i + j + 1, material="AISI1045", vc=v, tu=t, Fc=100 + 2000 * t, Fp=50 + 600 * t)
+            for i, v in enumerate((60.0, 120.0)) for j, t in enumerate((0.10, 0.15, 0.20))]
+    low = [dict(r, Fp=r["Fp"] - 30.0) for r in meas]
+    got = mod.ratio_part_errors({"measured": (meas, "Fc", "Fp"), "low": (low, "Fc", "Fp")})
+    n, full, with_intercept, with_growing = got[("AISI1045", "low")]
+    assert n == 6 and list(got) == [("AISI1045", "low")]
+    assert full == pytest.approx(100 * np.mean([30.0 / r["Fp"] for r in meas]), rel=1e-9)
+    assert with_intercept == pytest.approx(0.0, abs=1e-9) and with_growing == pytest.approx(full, rel=1e-9)

@@ -990,21 +990,7 @@ def report(res: dict, before: dict | None = None) -> str:
         {"SPH, t_u/10": rows, f"SPH, t_u/10, ref update {REF_UPDATE:g}": refined, "PFEM, t_u/10": pfem10}, noise)
     lines += ["", P("rake_ceiling")] + _ceiling_lines(rows)
     lines += ["", P("own_ceiling")] + _own_ceiling_lines(rows, pfem10)
-    force_sets = {"measured": (rows, "Fc_exp", "Fp_exp"), "paper SPH": (rows, "Fc_sph", "Fp_sph"),
-                  "paper PFEM": (rows, "Fc_pfem", "Fp_pfem"), "refsph SPH": (rows, "Fc_N_per_mm", "Fp_N_per_mm"),
-                  f"refsph SPH, ref update {REF_UPDATE:g}": (refined, "Fc_N_per_mm", "Fp_N_per_mm"),
-                  "refsph PFEM": (pfem10, "Fc_N_per_mm", "Fp_N_per_mm")}
-    lines += ["", P("force_slopes"), ""] + _slope_lines(force_slopes(
-        force_sets,
-        {(label, m): _force_sd(scatter(res, keys)) for label, m, keys in
-         (("refsph SPH", "AISI1045", SCATTER_KEYS), ("refsph SPH", "Ti6Al4V", SCATTER_TI10),
-          (f"refsph SPH, ref update {REF_UPDATE:g}", "AISI1045", SCATTER_REF),
-          (f"refsph SPH, ref update {REF_UPDATE:g}", "Ti6Al4V", SCATTER_TI10_REF),
-          ("refsph PFEM", "AISI1045", PFEM_SCATTER10), ("refsph PFEM", "Ti6Al4V", PFEM_SCATTER10_TI))}))
-    lines += ["", P("ratio_parts"), "", "| material | prediction | cases | Fp/Fc error [%] | with the measured "
-              "intercept | with the measured growing part |", "|---|---|---|---|---|---|"]
-    lines += [f"| {m} | {label} | {v[0]} | {v[1]:.1f} | {v[2]:.1f} | {v[3]:.1f} |"
-              for (m, label), v in ratio_part_errors(force_sets).items()]
+    lines += _thrust_part_lines(res, P, rows, refined, pfem10)
     gaps = rake_gaps(rows, {"refsph SPH": rows, f"refsph SPH, ref update {REF_UPDATE:g}": refined,
                             "refsph PFEM": pfem10})
     lines += ["", P("rake_gap"), ""] + _rake_gap_lines(gaps)
@@ -1014,6 +1000,26 @@ def report(res: dict, before: dict | None = None) -> str:
     lines += ["", P("total", n=len(recorded), minutes=f"{sum(r['wall_time_s'] for r in recorded) / 60:.1f}",
                     todo=len(todo), keys=", ".join(f"'{k}'" for k in todo) or "none"), ""]
     return "\n".join(lines)
+
+
+def _thrust_part_lines(res: dict, P, rows: list, refined: list, pfem10: list) -> list[str]:
+    """The page's sections on the thrust that grows with t_u and the thrust that does not (:func:`force_slopes`,
+    :func:`ratio_part_errors`): measured, the paper's two methods, refsph's SPH at both reference updates and its
+    PFEM, each refsph set with its method's run-to-run scatter of the forces."""
+    sets = {"measured": (rows, "Fc_exp", "Fp_exp"), "paper SPH": (rows, "Fc_sph", "Fp_sph"),
+            "paper PFEM": (rows, "Fc_pfem", "Fp_pfem"), "refsph SPH": (rows, "Fc_N_per_mm", "Fp_N_per_mm"),
+            f"refsph SPH, ref update {REF_UPDATE:g}": (refined, "Fc_N_per_mm", "Fp_N_per_mm"),
+            "refsph PFEM": (pfem10, "Fc_N_per_mm", "Fp_N_per_mm")}
+    noise = {(label, m): _force_sd(scatter(res, keys)) for label, m, keys in
+             (("refsph SPH", "AISI1045", SCATTER_KEYS), ("refsph SPH", "Ti6Al4V", SCATTER_TI10),
+              (f"refsph SPH, ref update {REF_UPDATE:g}", "AISI1045", SCATTER_REF),
+              (f"refsph SPH, ref update {REF_UPDATE:g}", "Ti6Al4V", SCATTER_TI10_REF),
+              ("refsph PFEM", "AISI1045", PFEM_SCATTER10), ("refsph PFEM", "Ti6Al4V", PFEM_SCATTER10_TI))}
+    lines = ["", P("force_slopes"), ""] + _slope_lines(force_slopes(sets, noise))
+    lines += ["", P("ratio_parts"), "", "| material | prediction | cases | Fp/Fc error [%] | with the measured "
+              "intercept | with the measured growing part |", "|---|---|---|---|---|---|"]
+    return lines + [f"| {m} | {label} | {v[0]} | {v[1]:.1f} | {v[2]:.1f} | {v[3]:.1f} |"
+                    for (m, label), v in ratio_part_errors(sets).items()]
 
 
 def _pfem_force_line(r: dict, res: dict) -> str:

@@ -784,13 +784,14 @@ def force_slopes(sets: dict, noise: dict | None = None) -> list[dict]:
     line's three cuts (t_u = 0.10, 0.15, 0.20 mm at one v_c) the least-squares lines Fc = Fc0 + c t_u and Fp = Fp0 + p
     t_u. The slope ratio p / c is the Fp/Fc of the force that grows with the chip (the rake face's, if the chip's forces
     are proportional to t_u); the thinnest cut's Fp/Fc splits into Fp0 / Fc, the thrust that does not grow with t_u
-    (Albrecht's edge, or ploughing, force, extrapolated to t_u = 0), and p t_u / Fc, the thrust that does. All are
+    (Albrecht's edge, or ploughing, force, extrapolated to t_u = 0), and (Fp - Fp0) / Fc, the thrust that does. All are
     ratios of forces at one width of cut, so the paper's forces in N and refsph's in N/mm compare directly. ``sets``:
     {label: (rows, Fc key, Fp key)} of :func:`comparison`'s rows; ``noise``: {(label, material): (sd of Fc, sd of Fp)}
-    in percent of one run (:func:`scatter`), which gives the slope ratio's standard deviation by propagation (each cut's
-    forces independent: Fc and Fp scatter together in a run, so this overstates it). Per material and speed: Merchant's
-    ceiling at mu0 and at mu(T) of the line's mean measured T_RF (:func:`rake_face_ceiling`), and per label (slope
-    ratio, its sd or None, Fp0 / Fc, p t_u / Fc at the thinnest cut), or None where the line lacks a cut."""
+    in percent of one run (:func:`scatter`), which gives the slope ratio's standard deviation by propagation (Fc and Fp
+    of each cut taken as independent of each other: where they scatter together, this overstates it). Per material and
+    speed: Merchant's ceiling at mu0 and at mu(T) of the line's mean measured T_RF (:func:`rake_face_ceiling`), and per
+    label (slope ratio, its sd or None, Fp0 / Fc, (Fp - Fp0) / Fc at the thinnest cut), or None where the line lacks a
+    cut."""
     out = []
     for mat in MATERIAL_NAMES:
         _, at_mu0, ceiling = _ceiling_law(mat)
@@ -805,7 +806,7 @@ def force_slopes(sets: dict, noise: dict | None = None) -> list[dict]:
 
 
 def _slope_fit(line: list, fc: str, fp: str, sd_pct) -> tuple | None:
-    """(p / c, its sd or None, Fp0 / Fc and p t_u / Fc at the thinnest cut) of one speed line (:func:`force_slopes`)."""
+    """(p / c, its sd or None, Fp0 / Fc and (Fp - Fp0) / Fc at the thinnest cut) of one line (:func:`force_slopes`)."""
     line = sorted(line, key=lambda r: r["tu"])
     if len(line) < 3 or any(r[fc] is None or r[fp] is None for r in line):
         return None
@@ -817,7 +818,7 @@ def _slope_fit(line: list, fc: str, fp: str, sd_pct) -> tuple | None:
         w = (tu - tu.mean()) / np.sum((tu - tu.mean()) ** 2)                     # slope = sum(w_i F_i)
         s_c, s_p = (float(np.sqrt(np.sum((w * F * pct / 100.0) ** 2))) for F, pct in zip((Fc, Fp), sd_pct))
         sd = float(np.hypot(s_p / c, p * s_c / c ** 2))
-    return float(p / c), sd, float(p0 / Fc[0]), float(p * tu[0] / Fc[0])
+    return float(p / c), sd, float(p0 / Fc[0]), float((Fp[0] - p0) / Fc[0])      # the parts add up to Fp/Fc
 
 
 def ratio_parts(rows: list, fc: str, fp: str) -> dict:
@@ -864,7 +865,8 @@ def _slope_lines(slopes: list[dict]) -> list[str]:
     labels = list(slopes[0]["fits"])
     cell = lambda f: "-" if f is None else (f"{f[0]:.2f}" + ("" if f[1] is None else f" ± {f[1]:.2f}")  # noqa: E731
                                             + f" ({_sum_text(f[2], f[3])})")
-    lines = ["| material | v_c [m/min] | ceiling at mu0 / at mu(T_RF measured) | " + " | ".join(labels) + " |",
+    lines = ["| material | v_c [m/min] | ceiling at mu0 / at mu(the line's mean measured T_RF) | "
+             + " | ".join(labels) + " |",
              "|---" * (len(labels) + 3) + "|"]
     lines += [f"| {s['material']} | {s['vc']:.0f} | {s['ceiling_mu0']:.2f} / {s['ceiling_T']:.2f} | "
               + " | ".join(cell(s["fits"][k]) for k in labels) + " |" for s in slopes]

@@ -322,12 +322,14 @@ display(Markdown(split_page.split("\n\n", 1)[1]))             # the page without
 
 # %% [markdown]
 # * **What grows with the chip.** Albrecht's separation (`force_slopes`, below): at each speed, straight lines through
-#   the three cuts' forces against $t_u$. About half of a measured thin cut's $F_p/F_c$ does not grow with $t_u$ (a
-#   force of the edge's kind), the rest does; refsph's SPH has about half of each part, its PFEM almost none of the
+#   the three cuts' forces against $t_u$. Each cell: the slope ratio $dF_p/dF_c$ (± its scatter), and in brackets the
+#   thinnest cut's $F_p/F_c$ as the part that does not grow with $t_u$ (a force of the edge's kind) plus the part that
+#   does. The measured steel's is about half each, titanium's mostly the first; refsph's PFEM has almost none of the
 #   second.
 
 # %% mystnb={"markdown_format": "gfm"}
-display(Markdown(page.split("## The thrust that grows with the chip")[1].split("\n## ")[0].split("\n\n", 2)[2]))
+slopes = page.split("## The thrust that grows with the chip")[1].split("\n## ")[0].split("\n\n", 2)[2]
+display(Markdown(slopes.split("\n\nWhich part of the thrust")[0]))      # the table and its summary lines only
 
 # %% [markdown]
 # * **The pinball carries friction only while a pair approaches** (Eq. (34) makes the normal force zero while the

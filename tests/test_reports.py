@@ -1029,15 +1029,18 @@ def test_thermal_cutting_every_key_the_page_reads_is_a_run_the_sweep_makes():
 def test_thermal_cutting_force_slopes_separate_the_growing_thrust_from_the_intercept():
     """force_slopes: forces exactly linear in t_u (Fc = 100 + 2000 t_u, Fp = 50 + 600 t_u) give the slope ratio 0.3
     and the thinnest cut's Fp/Fc 110 / 300 as 50 / 300 + 60 / 300; a scatter of Fp alone gives the sd of p / c as
-    the least-squares slope's over c; a line that lacks a cut has no fit; the summary counts the lines above
-    Merchant's ceiling at mu0."""
+    the least-squares slope's over c, one of Fc alone as p / c^2 times the slope's; the two parts add up to the thin
+    cut's own Fp/Fc where the line is not straight; a line that lacks a cut has no fit; the summary counts each
+    material's lines above Merchant's ceiling at mu0."""
     mod = _script("thermal_cutting")
     rows = [dict(material=m, vc=v, tu=t, TRF_exp=700.0, Fc=100 + 2000 * t, Fp=50 + 600 * t)
             for m in mod.MATERIAL_NAMES for v in (60.0, 120.0) for t in (0.10, 0.15, 0.20)]
     steep = [dict(r, Fp=0.9 * r["Fc"]) for r in rows]                       # p / c = 0.9: above either ceiling
     gap = [dict(r, Fp=None) if r["vc"] == 120.0 and r["tu"] == 0.15 else r for r in rows]
-    slopes = mod.force_slopes({"a": (rows, "Fc", "Fp"), "b": (steep, "Fc", "Fp"), "c": (gap, "Fc", "Fp")},
-                              {("a", "AISI1045"): (0.0, 10.0)})
+    bent = [dict(r, Fp=r["Fp"] + (6.0 if r["tu"] == 0.15 else -3.0)) for r in rows]    # the same fit, not straight
+    slopes = mod.force_slopes({"a": (rows, "Fc", "Fp"), "b": (steep, "Fc", "Fp"), "c": (gap, "Fc", "Fp"),
+                               "d": (bent, "Fc", "Fp")},
+                              {("a", "AISI1045"): (0.0, 10.0), ("b", "AISI1045"): (10.0, 0.0)})
     assert [(s["material"], s["vc"]) for s in slopes] == [(m, v) for m in mod.MATERIAL_NAMES for v in (60.0, 120.0)]
     first = slopes[0]["fits"]
     assert first["a"][0] == pytest.approx(0.3, rel=1e-9)
@@ -1045,11 +1048,16 @@ def test_thermal_cutting_force_slopes_separate_the_growing_thrust_from_the_inter
     w = np.array([-10.0, 0.0, 10.0])                                   # (t - mean) / sum((t - mean)^2), 1/mm
     fp = 50 + 600 * np.array([0.10, 0.15, 0.20])
     assert first["a"][1] == pytest.approx(np.sqrt(np.sum((w * 0.1 * fp) ** 2)) / 2000.0, rel=1e-9)
-    assert first["b"][1] is None and slopes[2]["fits"]["a"][1] is None               # no scatter for Ti6Al4V
+    fc = 100 + 2000 * np.array([0.10, 0.15, 0.20])
+    assert first["b"][1] == pytest.approx(0.9 / 2000.0 * np.sqrt(np.sum((w * 0.1 * fc) ** 2)), rel=1e-9)
+    assert first["d"][0] == pytest.approx(0.3, rel=1e-9) and first["d"][2] == pytest.approx(50 / 300, rel=1e-9)
+    assert first["d"][2] + first["d"][3] == pytest.approx((110 - 3) / 300, rel=1e-9)   # the cut's own Fp/Fc
+    assert slopes[2]["fits"]["a"][1] is None                                          # no scatter for Ti6Al4V
     assert slopes[1]["fits"]["c"] is None and slopes[0]["fits"]["c"] is not None
-    text = "\n".join(mod._slope_lines(slopes))
-    assert "b 0.90 (0.30 + 0.60), 2 of 2" in text and "a 0.30 (0.17 + 0.20), 0 of 2" in text
-    assert "c 0.30 (0.17 + 0.20), 0 of 1" in text
+    steel, titanium = mod._slope_lines(slopes)[-2:]
+    assert steel.startswith("\nAISI1045") and titanium.startswith("\nTi6Al4V")
+    assert "b 0.90 (0.30 + 0.60), 2 of 2" in steel and "a 0.30 (0.17 + 0.20), 0 of 2" in steel
+    assert "c 0.30 (0.17 + 0.20), 0 of 1" in steel and "b 0.90 (0.30 + 0.60), 2 of 2" in titanium
 
 
 def test_thermal_cutting_ratio_part_errors_tell_which_part_of_the_thrust_is_missed():
@@ -1065,3 +1073,6 @@ def test_thermal_cutting_ratio_part_errors_tell_which_part_of_the_thrust_is_miss
     assert n == 6 and list(got) == [("AISI1045", "low")]
     assert full == pytest.approx(100 * np.mean([30.0 / r["Fp"] for r in meas]), rel=1e-9)
     assert with_intercept == pytest.approx(0.0, abs=1e-9) and with_growing == pytest.approx(full, rel=1e-9)
+    low[4]["Fp"] = None                                        # the 120 m/min line incomplete: its three cases out
+    got = mod.ratio_part_errors({"measured": (meas, "Fc", "Fp"), "low": (low, "Fc", "Fp")})
+    assert got[("AISI1045", "low")][0] == 3

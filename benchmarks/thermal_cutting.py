@@ -805,10 +805,16 @@ def force_slopes(sets: dict, noise: dict | None = None) -> list[dict]:
     return out
 
 
+def _complete_line(line, fc: str, fp: str) -> list | None:
+    """The rows of one speed line sorted by t_u, or None unless all three cuts have both forces."""
+    line = sorted(line, key=lambda r: r["tu"])
+    return None if len(line) < 3 or any(r[fc] is None or r[fp] is None for r in line) else line
+
+
 def _slope_fit(line: list, fc: str, fp: str, sd_pct) -> tuple | None:
     """(p / c, its sd or None, Fp0 / Fc and (Fp - Fp0) / Fc at the thinnest cut) of one line (:func:`force_slopes`)."""
-    line = sorted(line, key=lambda r: r["tu"])
-    if len(line) < 3 or any(r[fc] is None or r[fp] is None for r in line):
+    line = _complete_line(line, fc, fp)
+    if line is None:
         return None
     tu = np.array([r["tu"] for r in line])
     Fc, Fp = (np.array([r[k] for r in line], dtype=float) for k in (fc, fp))
@@ -827,8 +833,8 @@ def ratio_parts(rows: list, fc: str, fp: str) -> dict:
     rest, what grows with it (and what the line's straight fit leaves over)."""
     out = {}
     for mat, vc in {(r["material"], r["vc"]) for r in rows}:
-        line = sorted((r for r in rows if r["material"] == mat and r["vc"] == vc), key=lambda r: r["tu"])
-        if len(line) < 3 or any(r[fc] is None or r[fp] is None for r in line):
+        line = _complete_line((r for r in rows if r["material"] == mat and r["vc"] == vc), fc, fp)
+        if line is None:
             continue
         _, p0 = np.polyfit([r["tu"] for r in line], [r[fp] for r in line], 1)
         out.update({r["case"]: (p0 / r[fc], (r[fp] - p0) / r[fc], r[fp] / r[fc]) for r in line})
@@ -848,9 +854,8 @@ def ratio_part_errors(sets: dict, measured: str = "measured") -> dict:
         for label, got in parts.items():
             both = [(got[c], parts[measured][c]) for c in got if c in parts[measured] and mat[c] == m]
             if label != measured and both:
-                out[(m, label)] = (len(both),) + tuple(
-                    100 * float(np.mean([abs(f(a) - f(e)) / e[2] for a, e in both]))
-                    for f in (lambda x: x[2], lambda x: x[1], lambda x: x[0]))
+                out[(m, label)] = (len(both),) + tuple(                       # Fp/Fc, growing part, intercept
+                    100 * float(np.mean([abs(a[i] - e[i]) / e[2] for a, e in both])) for i in (2, 1, 0))
     return out
 
 

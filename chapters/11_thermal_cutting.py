@@ -427,7 +427,7 @@ display(Markdown(slopes.split("\n\nWhich part of the thrust")[0]))      # the ta
 # * **Steel's 12.1 % is partly two errors cancelling.** At 0.1 the steel chip's free surface is 13–21 % too cold,
 #   and the rake face stands on average 421 K above it, where the measurement has 217 K (the page's table of
 #   $T_{RF} - T_{FCS}$). For Ti6Al4V the gap is 490 K against 156 K measured. At 0.5 the gaps are 170 / 268 K: the
-#   reference update moves the gap as much as the method does (refsph's PFEM: 453 / 508 K).
+#   reference update moves the gap as much as the method does (refsph's PFEM: 450 / 508 K).
 #
 # %% [markdown]
 # * **The gap is friction's** (the page's 'gap' study, $t_u/5$ at 0.1, against three runs of each case). In case 1

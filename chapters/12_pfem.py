@@ -22,12 +22,13 @@
 # 2. the α-shape: keep the triangles that are small enough, and find the boundary;
 # 3. solve the mechanical step implicitly (a mixed displacement–pressure element, Newton–Raphson);
 # 4. move the particles and update their velocity, acceleration, pressure and temperature;
-# 5. move the tool, and go to 1 (remesh, "if remeshing is needed"; refsph: every step) or 3.
+# 5. move the tool, and go to 1 (remesh, "if remeshing is needed"; refsph: every step, and it merges crowded nodes
+#    and puts one into each oversized triangle, `refsph.pfem.refine`: a rule of its own) or 3.
 #
-# The heat step follows the mechanics on the same mesh (a staggered scheme). No kernel, no neighbour sums, no
-# stability limit on the step: the step is set by how far the tool may move between remeshings, not by the speed
-# of sound. `refsph.pfem` implements steps 1–4 and the heat step (read its module texts); this chapter writes each
-# piece as plain code, checks the package against it, and ends with what does not work yet.
+# The heat step follows on the same mesh (a staggered scheme). No kernel, no neighbour sums, no stability limit: the
+# step is set by how far the tool may move between remeshings. `refsph.pfem` implements steps 1–4 and the heat step
+# (read its module texts); this chapter writes each piece as plain code, checks the package against it, and ends with
+# what does not work yet.
 #
 # Why bother? The paper's own numbers (`refsph.paper_data`): the mean error of each method over the 18 measured cuts.
 
@@ -59,7 +60,8 @@ for q, unit in (("Fc", "N"), ("Fp", "N"), ("TRF", "K"), ("TFCS", "K")):
 # α-shape removes every triangle whose circumradius $R_e$ exceeds $\alpha\,h_e$, with $h_e$ the local spacing
 # (refsph: the mean, over the triangle's three nodes, of each node's distance to its nearest neighbour; the paper
 # writes one $h$ for the whole body, which a graded mesh cannot use). Edges that only one kept triangle has are the
-# boundary, outer and inner. As a plain loop, one triangle at a time ($R = abc/(4A)$ for sides $a, b, c$):
+# boundary, outer and inner (the package also drops triangles of near-zero area). As a plain loop, one triangle at a
+# time ($R = abc/(4A)$ for sides $a, b, c$):
 
 # %%
 def alpha_shape_loop(x, alpha):
@@ -429,12 +431,12 @@ ch.show(fig, "12_newton.png", caption="Scaled residual per Newton iteration in o
 # %% [markdown]
 # With refsph's tangent the residual falls as $r_{k+1} \approx C r_k^2$: the digits double each iteration; with the
 # elastic stiffness it falls by a constant factor per iteration. refsph's tangent is the *exact derivative of the
-# discrete residual*, written by hand for the radial return (Johnson-Cook and its modification) and the elastic
-# solid: the midpoint and end gradients moving with $\Delta u$, the Hughes–Winget rotation, the return factor
-# $c_f = \sigma_y/\sigma_{vm}$ and Eq. (13) through $\det f$ (`solid._element_tangent_exact`; a test holds it to
-# central differences at $10^{-8}$). Any other law of `refsph.strength` gets forward differences of the element
-# residual (six perturbations of $10^{-8}$ of the element size): the same iterations, at 1.3 times the CPU on the
-# short cut. The assembled matrix against a derivative of the whole residual:
+# discrete residual*, written by hand for the radial return (Johnson-Cook and its modification) and the elastic solid:
+# the midpoint and end gradients moving with $\Delta u$, the Hughes–Winget rotation, the return factor $c_f =
+# \sigma_y/\sigma_{vm}$ and Eq. (13) through $J = J_n\det(\mathbf I + \nabla_n\Delta\mathbf u)$
+# (`solid._element_tangent_exact`; a test holds it to central differences at $10^{-8}$). Any other law of
+# `refsph.strength` gets forward differences of the element residual (six perturbations of $10^{-8}$ of the element
+# size): the same iterations at 1.3 times the CPU (the short cut). Against a derivative of the whole residual:
 
 # %%
 nodes5, hist5, du5 = mid_state
@@ -449,12 +451,12 @@ print(f"|K v - dR/ds| / |K v| = {dir_err:.1e}")
 assert dir_err < 1e-5
 
 # %% [markdown]
-# **The lagged strain rate.** The Johnson–Cook yield stress depends on the equivalent strain rate
-# $\dot\varepsilon = \sqrt{\tfrac23\operatorname{dev}\mathbf d:\operatorname{dev}\mathbf d}/\Delta t$, which has a
-# cone point at $\mathbf d = 0$: where a flowing element unloads, $\partial\sigma_y/\partial\mathbf d \sim
-# C\sigma_y/|\mathbf d|$ grows without bound (until the rate falls below $\dot\varepsilon_0$) and Newton stalls.
-# refsph takes the rate of the *previous* step (`History.eps_dot`, filled by `history_from_nodes`), so the step's
-# residual is smooth: the rate staggered one step behind, stated here because the paper does not say what it does.
+# **The lagged strain rate.** The Johnson–Cook yield stress depends on the equivalent strain rate $\dot\varepsilon =
+# \sqrt{\tfrac23\operatorname{dev}\mathbf d:\operatorname{dev}\mathbf d}/\Delta t$ (dev: the 3-D deviator, zz entry
+# $-\operatorname{tr}\mathbf d/3$), which has a cone point at $\mathbf d = 0$: where a flowing element unloads,
+# $\partial\sigma_y/\partial\mathbf d \sim C\sigma_y/|\mathbf d|$ grows without bound (until the rate falls below
+# $\dot\varepsilon_0$) and Newton stalls. refsph takes the rate of the *previous* step (`History.eps_dot`, filled by
+# `history_from_nodes`), so the step's residual is smooth: the rate staggered one step behind (the paper is silent).
 
 # %% [markdown]
 # ## 5. The heat step (Eq. (22))
@@ -462,9 +464,9 @@ assert dir_err < 1e-5
 # After the mechanics, at fixed configuration, the heat equation (Eq. (14): $\rho c_p\dot T = k\nabla^2T + Q_s$)
 # discretised as Eq. (18) and stepped by backward Euler, Eq. (22):
 # $$C\,\frac{T_{n+1} - T_n}{\Delta t} + K\,T_{n+1} = F_{ext}(T_{n+1}),$$
-# $K_{ab} = \sum_e k A_e\nabla N_a\cdot\nabla N_b$, $C$ lumped ($C_{aa} = \sum_e \rho c_p A_e/3$; why lumped:
-# exercise 3), $F_{ext}$ the plastic heat (Eq. (5), $\chi\,\Delta W_p/\Delta t$ per triangle, a
-# third to each node) minus the losses of Eq. (6). Insulated, it is one linear solve, here dense and by a plain loop:
+# $K_{ab} = \sum_e k A_e\nabla N_a\cdot\nabla N_b$, $C$ lumped ($C_{aa} = \sum_e \rho c_p A_e/3$, in the cut each
+# node's own $m_a c_p$; why lumped: exercise 3), $F_{ext}$ the plastic heat (Eq. (5), $\chi\,\Delta W_p/\Delta t$ per
+# triangle, a third to each node) minus the losses of Eq. (6). Insulated: one linear solve (dense, a plain loop):
 
 # %%
 from refsph.pfem import thermal
@@ -586,38 +588,36 @@ print(f"case 1: finest spacing {cut.info['dx'] * 1e6:.0f} um, edge radius {cut.i
       f"{cut.nodes.n} nodes, {cut.t_end / cut.dt:.0f} steps of {cut.dt * 1e9:.0f} ns")
 
 # %% [markdown]
-# **The first tool contact.** `refsph.pfem.cutting` builds the paper's cut (Figure 5: graded nodes, the rounded
-# tool as an exact shape, a penalty contact with Coulomb friction inside the Newton iterations). Newton stalled at
-# the first contact, twice over. The trapezoidal rule's velocities ring at an impact, so the predictor du = dt v
-# drove contact nodes deep into the tool: each step starts from the last step's du, the contact and slip sets
-# frozen (`solve_with_active_set`) and looked at again every two corrections (`settle=2`: a fifth to a third fewer
-# iterations). A node on the tool, held by soft flowing elements, got a correction of 12 spacings where tenths
-# would do: `max_move=0.05` caps each at 0.05 of a node's size. At t_u/10 the node where chip and surface part
-# slipped to and fro on alternate solves: a slip that reverses now sticks first. `--quick` takes 2-3 minutes.
+# **The first tool contact.** `refsph.pfem.cutting` builds the paper's cut (Figure 5: graded nodes; the rounded tool
+# an exact shape, rigid in the mechanics where the paper's is elastic; a penalty contact with Coulomb friction inside
+# Newton). Newton stalled at the first contact: the trapezoidal rule's velocities ring at an impact, and the predictor
+# du = dt v drove nodes deep into the tool, so a step starts from the last step's du, the contact and slip sets frozen
+# (`solve_with_active_set`) and looked at again every two corrections (`settle=2`). A node held by soft flowing
+# elements got a correction of 12 spacings: `max_move=0.05` caps each at 0.05 of a node's size. A slip that reverses
+# sticks first. `--quick` takes 2-3 minutes.
 #
-# **The cut, side by side.** `refsph run thermal_cutting --method pfem` writes a run folder like an SPH run's
-# (with the triangles); `python benchmarks/thermal_cutting.py --study pfem` runs the 18 cases, too slow for this
-# chapter, which reads what that sweep recorded: refsph's PFEM and SPH at t_u/5, the measurement, the paper's PFEM.
+# **The cut, side by side.** `refsph run thermal_cutting --method pfem` writes a run folder like an SPH run's (with
+# the triangles). The 18 cases (`python benchmarks/thermal_cutting.py --study pfem`) are too slow here; their records
+# at t_u/5 (the PFEM's with today's solver, 'rerun'):
 
 # %%
 import json
 records = json.loads((repository_root() / "benchmarks" / "thermal_cutting.json").read_text())["runs"]
-for case in (1, 10):
-    c = rla_cutting_case(case)
-    for name, key in (("refsph PFEM", f"case {case} pfem n_tu 5"), ("refsph SPH", f"case {case} n_tu 5")):
-        r = records.get(key, {})
-        m = r["metrics"] if r.get("status") == "ok" else None
-        print(f"case {case:2d} {name:11s} " + (f"{r.get('status', 'not recorded')} ({key})" if m is None else
-              f"Fc {m['cutting_force_N_per_m'] / 1e3:.0f} N/mm, Fp/Fc {m['force_ratio']:.2f}, T_RF "
-              f"{m['rake_face_temperature_K']:.0f} K, T_FCS {m['free_chip_surface_temperature_K']:.0f} K, chip "
-              f"{m['chip_thickness_mm']:.3f} mm ({r['n_particles']} particles, {r['wall_time_s']:.0f} s)"))
+for n in (1, 10):
+    c = rla_cutting_case(n)
+    for name, key in (("refsph PFEM", f"case {n} pfem n_tu 5 rerun"), ("refsph SPH", f"case {n} n_tu 5")):
+        m = (r := records[key])["metrics"]
+        print(f"case {n:2d} {name:11s} Fc {m['cutting_force_N_per_m'] / 1e3:.0f} N/mm, Fp/Fc {m['force_ratio']:.2f}, "
+              f"T_RF {m['rake_face_temperature_K']:.0f} K, T_FCS {m['free_chip_surface_temperature_K']:.0f} K, "
+              f"chip {m['chip_thickness_mm']:.3f} mm ({r['n_particles']} particles, {r['wall_time_s']:.0f} s)")
     for name, t in (("measured", "exp"), ("paper PFEM", "pfem")):
-        print(f"case {case:2d} {name:11s} Fp/Fc {c[f'Fp_{t}_N'] / c[f'Fc_{t}_N']:.2f}, T_RF {c[f'TRF_{t}_K']:.0f} K, "
+        print(f"case {n:2d} {name:11s} Fp/Fc {c[f'Fp_{t}_N'] / c[f'Fc_{t}_N']:.2f}, T_RF {c[f'TRF_{t}_K']:.0f} K, "
               f"T_FCS {c[f'TFCS_{t}_K']:.0f} K")
 
 # %% [markdown]
-# **Fails:** Fp/Fc 0.08-0.40 at t_u/10 (measured 0.45-0.83; μ0 allows 0.55 / 0.31; the paper's above in 13 of 18),
-# unconverged at 10 µm (case 2: 0.24 → 0.33 → 0.35, scatter 9 / 3 % at t_u/5 / 10; ceiling 0.42); the time rule rings.
+# **Fails:** Fp/Fc is 0.08-0.38 at t_u/10 against 0.45-0.83 measured (a rake face slipping at μ0 allows 0.55 / 0.31
+# for steel / Ti6Al4V; the paper's PFEM is above that in 13 of 18 cases); 10 µm nodes do not close it (case 2: 0.24 →
+# 0.33 → 0.35). T_RF is 21 / 63 % off (the paper's PFEM 15 / 40 %); the time rule rings (five cases on Bossak's).
 
 # %% [markdown]
 # ## Your turn

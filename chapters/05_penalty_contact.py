@@ -123,9 +123,9 @@ ch.show(fig, "05_incline.png", caption="A block sliding down a tilted plane on t
 # 0): the block's bottom particles sit in the dips between the tool's pinballs (they start above them, staggered
 # by half a spacing, and fall for 3.5 µs before they touch), each pair's line of centres is
 # tilted, and the push along it has a part along the plane (the washboard of the oblique throw). *With* $\mu$ = 0.3
-# the block locks at twice the friction angle ($a \approx 0$, $F_t/F_N$ = the tilt's 0.6 or more): friction,
+# the block locks at $\tan\theta = 2\mu$ ($a \approx 0$, $F_t/F_N$ = the tilt's 0.6 or more): friction,
 # applied across those tilted lines and only in the pulses of approach, adds to the washboard instead of giving
-# Coulomb's $\mu$. The resistance is set by the row's geometry and the step, not by $\mu$. Issue 22 found the other
+# Coulomb's $\mu$. The row's geometry and the step set the resistance; $\mu$ adds to it. Issue 22 found the other
 # face of the same pulses at steady sliding under a cutting pressure: there the cap $m\lvert\mathbf
 # v_t\rvert/\Delta t$ binds and friction delivers far less than $\mu$ (`benchmarks/rake_face_friction.py`). The
 # accelerating block here never meets the cap: its $\lvert\mathbf v_t\rvert/\Delta t$ is far above $\mu g$.
@@ -134,13 +134,12 @@ ch.show(fig, "05_incline.png", caption="A block sliding down a tilted plane on t
 # ### The penalty force, one particle at a time
 #
 # From the module text: the gap $g = \text{offset} - d(\mathbf x)$, $d$ the signed distance to the rounded polygon
-# (outside the core: distance to the nearest edge minus $r$; inside: minus the distance to the nearest edge line,
-# minus $r$), $\mathbf n$ the outward normal there. With $k = \alpha m/\tau^2$ ($\tau$ the step of the material at
-# rest), $\beta = 2\zeta\sqrt\alpha$ and $v_n = (\mathbf v - \mathbf V)\cdot\mathbf n$:
-# $f_N = \max(k g - \beta m v_n/\tau, 0)$. Friction is a tangential spring with history $\boldsymbol\xi$:
-# trial $\boldsymbol\xi^* = P\boldsymbol\xi + \mathbf v_t\Delta t$, $\mathbf f^* = -k\boldsymbol\xi^*$; it sticks
-# if $\lvert\mathbf f^*\rvert \le \mu f_N$, else slips back onto the cone, $\mathbf f_t = \mu f_N
-# \mathbf f^*/\lvert\mathbf f^*\rvert$, $\boldsymbol\xi = -\mathbf f_t/k$.
+# (`plain_penalty` below), $\mathbf n$ the outward normal there, $\mathbf V$ the tool's velocity. With $k = \alpha
+# m/\tau^2$ ($\tau$ the step of the material at rest, $\zeta$ the damping ratio), $\beta = 2\zeta\sqrt\alpha$ and $v_n
+# = (\mathbf v - \mathbf V)\cdot\mathbf n$: $f_N = \max(k g - \beta m v_n/\tau, 0)$. Friction is a tangential spring
+# with history $\boldsymbol\xi$: trial $\boldsymbol\xi^* = P\boldsymbol\xi + \mathbf v_t\Delta t$ ($P$: onto the
+# tangent), $\mathbf f^* = -k\boldsymbol\xi^*$; it sticks if $\lvert\mathbf f^*\rvert \le \mu f_N$, else slips back
+# onto the cone, $\mathbf f_t = \mu f_N \mathbf f^*/\lvert\mathbf f^*\rvert$, $\boldsymbol\xi = -\mathbf f_t/k$.
 
 # %%
 def plain_penalty(x, v, m, T, polygon_vertices, radius, V, tau, alpha, damping, offset, mu, xi, dt):
@@ -231,8 +230,8 @@ print(f"heat of the slipping particle in this step: {2.0 * (5e-6 - 2e-6) * 1e6:.
 #
 # * **Convex, 2D, translating tools only.** A `RoundedPolygon` is convex; a tool that rotates or a 3D tool has no
 #   exact shape here yet, and the pinball is the only choice there.
-# * **A penalty is a spring.** The particle's surface does penetrate, by about $g\,\tau^2/\alpha$ per unit of
-#   pressure acceleration $g$; $\alpha$ close to 4 is unstable in the leapfrog.
+# * **A penalty is a spring.** The particle's surface does penetrate, by about $a\,\tau^2/\alpha$ under a
+#   pressure acceleration $a$; $\alpha$ close to 4 is unstable in the leapfrog.
 # * **The tool's particles still carry the heat and the reaction**, but not the geometry: the contact never sees them.
 #
 # ## Your turn

@@ -109,15 +109,14 @@ for name, rows in conv.items():
 # %% [markdown]
 # ## 2. Friction whose coefficient falls with temperature
 #
-# Coulomb friction $f_t \le \mu(T) f_n$ with (their Eqs. (10)–(11))
-# $\mu(T) = \mu_0\,(1 - T^{*q})$, $T^* = (T - T_r)/(T_m - T_r)$, acts on each workpiece particle that the tool's
-# outline pushes (the penalty contact, section 4), as a return map: a particle sticks while its tangential force
-# stays below $\mu(T) f_n$ and slides at that bound otherwise. (With the first paper's pinball it acts in each
-# contact pair, capped at $m_{ij}|v_t|/\Delta t$ so that it stops the sliding within a step but never reverses
-# it.) The work friction does, $\eta\,|f_t|\,|v_t|$ with $\eta = 1$ (their Eq. (7)), becomes heat: refsph puts
-# half of it into the chip particle and half into the nearest tool particle (the paper does not say; conduction
-# across the interface then redistributes it; `--option chip_fraction=1` puts it all in the chip, as the paper's
-# SPH code does).
+# Coulomb friction $f_t \le \mu(T) f_n$ with (their Eqs. (10)–(11)) $\mu(T) = \mu_0\,(1 - T^{*q})$, $T^* = (T -
+# T_r)/(T_m - T_r)$, acts on each workpiece particle that the tool's outline pushes (the penalty contact, section 4),
+# as a return map: a particle sticks while its tangential force stays below $\mu(T) f_n$ and slides at that bound
+# otherwise. (With the first paper's pinball it acts in each contact pair, capped at $m_{ij}|v_t|/\Delta t$ so that it
+# stops the sliding within a step but never reverses it.) The work the return map dissipates ($\eta\,|f_t|\,|v_t|$
+# when sliding, none while stuck; $\eta = 1$, their Eq. (7)) becomes heat: refsph puts half of it into the chip
+# particle and half into the nearest tool particle (the paper does not say; conduction across the interface then
+# redistributes it; `--option chip_fraction=1` puts it all in the chip, as the paper's SPH code does).
 
 # %%
 from refsph.contact import CoulombFriction
@@ -274,14 +273,14 @@ for label, cases_run in drawn.items():
 # Steel (cases 1–9) is the easier material: every method is within a few tens of per cent on the temperatures,
 # and every method underestimates the force ratio. Titanium conducts heat seven times worse than steel, so its
 # shear zones stay hot and narrow: both of the paper's methods overestimate its rake-face temperature, by several
-# hundred kelvin, and so does refsph in all nine titanium cases at $t_u/5$.
+# hundred kelvin, and so does refsph in all nine titanium cases, at $t_u/5$ and at $t_u/10$.
 #
 # *Where a number is read matters as much as how it is computed.* The rake face still warms at the end of the cut
 # (the page's drift table), so a temperature depends on the length of cut it is read at. The paper's PFEM cuts
 # 2 mm for every $t_u$ (2/3 of its 3 mm workpiece: 20, 13.3 and 10 $t_u$); this sweep cuts 16 $t_u$. The page's
-# section "At the paper's length of cut" reads both methods' histories over the last quarter of 2 mm instead: for
-# refsph's PFEM on steel that alone moves the mean rake-face error from about 21 % to about 17 %, and one case's
-# rake face by 150 K. Exercise: which of the paper's numbers would you expect to move most with the cut's length,
+# section "At the paper's length of cut" reads both methods' histories over the last quarter of 2 mm instead: on
+# steel that alone moves the mean rake-face error of refsph's PFEM from about 21 % to about 17 % (one case's rake face
+# by 150 K), and of its SPH from 19.3 % to 24.3 % (the thin cuts run to 2 mm on the paper's 3 mm workpiece). Exercise: which of the paper's numbers would you expect to move most with the cut's length,
 # and why do the thin cuts ($t_u$ = 0.1 mm) need their own, longer runs for it?
 
 # %% [markdown]
@@ -310,13 +309,14 @@ for title in ("## Mass scaling", "## The mass scale", "## Run-to-run scatter at 
 #   sticking rake face cannot give more than the chip's shear flow stress times the contact length. Every
 #   measured ratio lies above Merchant's ceiling $\tan(\arctan\mu_0 - \gamma)$ (the first table below, from
 #   the paper's data alone): no model whose thrust comes from the rake face's friction, with the paper's law
-#   $\mu(T) \le \mu_0$, can bring the mean error below 26 % for steel or 43 % for titanium. The second splits the tool's force in recorded cuts
+#   $\mu(T) \le \mu_0$, can bring the mean error below 26 % for steel or 43 % for titanium. The second sets each
+#   prediction against the ceiling at its own $T_{RF}$; the third splits the tool's force in recorded cuts
 #   (`benchmarks/force_split.py`): how much of the rake face sticks, and what a rake face slipping everywhere
 #   at $\mu(T)$ would give.
 
 # %% mystnb={"markdown_format": "gfm"}
 ceiling = page.split("## What friction on the rake face alone")[1].split("\n## ")[0]
-display(Markdown(ceiling.split("\n\n", 2)[2]))               # its table, without the heading and the prose
+display(Markdown(ceiling.split("\n\n", 2)[2]))               # its tables, without the heading and first prose
 split_page = (repository_root() / "benchmarks" / "force_split_report.md").read_text()
 display(Markdown(split_page.split("\n\n", 1)[1]))             # the page without its title
 
@@ -333,9 +333,10 @@ display(Markdown(slopes.split("\n\nWhich part of the thrust")[0]))      # the ta
 
 # %% [markdown]
 # * **The pinball carries friction only while a pair approaches** (Eq. (34) makes the normal force zero while the
-#   particles separate): on chapter 5's (continued) tilted plane its block slides at 0.07–0.46 of the closed-form
-#   acceleration, and a frictionless pinball plane still drags. The penalty contact gives the law's $\mu$ and the
-#   closed form at every mass scale, which is why it is the default here; the page's contact table shows what the
+#   particles separate): on the tilted plane of `contact_checks_report.md` (the plane's row under the block's) its
+#   block slides at 0.07–0.46 of the closed-form acceleration, on chapter 5's staggered row it locks, and a
+#   frictionless pinball plane still drags. The penalty contact gives the law's $\mu$ and the closed form at every
+#   mass scale, which is why it is the default here; the page's contact table shows what the
 #   choice does to the cut.
 #
 # %% [markdown]
@@ -353,7 +354,7 @@ display(Markdown(slopes.split("\n\nWhich part of the thrust")[0]))      # the ta
 #   how often the reference configuration is updated, which the paper leaves open. Updated when some
 #   $\lVert\mathbf E\rVert_F$ passes 0.5, Eq. (18) sees 71 % of the particles' own deformation; at 0.1, 91 %
 #   (`registered_strain_report.md`). The unseen part is particles sliding past non-neighbours (chapter 3, exercise
-#   2), resisted by the artificial viscosity: its heat falls from 14–22 % of the tool's work to 6–8 %. At 0.1 the
+#   2), resisted by the artificial viscosity: its heat falls from 16–22 % of the tool's work to 6–8 %. At 0.1 the
 #   chip is 22–31 % thinner, $F_c$ 19–26 % lower and the rake face hotter: steel at $t_u/5$ 655 → 775 K (four runs
 #   against three; measured 668), Ti6Al4V at $t_u/10$ 835 → 959 K (measured 701). Steel at 0.05 stays within the
 #   scatter of the three runs at 0.1 but for $T_{RF}$ (−2 %); Ti6Al4V's chip surface cools 8 % more.
@@ -420,8 +421,8 @@ display(Markdown(slopes.split("\n\nWhich part of the thrust")[0]))      # the ta
 #
 # %% [markdown]
 # * **Converged at 0.1.** Both cases checked are converged at $t_u/10$: $t_u/15$ moves every quantity but case
-#   10's hottest contact particle by less than twice the scatter of three runs (case 1: $F_c$ −4.5 %, $T_{RF}$
-#   −0.6 %; case 10: +1.3 %, −2.3 %).
+#   10's hottest contact particle by less than twice the scatter of three runs (case 1 against its three: $F_c$
+#   −4.5 %, $T_{RF}$ −0.6 %; case 10 against its record: +1.3 %, −2.3 %).
 #
 # %% [markdown]
 # * **Steel's 12.1 % is partly two errors cancelling.** At 0.1 the steel chip's free surface is 13–21 % too cold,
@@ -504,7 +505,8 @@ print(f"c_p = {CP_TOOL:g}: heat crosses the tool's {depth * 1e3:.2f} mm in {tau 
 # With 15 J/(kg K) heat crosses the tool in about the time of the cut, so the tool's temperature can settle
 # within it (the paper's reason for the reduced $c_p$); with 200, thirteen times slower: the simulated tool would
 # stay nearly cold and draw more heat from the rake face. Conduction never limits the step here: its step is
-# microseconds, the mechanical step tens of nanoseconds, although mass scaling has already made it 38 times longer.
+# about a microsecond, the mechanical step tens of nanoseconds, though mass scaling made that $\sqrt s$ times longer
+# (38 at this quick run's $s$; 19 in the sweep's case 1).
 # </details>
 
 # %% [markdown]

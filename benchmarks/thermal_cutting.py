@@ -1946,6 +1946,8 @@ REF_SINGLES = ((SCATTER_T5, tuple(f"case 1{COARSE}{REF_KEY}{r:g}" for r in REF_U
                (REF_SCATTER, tuple(f"case 1{COARSE}{REF_KEY}{r:g}" for r in REF_UPDATES
                                    if r < SCENE_REF_UPDATE and r != REF_UPDATE)),
                (RESOLUTION_NOISE[10][0], tuple(f"case 10{COARSE}{REF_KEY}{r:g}" for r in REF_UPDATES)),
+               (REF_SCATTER_TI, tuple(f"case 10{COARSE}{REF_KEY}{r:g}" for r in REF_UPDATES
+                                      if r < SCENE_REF_UPDATE and r != REF_UPDATE)),   # ... and at REF_UPDATE's
                (SCATTER_KEYS, (f"case 1{REF_KEY}{REF_UPDATE:g}",)),
                (SCATTER_TI10, (f"case 10{REF_KEY}{REF_UPDATE:g}",)))
 TABLE_SINGLES = {REF_RUNS: REF_SINGLES, GAP_RUNS: GAP_SINGLES}   # a table -> (group, its single runs) read under it

@@ -406,10 +406,10 @@ ch.show(fig, "06_2d_history.png", caption="The 2D half slab of the Taylor test w
                                           "the 3D bar (dotted).")
 
 # %% [markdown]
-# The length falls fast at first (the end moves at nearly the impact speed), then more slowly as the plastic
-# front slows down and the rear of the bar is braked. It stops; the small wiggle at the end is the bar ringing
-# in its free axial mode after it has left the wall (the final length is the mean over the last 30 µs). The foot
-# widens while the material flows outward along the wall.
+# The length falls fast at first (the end moves at nearly the impact speed), then more slowly as the plastic front
+# slows down and the rear of the bar is braked. It stops; the small wiggle at the end is the bar ringing in its free
+# axial mode after it has left the wall (final length: the last 30 µs' mean once settled; exercise 4). The foot widens
+# while the material flows outward along the wall.
 #
 # ### Plastic strain and temperature
 #
@@ -444,7 +444,7 @@ ch.show(fig, "06_2d_fields.png", caption="The 2D Taylor slab at 30 µs, mirrored
 # %% [markdown]
 # The plastic strain, and with it the temperature ($\Delta T$ grows with the plastic work), is largest at the
 # wall in the centre of the foot and falls off towards the rear. Look at the edge of the foot: the ESPH particles
-# are more disordered than the TLSPH ones (more on that under "Where it fails"). The whole impact, 2 µs a frame:
+# are more disordered than the TLSPH ones (more on that under "Where it fails"). The whole impact, t_end/25 a frame:
 
 # %%
 fig, axes = plt.subplots(1, 2, figsize=(6.4, 6), sharey=True)

@@ -402,7 +402,7 @@ for m, r in res.items():
 #
 # As in the paper, the bands become narrower and sharper as the spacing shrinks, while the overall shape (how far
 # the block spreads, where the bands cross) and the mean force hardly change. ESPH does not care about the
-# smaller time step; TLSPH's strain field moves by a few per cent with the time step and with $K_p$, because both
+# smaller time step; TLSPH's strain line moves by 4–10 % (L2) with the time step and with $K_p$, because both
 # enter its contact law.
 
 # %% [markdown]

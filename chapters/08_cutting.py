@@ -345,8 +345,8 @@ for m, r in res.items():
 # %% [markdown]
 # ### The chip
 #
-# Plastic strain and temperature at the end of the cut (cf. the paper's Figs. 12–15). Particles are squares 1.5
-# spacings wide, so a white gap is a real gap; the tool's surface layers are grey.
+# Plastic strain and temperature at the end of the cut (cf. the paper's Figs. 12–15). Squares 1.5 spacings wide
+# over a 2.5-wide underlay: white is a real gap; the tool's surface layers are grey.
 
 # %%
 XLIM, YLIM = ((1.9, 3.3), (0.3, 1.55)) if ch.quick else ((1.3, 3.6), (0.25, 2.15))
@@ -508,8 +508,8 @@ ch.show(fig, "08_band_profiles.png", caption="Plastic strain along the chip's mi
 
 # %% [markdown]
 # At the paper's spacing the profile along the chip has sharp peaks (dotted: the bands counted). At the coarse
-# spacing the same measure sees a few broad humps or a plain ramp, and at the package's threshold usually **no band
-# at all**. This is not a bug in the measure: a band in a simulation is one to two particle spacings wide, and at
+# spacing the same measure sees a few broad humps or a plain ramp, and at the package's threshold **one band or
+# none**. This is not a bug in the measure: a band in a simulation is one to two particle spacings wide, and at
 # several times the paper's spacing that is as wide as a whole chip segment, so neighbouring bands merge into one
 # smear (Exercise 3 shows it on drawn bands). The chip, the shear zone and the force are there at a coarse
 # spacing; **to see bands you need the paper's resolution**, at the cost printed above. That is the benchmark's
@@ -533,8 +533,8 @@ ch.show(fig, "08_band_profiles.png", caption="Plastic strain along the chip's mi
 #   the sharp edge take strains without limit as the spacing shrinks, and with no heat conduction they heat
 #   towards the melting point. Compare the 99th percentile, not the maximum.
 # * **A frictionless tool that pushes up.** Merchant's tool feels no thrust. ESPH's tool particles are SPH
-#   neighbours, so the face drags the chip; TLSPH's pinball face is a washboard of particles one spacing apart.
-#   The thrust-to-cutting-force ratio measures how far each is from frictionless.
+#   neighbours, so the face drags the chip; TLSPH's zero-clearance face rubs the new surface. Ft/Fc
+#   mixes that with each contact's error (the penalty's thrust is ~0).
 # * **Band counts depend on a threshold** (`BAND_REL_PROMINENCE`), strongly so where the profile has humps
 #   rather than peaks.
 
@@ -573,9 +573,9 @@ print(f"feed {1e3 * FEED:.2f} mm: Fc = {1e-6 * Fc:.3f} MN/m, Fc / feed = {Fc / F
 # %% [markdown]
 # <details><summary>What you should see</summary>
 #
-# The cutting force grows with the feed, by somewhat less than the ratio of the feeds (the paper: "the increase of
-# the feeding length increases the cutting force"), so $F_c/f$ stays about the same: the specific cutting
-# energy, close to a material constant of machining.
+# The cutting force grows about in proportion to the feed (benchmark: ×1.52–1.68 for ×1.67; the paper: "the increase
+# of the feeding length increases the cutting force"), so $F_c/f$ stays about the same: the specific cutting energy,
+# close to a material constant of machining.
 # </details>
 
 # %% [markdown]

@@ -679,7 +679,7 @@ report = check(my_force_history, pkg_force_history, cases_ex4, names=("t", "Fc",
 # <details><summary>What you should see</summary>
 #
 # As handed out: `FAIL ... not written yet`. The plain mean fails already in the first case: the CFL step
-# changes during the cut (by a factor of about 4 here), and a short step must count less. With more bins than
+# changes during the cut, and a short step must count less. With more bins than
 # steps some bins stay empty: they are left out, not returned as nan. The time mean is what turns TLSPH's
 # impulsive contact force into a curve you can read.
 # </details>

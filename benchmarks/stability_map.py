@@ -1,6 +1,6 @@
 """The stability map: each hard case, each method, the paper's settings and one change at a time.
 
-    python benchmarks/stability_map.py --jobs 2     # every run not yet done (about 40 CPU-minutes), then the map
+    python benchmarks/stability_map.py --jobs 2     # every run not yet done (about 25 CPU-minutes), then the map
     python benchmarks/stability_map.py --report     # table and figure again from the committed JSON only
 
 Hard cases (quick resolution, 2D):

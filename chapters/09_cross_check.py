@@ -111,7 +111,7 @@ assert not any(r.passed for r in rows)
 # sums add in a fixed order), so a rerun on another thread count must pass.
 
 # %%
-kw = dict(dim=2, quick=True, progress=False, t_end=6e-6)       # 6 us: one period, about
+kw = dict(dim=2, quick=True, progress=False, t_end=6e-6)       # 6 us: about 0.8 of a period
 run("bar", "tlsph", out=ch.tmp / "one", numerics=dict(threads=1), **kw)
 run("bar", "tlsph", out=ch.tmp / "two", numerics=dict(threads=2), **kw)
 rows = compare(ch.tmp / "one", ch.tmp / "two")
@@ -169,7 +169,7 @@ else:
     print(format_table([r for r in rows if r.quantity.startswith("metric") or "00010" in r.quantity]))
 
 # %% [markdown]
-# The full cross-check (`python benchmarks/lammps_crosscheck.py`, about 40 CPU-minutes) runs the bar at
+# The full cross-check (`python benchmarks/lammps_crosscheck.py`, about 55 CPU-minutes) runs the bar at
 # dp = 0.25 mm and the whole Taylor cylinder at dp = 0.5 mm (13,680 particles, no heating: LAMMPS-SMD's
 # Johnson-Cook has no thermal softening), each code on one core. Its committed results:
 
@@ -196,19 +196,19 @@ for a, b in pairs:
 # %% [markdown]
 # ## Why the numbers differ: two formulations, not two builds
 #
-# The bar's wave speed agrees to about 1e-4: both codes are correct on the same particles. The damping and the
-# Taylor bar's shape differ by more than the tolerance. With the artificial viscosity off in both, the lengths
-# agree to 0.1 %: LAMMPS's $Q_1$ term is not Eq. (12) (it acts on separating pairs too), so "1.5" means two
-# different dampings. The diameter gap (+3 %) is LAMMPS's hourglass control: with refsph's own, α = 5, it turns
-# to −1.7 % and every metric is within tolerance; the reference update makes no difference. The fields stay apart
-# in the foot, where the formulations differ most.
+# The bar's wave speed agrees to about 1e-4: both codes are correct on the same particles. The damping and the Taylor
+# bar's shape differ by more than the tolerance. With the artificial viscosity off in both, the lengths agree to 0.1
+# %: LAMMPS's $Q_1$ term is not Eq. (12) (it acts on separating pairs too), so "1.5" means two different dampings. The
+# diameter gap (+3 %) is LAMMPS's hourglass control: with refsph's own, α = 5, it turns to −1.7 % and every metric is
+# within tolerance; the reference update leaves the shape alone (not the peak strain). The fields stay apart in the
+# foot, where the formulations differ most.
 
 # %% [markdown]
 # Every difference, read from LAMMPS's source (`src/MACHDYN/`):
 #
 # | | refsph (the paper) | LAMMPS-SMD | setting that closes it |
 # |---|---|---|---|
-# | kernel | cubic B-spline, support 2h = 3 dp | spiky $(h-r)^3$, support $h$ = `hfac` dp | `hfac 3.0` (the decks' default 2.01 is a smaller support) |
+# | kernel | cubic B-spline, support 2h = 3 dp | spiky $(h-r)^3$, support $h$ = `hfac` dp | `hfac 3.0` (the Taylor deck's default 2.01 is a smaller support) |
 # | viscosity | Eq. (12), only approaching pairs | $Q_1 c_0 \mu$, on every pair, clipped | $\beta = 0$ and $Q_1 = 0$ together |
 # | hourglass | off (`hourglass`, Ganzenmüller's form) | Ganzenmüller 2015, `hg` = 10; a viscous form once plastic | `--set hourglass=5` ≈ `hg 10` (elastic branch only) |
 # | stress rate | Jaumann, Eq. (20) | Green-Naghdi (polar R of F) | none here; equal for small spins |

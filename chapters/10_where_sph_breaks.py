@@ -266,10 +266,10 @@ print(f"{len(runs)} runs; failed: ESPH {failed['esph']}, TLSPH {failed['tlsph']}
 
 # %% [markdown]
 # Read it by rows and columns. Without artificial viscosity (beta 0) almost everything fails with the
-# predictor-corrector; the leapfrog rescues the elastic cases but not the impacts. Uncorrected ESPH never keeps the
-# spinning disc; TLSPH's Taylor bar at twice the speed fails with every setting but a weaker viscosity (beta 0.5).
-# A run whose settings the map shows failing warns when it starts (`refsph.stability`): the warning names the case
-# that failed and the remedy.
+# predictor-corrector; the leapfrog rescues the bar, and TLSPH's disc and rings, never the fast Taylor bar.
+# Uncorrected ESPH never keeps the spinning disc; TLSPH's Taylor bar at twice the speed fails with every setting but a
+# weaker viscosity (beta 0.5). A run whose settings the map shows failing warns when it starts (`refsph.stability`):
+# the warning names the case that failed and the remedy.
 
 # %% [markdown]
 # ## 6. Pairs in a chip: self-contact
@@ -303,16 +303,17 @@ for key in [f"case {n} n_tu 5 {x}" for n in (1, 10) for x in (
           f"{1e-3 * m.get('cutting_force_N_per_m', np.nan):6.0f} {m.get('rake_face_temperature_K', np.nan):5.0f}")
 
 # %% [markdown]
-# Without self-contact a quarter to a third of the workpiece's particles end the cut paired at the scene's
-# threshold, fewer with frequent updates. With it no pair comes closer than 0.45 dp, yet the cuts do not run more
-# safely: at the scene's step (Courant 0.3), of the 8 configurations run both ways, 4 failed with it and 3 without. The one traced
+# Without self-contact a quarter to a third of the workpiece's particles end the cut paired at the scene's threshold,
+# fewer with frequent updates. With it no pair comes closer than 0.45 dp, yet the cuts do not run more safely: at the
+# scene's step (Courant 0.3), of the 8 configurations run both ways, 4 failed with it and 3 without. The one traced
 # (case 10 at 0.5) broke where an update left a particle at 1858 K (Ti6Al4V melts at 1877 K) with 4 reference
 # neighbours instead of about 20: in five steps it went from 0.06 to 28 m/s. At half the step that cut and the two
 # failed cuts without self-contact (case 10 at 0.2, case 1 at 0.02) ran to the end, one run each: the blow-ups look
-# mainly like a time-step instability, with the step as the cure rather than the contact. Not only: at $t_u/10$,
-# at half the step already, case 1 at 0.1 failed without self-contact (and ran to the end with it). The step rule $C h/(c_L + |v|_{max})$ leaves the
-# artificial viscosity's own signal speed out, and mass scaling brings $c_L$ down to 305 m/s in case 1 and 45 m/s
-# in case 10, where the traced particle's 28 m/s is not small beside it.
+# mainly like a time-step instability, with the step as the cure rather than the contact. Not only: at $t_u/10$, at
+# half the step already, case 1 at 0.1 failed without self-contact (and ran to the end with it). Chapter 11 traces
+# why: after an update the corrected gradient's gain grows (to 2.8) and the stable Courant number falls below the 0.3
+# in use (to 0.255; `benchmarks/stable_step_report.md`); `gain_step` or `frequency_step=0.5` ran every such cut to its
+# end.
 
 # %% [markdown]
 # Self-contact moves the results by more than their scatter: case 1, three runs with it against four without, has
@@ -371,7 +372,7 @@ print(f"hourglass {ALPHA:g} against none: {r1.summary['n_steps']} against {r0.su
 # <details><summary>What you should see</summary>
 #
 # The same number of steps (the CFL step does not see the penalty), about the same restitution (0.74 against
-# 0.71), and the closest pair at 0.8 instead of a thousandth of a spacing: the collapse is gone. The price is one
+# 0.71), and the closest pair at 0.8 instead of a few thousandths of a spacing: the collapse is gone. The price is one
 # more pair sum per force evaluation, a little wall time (on a busy machine the times scatter more than that).
 # $\alpha$ = 10 keeps the lattice as well, at the same steps; $\alpha$ = 0.1 is too weak: a pair collapses again.
 # </details>

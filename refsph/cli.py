@@ -1,4 +1,4 @@
-"""Command line: ``refsph list``, ``refsph run SCENE [--method {esph,tlsph,both}] ...``, ``refsph book``,
+"""Command line: ``refsph list``, ``refsph run SCENE [--method {esph,tlsph,both,pfem}] ...``, ``refsph book``,
 ``refsph oracle DIR``, ``refsph compare REF TEST``, ``refsph export RUN_DIR --vtk`` and ``refsph handout DIR``.
 
 Exit codes (:data:`EXIT_CODES`): 0 done, 1 a comparison found a difference (or the book failed), 2 bad input (a

@@ -1,6 +1,6 @@
 """Heat conduction in SPH (Rodriguez Prieto, Larsson & Afrasiabi, Eqs. (4), (26), (29)): the first piece of the
 thermomechanical cutting model (issue 16). A run conducts heat only when its Setup asks (``Setup.thermal``, a
-:class:`Conduction`; None, the default and every scene so far: no conduction, the paper's adiabatic model).
+:class:`Conduction`; None, the default: no conduction, the first paper's adiabatic model; ``thermal_cutting`` conducts).
 
     Eq. (4)   rho c_p dT/dt = k lap T + Q_s
     Eq. (26)  lap f_i = sum_j 2 f_ij / |r_ij| (e_ij . grad_i W_ij) V_j,    f_ij = f_i - f_j, e_ij = r_ij / |r_ij|

@@ -6,7 +6,8 @@ report. The registry :data:`SCENES` is what ``refsph list`` prints.
 * :mod:`.measure` -- what the scenes share: lattices, the Table 3 material, time averages, energies, momentum;
 * :mod:`.bar`, :mod:`.tension` -- elastic test cases; :mod:`.spinning_disc`, :mod:`.rings` -- hard cases
   (objectivity; contact and fracture); :mod:`.taylor`, :mod:`.pressing`, :mod:`.cutting` -- the
-  paper's three benchmarks (Sections 3.1-3.3); :mod:`.thermal_cutting` -- the second paper's 18 measured cuts.
+  paper's three benchmarks (Sections 3.1-3.3); :mod:`.thermal_cutting` -- the second paper's 18 measured cuts;
+  :mod:`.contact_checks` -- contact checks with closed-form answers (issue 22).
 """
 from __future__ import annotations
 

@@ -251,7 +251,7 @@ ch.show(fig, "02_velocity_gradient_patch.png", caption="The error (log10) of the
 # tens of per cent: a surface particle sees about half a kernel, so Eq. (23) underestimates the derivatives
 # normal to the surface. **The surface of an ESPH body is softer than the material**; the vibrating bar below feels it.
 # The cure is in the formula: $\mathbf l_i \mathbf M_i^{-1} = \mathbf A$ wherever $\mathbf M_i$ is invertible
-# (Randles & Libersky 1996; Bonet & Lok 1999). TLSPH (Chapter 3) always does it; in ESPH it is the option
+# (Randles & Libersky 1996; Bonet & Lok 1999). TLSPH (Chapter 3) does it by default; in ESPH it is the option
 # `esph_correction` (the paper's Eq. (23) is the default).
 
 # %%
@@ -271,7 +271,8 @@ for corr in (False, True):
     print(f"esph_correction={corr!s:5s}: L/L0 = {m_sd['angular_momentum_ratio']:.4f}, largest stress "
           f"{m_sd['max_stress_over_1pct']:.2e} x (E 1%)  (the centrifugal stress: "
           f"{m_sd['centrifugal_stress_over_1pct']:.1e})")
-#
+
+# %% [markdown]
 # ## Plane strain: why $s_{zz}$ must be carried
 #
 # In plane strain $\dot\epsilon_{zz} = 0$, but the out-of-plane *stress* is not zero. Eq. (20) for the $zz$
@@ -436,9 +437,9 @@ ch.show(fig, "02_tensile_instability.png", caption="The tensile instability: the
 #   $\gamma$ is "a case-dependent tuning parameter" (the paper). It comes from no constitutive law: it also makes
 #   an elastic bar softer in tension, and Exercise 1 shows what too much of it does. A large artificial viscosity
 #   hides the instability too, at the price of dissipating physical energy.
-# * **Free surfaces.** Eq. (23) is not corrected, so the surface layers are too soft and a bar is too slow; the
-#   error shrinks only like $\Delta p$. In machining the chip, the cut surface and the tool contact are all free
-#   surfaces.
+# * **Free surfaces.** Eq. (23) as printed (the default) is uncorrected, so the surface is too soft and a bar too
+#   slow; the error shrinks only like $\Delta p$. In machining the chip, the cut surface and the tool contact are all
+#   free surfaces.
 # * **On the plus side**, ESPH needs no reference configuration, handles any distortion and separation (pairs
 #   simply form and break), and conserves linear momentum exactly.
 

@@ -72,7 +72,7 @@ print(f"K = {mat.K / 1e9:.1f} GPa, G = {mat.G / 1e9:.1f} GPa, c0 = {mat.c0:.0f} 
 #   with $\mathbf L_i = \mathbf M_i^{-T}$, $\mathbf M_i = \sum_j V_j(\mathbf X_j - \mathbf X_i)\otimes\nabla_i W_{ij}$.
 #   In Eq. (17) the $j$ term uses $j$'s correction $\mathbf L_j$, so the pair force stays antisymmetric.
 # * **Stress measure**: $\mathbf P = J\boldsymbol\sigma\mathbf F^{-T}$, the transpose of the printed
-#   $J\mathbf F^{-1}\boldsymbol\sigma$ (Section 3).
+#   $J\mathbf F^{-1}\boldsymbol\sigma$ (§3 below).
 # * **Artificial viscosity**: $\boldsymbol\Pi_{ij} = \pi_{ij}(\mathbf B_i + \mathbf B_j)/2$ with
 #   $\mathbf B = J\mathbf F^{-T}$ and $\pi_{ij}$ of Eqs. (12)–(13) from current positions and velocities, contracted
 #   with the *uncorrected* gradient.
@@ -331,12 +331,12 @@ for deg in (90, 30):
 #
 # ## 4. The stress must turn with the body
 #
-# A block with a deviatoric pre-stress $\mathbf s_0$ is turned rigidly by a quarter turn. We prescribe the motion
-# and integrate only the stress with the package's rates (TLSPH $\mathbf l$ and the Jaumann rate, Eq. 20) and
-# the predictor–corrector step of `refsph.integrate`. Exact answer: $\mathbf s(t) = \mathbf R\mathbf s_0\mathbf R^T$.
-# Two wrong laws for comparison: the spin terms in the printed order $\mathbf s\boldsymbol\omega -
-# \boldsymbol\omega\mathbf s$ (right only for the transposed convention $l_{ab} = \partial v_b/\partial x_a$;
-# `refsph` uses $l_{ab} = \partial v_a/\partial x_b$), and no spin terms at all.
+# A block with a deviatoric pre-stress $\mathbf s_0$ is turned rigidly by a quarter turn. We prescribe the motion and
+# integrate only the stress with the package's rates (TLSPH $\mathbf l$ and the Jaumann rate, Eq. 20) and a
+# predictor–corrector step written as in `refsph.integrate`. Exact answer: $\mathbf s(t) = \mathbf R\mathbf s_0\mathbf
+# R^T$. Two wrong laws for comparison: the spin terms in the printed order $\mathbf s\boldsymbol\omega -
+# \boldsymbol\omega\mathbf s$ (right only for the transposed convention $l_{ab} = \partial v_b/\partial x_a$; `refsph`
+# uses $l_{ab} = \partial v_a/\partial x_b$), and no spin terms at all.
 
 # %%
 dp_r = 1e-4
@@ -567,8 +567,8 @@ print("det M_i of a row of 6 particles:", det(op_line.M))
 print("det F of the row at rest:", det(op_line.deformation_gradient(X_line)))
 
 # %% [markdown]
-# `refsph` uses the pseudo-inverse for such particles (`op.degenerate` lists them), so the operator stays finite,
-# but $\mathbf F$ is still singular in the missing direction ($J = 0$) and a run that needs it stops.
+# `refsph` uses the pseudo-inverse for such particles (`op.degenerate` lists them) and completes $\mathbf F$ with
+# the identity in the missing direction ($J = 1$ at rest): it cannot see a stretch across the row.
 #
 # ## Your turn
 #

@@ -537,7 +537,8 @@ print(f"1045 at eps_p = 4: Eq. (25) {s_org[-1] / 1e6:.0f} MPa, modified {s_mod[-
 #   no erosion. Chip separation comes from the discretisation, not from the material law.
 # * **The clamped rate term** has a kink at $\dot\epsilon_0$ and no rate effect below it: a choice, not part of
 #   the 1983 model.
-# * **Adiabatic.** No heat conduction; $C_p$, $\chi$ and the elastic constants do not depend on temperature.
+# * **Adiabatic** (paper 1; conduction: `refsph.thermal`, Ch. 11); $C_p$, $\chi$ and the elastic constants do not
+#   depend on temperature.
 # * **The model itself** is multiplicative (the three effects do not interact), fitted over a limited range, so
 #   the strains and rates in a chip are extrapolation; hardening is isotropic (no Bauschinger effect).
 # * **At and above $T_m$ the material is a fluid.** $\sigma_y = 0$ gives $c_f = 0$: the whole trial deviator becomes

@@ -191,8 +191,8 @@ def correction_matrix(M: np.ndarray, tol: float = 1e-6, max_condition: float | N
     """L_i = M_i^-T (Bonet & Lok 1999). Where M_i is (nearly) singular -- a particle whose neighbours do not
     span every direction (no neighbours, a single row of particles) -- the Moore-Penrose pseudo-inverse is used
     instead (Bonet & Lok's correction restricted to the directions the neighbours span), so the operator stays
-    finite. Returns (L, indices of those degenerate particles); F of such a particle is singular in the
-    missing direction, so a run that depends on it stops with a non-finite-state error that names it.
+    finite. Returns (L, indices of those degenerate particles); the caller completes F of such a particle with
+    the identity in the missing direction (:meth:`refsph.tlsph.ReferenceOperator.deformation_gradient`).
 
     ``max_condition`` (None: no limit, the paper's correction): where M_i = U diag(s) V^T is invertible but its
     condition number s_max / s_min exceeds it -- a particle on a ragged free surface whose few neighbours lie

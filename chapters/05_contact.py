@@ -60,19 +60,19 @@ ch = chapter("05_contact")
 # \quad (34) \qquad\qquad F^2_{ij} = \mu_{ij}\sqrt{\frac{R_i R_j}{R_i + R_j}}\; p_d^{3/2} \quad (35)$$
 #
 # $$\frac{d\mathbf v_i}{dt} \mathrel{+}= \mathbf e_{ij}\,\frac{F_{ij}}{m_i}, \qquad
-# \frac{d\mathbf v_j}{dt} \mathrel{-}= \mathbf e_{ij}\,\frac{F_{ij}}{m_j} \qquad (36)$$
+# \frac{d\mathbf v_j}{dt} \mathrel{-}= \mathbf e_{ij}\,\frac{F_{ij}}{m_j} \qquad \text{(36; $j$: the reaction)}$$
 #
 # $F^1$ is the force that would stop the approach of the pair within one step; $F^2$ is a Hertz spring. The
 # smaller of the two acts, scaled by $K_p$, along the line of centres, equal and opposite on the two particles.
 
 # %% [markdown]
-# ### Choices the paper leaves open
+# ### Where `refsph` reads or changes the printed equations
 #
 # * **Penetration rate.** The paper prints $\dot p_d = \lvert\dot{\mathbf v}_i - \dot{\mathbf v}_j\rvert$, which is
 #   never negative. `refsph` uses the rate of Eq. (32), $\dot p_d = -(\mathbf v_i - \mathbf v_j)\cdot\mathbf e_{ij}$:
 #   positive while the pair approaches, so nothing acts while it separates.
-# * **Effective mass.** $m_{ij} = m_i m_j/(m_i + m_j)$, the particles' own masses; $m_{ij} = m_i$ for a rigid
-#   partner ($m_j = \infty$).
+# * **Effective mass.** Printed: $\rho_i\rho_jR_i^3R_j^3/(\rho_iR_i^3+\rho_jR_j^3)$; used: $m_{ij} = m_i m_j/(m_i +
+#   m_j)$, the particles' own masses ($m_{ij} = m_i$ for a rigid partner).
 # * **Hertz modulus.** The shear modulus $G = E/(2(1+\nu))$, combined as $\mu_{ij} = \mu_i\mu_j/(\mu_i+\mu_j)$
 #   ($= \mu_i$ for a rigid partner).
 # * **2D.** A particle stands for a row of particles $\Delta p$ apart through the thickness, so the Hertz force
@@ -503,7 +503,7 @@ ch.show(fig, "05_kp_scan.png", caption="TLSPH bounces against the scaling factor
 # `refsph.contact.CoulombFriction` adds to each pinball pair a force against the pair's sliding velocity, of size
 # $\mu(T_i)F_{ij}$, capped at $m_{ij}\lvert\mathbf v_t\rvert/\Delta t$ so that friction stops the sliding of a
 # pair but never reverses it within a step (the loop above does the same). It is TLSPH only, and needs the
-# particles' temperatures in the state (`make_state(..., T0=...)`). The frictional heat is not added.
+# particles' temperatures in the state (`make_state(..., T0=...)`). Its heat: `Setup.friction_heat` (chapter 11).
 #
 # The test case: an elastic steel block (2 mm × 1 mm) thrown obliquely at a wall, 100 m/s along it and 25 m/s
 # towards it. The ratio of the tangential to the normal impulse on the wall, $J_t/J_n$, measures the drag.
@@ -556,10 +556,9 @@ print(f"K_p = 1 at 400 m/s: lowest disc centre at x = {o['face'].min() / DP:+.2f
 assert o["face"].min() < 0.0
 
 # %% [markdown]
-# * **Only rigid partners, no self-contact.** `pinball_contact` handles two deformable sets, but the TLSPH solver
-#   calls it only between the workpiece and the rigid bodies: a chip that curls back onto the workpiece passes
-#   through it in TLSPH.
-# * **No frictional heat**, and no heat flow into the tool.
+# * **No self-contact by default.** The solver applies the pinball between tools and between different bodies, not
+#   within one: a chip that curls back onto its workpiece passes through it unless `Numerics.self_contact` is set.
+# * **Isothermal here:** frictional heat and conduction into the tool are chapter 11's.
 # * **Resolution.** The pinball radius, the washboard and the ESPH stand-off all scale with $\Delta p$: a particle
 #   wall is a surface only to within a fraction of a spacing.
 # * **Sliding.** On a row of tool particles the pinball's resistance to sliding is set by the row's geometry and

@@ -391,3 +391,20 @@ def test_oracle_only_names_what_it_writes(tmp_path, capsys):
     assert main(["oracle", str(tmp_path / "g"), "--only", "kernel_*", "esph_pair_terms"]) == 0
     assert capsys.readouterr().out.startswith(f"{len(names)} golden cases in")
     assert sorted(p.name for p in (tmp_path / "g").iterdir() if p.is_dir()) == sorted(names)
+
+
+def test_null_field_tolerance_leaves_the_array_out(tmp_path, capsys):
+    """A ``--tolerances`` file's ``"fields": {"W": null}`` means "not compared" for golden cases too (it raised a
+    TypeError before): the kernel case's W is left out, its dW_dr still compared, and a wrong W then passes."""
+    test = tmp_path / "mine"
+    shutil.copytree(GOLDEN / "kernel_cubic_2d", test / "kernel_cubic_2d")
+    out = dict(np.load(test / "kernel_cubic_2d" / "output.npz"))
+    out["W"] = out["W"] * 2.0
+    np.savez(test / "kernel_cubic_2d" / "output.npz", **out)
+    tol = tmp_path / "tol.json"
+    tol.write_text(json.dumps({"fields": {"W": None}}))
+    args = ["compare", str(GOLDEN), str(test), "--only", "kernel_cubic_2d"]
+    assert main(args) == 1                                      # W wrong: fails by default
+    assert main(args + ["--tolerances", str(tol)]) == 0
+    table = capsys.readouterr().out.split("kernel_cubic_2d/W")
+    assert len(table) == 2                                      # W in the first table only

@@ -216,8 +216,8 @@ def compare_cases(ref: Path, test: Path, tolerances: dict | None = None, only=No
 def compare_case(case_dir: Path, out_test: dict | None, fields: dict | None = None) -> list[Row]:
     """The output arrays of one golden case (folder ``case_dir``) against ``out_test`` {name: array} (None: TEST
     has no output for this case), each with the case's tolerance (``fields``: {name: tolerance} overriding it) and
-    error measure (a missing array fails), and where each failing one fails worst (the case's ``rows``: the
-    particle, or the pair and its particles I, J)."""
+    error measure (a missing array fails; one whose ``fields`` tolerance is None is not compared), and where each
+    failing one fails worst (the case's ``rows``: the particle, or the pair and its particles I, J)."""
     case_dir = Path(case_dir)
     case = read_json(case_dir / "case.json", "golden case")
     measure = case.get("measure", {})
@@ -226,6 +226,8 @@ def compare_case(case_dir: Path, out_test: dict | None, fields: dict | None = No
     pairs = None
     rows = []
     for k, a in out_ref.items():
+        if k in (fields or {}) and fields[k] is None:      # a tolerance null: not compared (module text)
+            continue
         tol = (fields or {}).get(k, scatter[k][0] if k in scatter else case["tolerance"].get(k, DEFAULTS["field"]))
         kind = case.get("arrays", {}).get(f"output/{k}", {}).get("rows", "row")
         if kind == "pair" and pairs is None:

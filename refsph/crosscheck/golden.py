@@ -829,6 +829,7 @@ def _surface_case(root):
                   "lambda_min: a pair sum and a closed-form eigenvalue, round-off only; the masks (1 on the surface) "
                   "must agree exactly: no particle lies near a threshold (margins below)",
                   kind="surface", kernel="wendland (support 2h)",
+                  meaning=dict(dp="initial particle spacing (the alpha-shape's length unit)"),
                   conventions=dict(kernel=KERNEL_TEXT["wendland"],
                                    moment_matrix="M_i = - sum_j V_j x_ij (x) grad_i W_ij over the neighbours within "
                                                  "2h (symmetrised); lambda_min its smallest eigenvalue; "
@@ -885,6 +886,7 @@ def _penalty_friction_case(root):
                   margins=dict(trial_friction_over_mu_f_normal_to_1=margin), kind="penalty",
                   rows=dict(core="vertex", shift="component", V="component", force_on_tool="component"),
                   meaning=dict(V="tool velocity", m="particle mass", T="particle temperature",
+                               a="acceleration of each particle from the contact",
                                force_on_tool="total force on the tool (the reaction)",
                                alpha="fraction of the penetration the spring removes per time_scale"),
                   conventions=dict(

@@ -94,13 +94,13 @@ def test_friction_coefficient_and_cap():
 
 
 def test_contact_parameters_validated():
-    with pytest.raises(ValueError):
+    with pytest.raises(ValueError, match="radius factor k"):
         PinballContact(k=0.0, K_p=1.0)
-    with pytest.raises(ValueError):
+    with pytest.raises(ValueError, match="K_p"):
         PinballContact(k=0.3, K_p=-1.0)
-    with pytest.raises(ValueError):
+    with pytest.raises(ValueError, match="rigid body id"):
         RigidBody("tool", 0, (1.0, 0.0))
-    with pytest.raises(ValueError):
+    with pytest.raises(ValueError, match="non-empty"):
         Clamp("left", np.array([], dtype=int))
 
 

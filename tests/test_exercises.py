@@ -1,5 +1,5 @@
-"""Chapters are lessons: at most ~600 lines of code and markdown, no markdown cell over ~250 words, three lines of
-set-up, and a "Your turn" section of 2-4 exercises.
+"""Chapters are lessons: at most ~600 lines of code and markdown, no markdown cell over ~250 words, a set-up cell
+of at most 12 lines, and a "Your turn" section of 2-4 exercises.
 
 Exercises that teach (issue 25): every exercise keeps its expected result in a collapsed block (``<details><summary>
 What you should see</summary> ... </details>``, closed in Jupyter and in the book, so "predict first" can work), at

@@ -68,8 +68,10 @@ def test_restart_is_bit_for_bit(tmp_path, monkeypatch, scene, method, kw):
     numbers = {k: v for k, v in whole.summary["metrics"].items() if isinstance(v, (int, float))}
     assert numbers and all(again["metrics"][k] == v for k, v in numbers.items() if v == v)
     forces = [d / "reaction_forces.csv" for d in (tmp_path / "whole", tmp_path / "cut")]
+    assert forces[0].exists() == (scene in ("pressing", "thermal_cutting"))     # the scenes with tools or clamps
     if forces[0].exists():                                         # every step's reaction, none lost at the restart
         assert forces[0].read_text() == forces[1].read_text()
+    assert ("heat_balance" in whole.summary) == (scene == "thermal_cutting")
     if "heat_balance" in whole.summary:                            # the heat ledger continues, not restarts
         assert again["heat_balance"] == whole.summary["heat_balance"]
 

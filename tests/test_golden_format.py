@@ -103,6 +103,22 @@ def test_switched_off_terms_change_only_the_acceleration():
         for k in ("rho_dot", "S_dot", "S_zz_dot", "l"):
             np.testing.assert_array_equal(other[k], full[k])
         assert (name == "esph_rates") == np.array_equal(other["v_dot"], full["v_dot"])
+    with np.load(GOLDEN / "esph_pair_terms" / "input.npz") as z:          # ... by that term: the pair case's pi and
+        I, J, m = z["I"], z["J"], z["m"]                                   # p^a summed as Eq. (11) sums them
+    terms = out("esph_pair_terms")
+
+    def acceleration(per_pair):
+        f = -per_pair[:, None] * terms["grad_W"]
+        a = np.zeros_like(full["v_dot"])
+        np.add.at(a, I, m[J, None] * f)
+        np.add.at(a, J, -m[I, None] * f)
+        return a
+    for name, term in (("esph_rates_no_viscosity", terms["pi"]), ("esph_rates_no_artificial_pressure", terms["p_a"]),
+                       ("esph_rates_stress_only", terms["pi"] + terms["p_a"])):
+        assert name in ESPH_RATE_CASES
+        off = full["v_dot"] - out(name)["v_dot"]
+        assert np.max(np.abs(off - acceleration(term))) <= 1e-12 * np.max(np.abs(full["v_dot"])), name
+        assert np.max(np.abs(off)) > 1e-6 * np.max(np.abs(full["v_dot"])), name          # the term is not nil
 
 
 def test_pair_terms_add_up_to_the_rates():

@@ -336,8 +336,8 @@ display(Markdown(slopes.split("\n\nWhich part of the thrust")[0]))      # the ta
 #   particles separate): on the tilted plane of `contact_checks_report.md` (the plane's row under the block's) its
 #   block slides at 0.07–0.46 of the closed-form acceleration, on chapter 5's staggered row it locks, and a
 #   frictionless pinball plane still drags. The penalty contact gives the law's $\mu$ and the closed form at every
-#   mass scale, which is why it is the default here; the page's contact table shows what the
-#   choice does to the cut.
+#   mass scale, which is why it is the default here. In the cut (the page's contact table: case 1 at $t_u/10$,
+#   one run against four) the pinball gives 30 % less $F_c$, 46 % less $F_p$ and a rake face 58 K hotter.
 #
 # %% [markdown]
 # * **What "rake-face temperature" means.** The paper does not say how its source measured $T_{RF}$ (a radiation

@@ -310,7 +310,9 @@ for key in [f"case {n} n_tu 5 {x}" for n in (1, 10) for x in (
 # neighbours instead of about 20: in five steps it went from 0.06 to 28 m/s. At half the step that cut and the two
 # failed cuts without self-contact (case 10 at 0.2, case 1 at 0.02) ran to the end, one run each: the blow-ups look
 # mainly like a time-step instability, with the step as the cure rather than the contact. Not only: at $t_u/10$, at
-# half the step already, case 1 at 0.1 failed without self-contact (and ran to the end with it). Chapter 11 traces
+# half the step already, case 1 at 0.1 failed without self-contact (and ran to the end with it), and case 1 at 0.5
+# failed with it (at 0.80 of 1.6 ms: a particle torn off with 2 neighbours, at 821 m/s), where its four runs without
+# it ran to the end. Chapter 11 traces
 # why: after an update the corrected gradient's gain grows (to 2.8) and the stable Courant number falls below the 0.3
 # in use (to 0.255; `benchmarks/stable_step_report.md`); `gain_step` or `frequency_step=0.5` ran every such cut to its
 # end.

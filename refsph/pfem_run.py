@@ -34,6 +34,7 @@ import json
 import os
 import sys
 import time
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -133,9 +134,14 @@ def _restore(folder: Path, cut):
         try:
             arrays = read_npz(folder / name, "PFEM checkpoint")
             rec = json.loads(str(arrays.pop("run")))
-            return CutRun.restore(cut, arrays), rec["snapshots"], rec["next_snap"]
+            restored = CutRun.restore(cut, arrays), rec["snapshots"], rec["next_snap"]
         except (ValueError, KeyError) as e:
             failures.append(f"{type(e).__name__}: {e}")
+            continue
+        if failures:                                         # said, as the SPH restart says it (refsph.simulate)
+            warnings.warn(f"{failures[0]}; continuing from the checkpoint before it, {folder / PREVIOUS}",
+                          stacklevel=2)
+        return restored
     raise ValueError(f"{folder}: nothing to restart from ({'; '.join(failures)})")
 
 

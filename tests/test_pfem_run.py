@@ -160,6 +160,22 @@ def test_cli_refuses_what_the_pfem_cannot_take(args, says, tmp_path, capsys):
     assert not (tmp_path / "o").exists()
 
 
+def test_a_spoilt_last_checkpoint_falls_back_on_the_one_before(short_run, tmp_path):
+    """With restart.npz spoilt (a crash while writing it), --restart continues from restart_prev.npz, says so, and
+    still ends as the uninterrupted run: the same reactions at every step."""
+    out, res = short_run
+    part = tmp_path / "split"
+    run_pfem("thermal_cutting", out=part, options=SHORT, quick=True, progress=False, max_steps=3, checkpoint_every=0)
+    snaps = part / "snapshots"
+    assert (snaps / "restart_prev.npz").exists()
+    (snaps / "restart.npz").write_bytes(b"not a zip")
+    with pytest.warns(UserWarning, match="continuing from the checkpoint before it"):
+        assert main(["run", "--restart", str(part), "--quiet"]) == 0
+    a, b = load_reactions(out / "reaction_forces.csv"), load_reactions(part / "reaction_forces.csv")
+    np.testing.assert_array_equal(a["t"], b["t"])
+    np.testing.assert_array_equal(a["tool"], b["tool"])
+
+
 def test_a_spoilt_checkpoint_is_a_clear_error(tmp_path, capsys):
     """A truncated restart.npz falls back on restart_prev.npz; with both spoilt, refsph run --restart says which
     files it could not read (exit 2), no zipfile traceback."""

@@ -1046,13 +1046,22 @@ METRIC_RUNS = {
 }
 
 
+# The metrics' definitions (refsph/scenes/<scene>.py, _metrics / cutting_metrics); "time mean over the second half":
+# sum(f dt) / sum(dt) over the steps of the reaction history with t > t_end / 2 (refsph.scenes.measure.time_mean)
 METRIC_MEANING = dict(
-    final_length_mm="final length of the bar", final_diameter_mm="final diameter of the impact face",
-    max_plastic_strain="largest plastic strain", max_temperature_K="highest temperature",
-    tool_force_peak_N_per_m="peak tool force", tool_force_mean_N_per_m="mean tool force",
-    clamp_force_mean_N_per_m="mean clamp force", plastic_strain_line_eps_p="plastic strain along the scene's line "
-    "(input scene_line_index), point by point", cutting_force_mean_N_per_m="mean cutting force",
-    thrust_force_mean_N_per_m="mean thrust force")
+    final_length_mm="final length of the bar, max z - min z of the particle centres plus one spacing dz, in mm: the "
+    "mean over the last 30 us once the bar is at rest (its plastic work at 99.5 % of the final), else at the end",
+    final_diameter_mm="final diameter of the impact face, 2 (max r + dr/2) over all particles (r = sqrt(x^2 + y^2)), "
+    "in mm, over the same window as the length",
+    max_plastic_strain="largest plastic strain of any particle at the end", max_temperature_K="highest temperature "
+    "of any particle at the end",
+    tool_force_peak_N_per_m="peak of the tool force (block on tool, +x) binned into 400 equal time means",
+    tool_force_mean_N_per_m="time mean over the second half of the run of the tool force (block on tool, +x)",
+    clamp_force_mean_N_per_m="time mean over the second half of the run of the force of the block on its clamped "
+    "column (+x)", plastic_strain_line_eps_p="plastic strain along the scene's line (input scene_line_index), "
+    "point by point", cutting_force_mean_N_per_m="time mean over the second half of the run of the force of the "
+    "workpiece on the tool along +x (against the cut)", thrust_force_mean_N_per_m="time mean over the second half "
+    "of the run of the force of the workpiece on the tool along +y (pushing it away from the workpiece)")
 
 
 def _metric_arrays(spec: dict, metrics: dict) -> dict:

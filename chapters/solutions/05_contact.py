@@ -92,8 +92,8 @@ assert abs((V_T - rough["vt_after"]) / (0.81 * (1 + e_n) * V_N) - 1) < 0.2
 # v_i\cdot\mathbf e$ (the wall is at rest), $F^1 = m_i\dot p_d/\Delta t$ where $\dot p_d > 0$ and 0 elsewhere, $F^2 =
 # G\sqrt{R/2}\,p_d^{3/2}$/thickness, and `np.add.at` to sum $\mathbf e F/m_i$ per particle.
 #
-# Then a mistake the cases catch: the paper's printed $\dot p_d = \lvert\mathbf v_i - \mathbf v_j\rvert$, never
-# negative, so the contact also pushes pairs that already separate. The first case's random velocities catch it
+# Then a mistake the cases catch: the paper's printed $\dot p_d = \lvert\dot{\mathbf v}_i - \dot{\mathbf v}_j\rvert$,
+# read as speeds, never negative, so the contact also pushes pairs that already separate. The first case's random velocities catch it
 # (the leaving disc would too).
 
 # %%

@@ -48,7 +48,7 @@ for o_a in (stiff, soft):
 # block at rest on the plane needs a tangential force $mg\sin\theta$ against a normal one $mg\cos\theta$: a ratio
 # $\tan\theta = 0.6$, inside the cone of $\mu = 0.8$. So it sticks ($a \approx 0$, but for its elastic ringing),
 # and the plane carries $F_t/F_N = 0.6$, not 0.8. Each particle's spring stays inside its cone, which is what the
-# return map is for; the pinball, which pushes only in pulses of approach, cannot hold such a static force.
+# return map is for; the pinball holds a block only by its washboard, not inside a Coulomb cone.
 
 # %%
 stuck = incline("penalty", 100.0, mu=0.8)

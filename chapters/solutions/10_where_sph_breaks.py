@@ -23,7 +23,7 @@
 # %% [markdown]
 # ### Solution 1 — Tension in TLSPH
 #
-# TLSPH keeps its lattice: its smallest pair distance at the end is 0.94 dp, as ESPH's *with* artificial pressure
+# TLSPH keeps its lattice: its smallest pair distance over the run is 0.94 dp, as ESPH's *with* artificial pressure
 # (0.94), against 0.78 for ESPH without. The tensile instability is a property of the Eulerian kernel: ESPH sums
 # over the current neighbours at the current distances, and in tension the slope of the kernel makes the pair force
 # attractive, so a small perturbation pulls neighbours into pairs. TLSPH evaluates its kernel, and chooses its
@@ -64,7 +64,7 @@ assert m0["min_pair_distance_over_dp"] < 0.01 and abs(a1[0]["min_pair_distance_o
 #
 # At 5 % of $c_L$ the largest stress is 0.126 of E × 1 %, 25 times that at 1 % (0.0050): stress grows as the speed
 # squared, as a centrifugal stress must. The metrics' centrifugal scale $\frac{3+\nu}{8}\rho\,\omega^2R^2$ (the
-# peak stress of a spinning elastic disc, at its centre) is 0.139, and the largest stress is 0.9 of it at both
+# scene's scale: a thin disc's centre stress) is 0.139, and the largest stress is 0.9 of it at both
 # speeds. So it is physics: a rigid rotation must not make stress *beyond* this. The uncorrected disc of section 2
 # had 160 times the centrifugal stress, at 1 %. The angular momentum stays 1 to $10^{-5}$.
 

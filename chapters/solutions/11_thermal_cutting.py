@@ -89,10 +89,10 @@ assert round(dt_wave * 1e6, 3) == 0.063 and round(np.sqrt(info["mass_scale"])) =
 # Systematic: in all nine steel cases of the $t_u/10$ table refsph is below the measurement on all three
 # quantities. The force ratio is 39–51 % low, the free chip surface 15–24 % cold, the rake face 7–26 % cold (14 %
 # in case 1), on average colder at 120 and 180 m/min (21 and 24 %) than at 60 (13 %), because the measured
-# rake-face temperature rises with the speed faster than refsph's. Nine cases with one sign are not noise (the run-to-run scatter of section 6 is a few
-# per cent): the model lacks something, such as thrust from the edge and the flank, friction above the law's
-# $\mu$ (Merchant, "Where it fails") or heat at the rake face. The titanium case is the other way: 19 % too hot at
-# the rake face, 12 % at the free surface. The rake face's sign is the numerics' as much as the model's: at the
+# rake-face temperature rises with the speed faster than refsph's. Nine cases with one sign are not noise (section 6's scatter:
+# 2–5 % in T, 12 % in Fp/Fc): the model lacks something, such as thrust from the edge and the flank, friction above the law's
+# $\mu$ (Merchant, "Where it fails") or heat at the rake face. Titanium goes the other way: rake face 19–38 %, free
+# surface 12–30 % too hot. The rake face's sign is the numerics' as much as the model's: at the
 # converged reference update 0.1 seven of the nine steel rake faces are 6–27 % too hot (cases 8 and 9 at the
 # measurement, +0.1 and +1.7 %), while the force ratio stays 46–57 % low.
 

@@ -91,32 +91,39 @@ def test_esph_cases_carry_their_numbers_and_conventions():
         assert "omega S - S omega" in c["jaumann"] and "I[k] < J[k]" in c["pairs"]
 
 
+def _golden(name: str, which: str) -> dict:
+    """A golden case's input or output arrays."""
+    with np.load(GOLDEN / name / f"{which}.npz") as z:
+        return {k: z[k] for k in z.files}
+
+
+def _pair_sum(f: np.ndarray, I, J, m, n: int) -> np.ndarray:
+    """Eq. (11)'s sum over the half pairs of a per-pair force f (P, 2): +m_j f on I, -m_i f on J."""
+    a = np.zeros((n, f.shape[1]))
+    np.add.at(a, I, m[J, None] * f)
+    np.add.at(a, J, -m[I, None] * f)
+    return a
+
+
 def test_switched_off_terms_change_only_the_acceleration():
     """The rate cases with viscosity / artificial pressure off share esph_rates' state and differ from it in v_dot
     alone, and by that term: what fails in which case names the term."""
-    def out(name):
-        with np.load(GOLDEN / name / "output.npz") as z:
-            return {k: z[k] for k in z.files}
-    full = out("esph_rates")
+    full = _golden("esph_rates", "output")
     for name in ESPH_RATE_CASES:
-        other = out(name)
+        other = _golden(name, "output")
         for k in ("rho_dot", "S_dot", "S_zz_dot", "l"):
             np.testing.assert_array_equal(other[k], full[k])
         assert (name == "esph_rates") == np.array_equal(other["v_dot"], full["v_dot"])
-    with np.load(GOLDEN / "esph_pair_terms" / "input.npz") as z:          # ... by that term: the pair case's pi and
-        I, J, m = z["I"], z["J"], z["m"]                                   # p^a summed as Eq. (11) sums them
-    terms = out("esph_pair_terms")
+    # ... by that term: the pair case's pi and p^a summed as Eq. (11) sums them
+    inp, terms = _golden("esph_pair_terms", "input"), _golden("esph_pair_terms", "output")
+    n = len(full["v_dot"])
 
     def acceleration(per_pair):
-        f = -per_pair[:, None] * terms["grad_W"]
-        a = np.zeros_like(full["v_dot"])
-        np.add.at(a, I, m[J, None] * f)
-        np.add.at(a, J, -m[I, None] * f)
-        return a
+        return _pair_sum(-per_pair[:, None] * terms["grad_W"], inp["I"], inp["J"], inp["m"], n)
     for name, term in (("esph_rates_no_viscosity", terms["pi"]), ("esph_rates_no_artificial_pressure", terms["p_a"]),
                        ("esph_rates_stress_only", terms["pi"] + terms["p_a"])):
         assert name in ESPH_RATE_CASES
-        off = full["v_dot"] - out(name)["v_dot"]
+        off = full["v_dot"] - _golden(name, "output")["v_dot"]
         assert np.max(np.abs(off - acceleration(term))) <= 1e-12 * np.max(np.abs(full["v_dot"])), name
         assert np.max(np.abs(off)) > 1e-6 * np.max(np.abs(full["v_dot"])), name          # the term is not nil
 
@@ -124,19 +131,12 @@ def test_switched_off_terms_change_only_the_acceleration():
 def test_pair_terms_add_up_to_the_rates():
     """The per-pair terms of esph_pair_terms, summed over the half pairs as FORMAT.md says (Eq. (11)), give
     esph_rates' acceleration: the pair case and the rate case tell one story."""
-    with np.load(GOLDEN / "esph_pair_terms" / "input.npz") as z:
-        inp = {k: z[k] for k in z.files}
-    with np.load(GOLDEN / "esph_pair_terms" / "output.npz") as z:
-        terms = {k: z[k] for k in z.files}
-    with np.load(GOLDEN / "esph_rates" / "output.npz") as z:
-        v_dot = z["v_dot"]
+    inp, terms = _golden("esph_pair_terms", "input"), _golden("esph_pair_terms", "output")
+    v_dot = _golden("esph_rates", "output")["v_dot"]
     I, J, m, rho, p, g = inp["I"], inp["J"], inp["m"], inp["rho"], terms["p"], terms["grad_W"]
     s = (inp["S"] - p[:, None, None] * np.eye(2)) / (rho**2)[:, None, None]
     bracket = s[I] + s[J] - (terms["pi"] + terms["p_a"])[:, None, None] * np.eye(2)
-    f = np.einsum("pab,pb->pa", bracket, g)
-    a = np.zeros_like(v_dot)
-    np.add.at(a, I, m[J, None] * f)
-    np.add.at(a, J, -m[I, None] * f)
+    a = _pair_sum(np.einsum("pab,pb->pa", bracket, g), I, J, m, len(v_dot))
     assert np.max(np.abs(a - v_dot)) <= 1e-12 * np.max(np.abs(v_dot))
 
 

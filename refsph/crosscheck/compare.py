@@ -218,7 +218,7 @@ def compare_case(case_dir: Path, out_test: dict | None, fields: dict | None = No
     has no output for this case), each with the case's tolerance (``fields``: {name: tolerance} overriding it) and
     error measure (a missing array fails; one whose ``fields`` tolerance is None is not compared), and where each
     failing one fails worst (the case's ``rows``: the particle, or the pair and its particles I, J)."""
-    case_dir = Path(case_dir)
+    case_dir, fields = Path(case_dir), fields or {}
     case = read_json(case_dir / "case.json", "golden case")
     measure = case.get("measure", {})
     out_ref = read_npz(case_dir / "output.npz", "golden-case output")
@@ -226,9 +226,9 @@ def compare_case(case_dir: Path, out_test: dict | None, fields: dict | None = No
     pairs = None
     rows = []
     for k, a in out_ref.items():
-        if k in (fields or {}) and fields[k] is None:      # a tolerance null: not compared (module text)
+        if k in fields and fields[k] is None:               # a tolerance null: not compared (module text)
             continue
-        tol = (fields or {}).get(k, scatter[k][0] if k in scatter else case["tolerance"].get(k, DEFAULTS["field"]))
+        tol = fields.get(k, scatter[k][0] if k in scatter else case["tolerance"].get(k, DEFAULTS["field"]))
         kind = case.get("arrays", {}).get(f"output/{k}", {}).get("rows", "row")
         if kind == "pair" and pairs is None:
             pairs = _pairs_of(case_dir)
@@ -236,7 +236,7 @@ def compare_case(case_dir: Path, out_test: dict | None, fields: dict | None = No
                    else f"TEST's {case_dir.name}/output.npz has no array {k}")
         row = _array_row(f"{case_dir.name}/{k}", None if out_test is None else out_test.get(k), a, tol,
                          measure.get(k), rows=kind, pairs=pairs if kind == "pair" else None, missing=missing)
-        if k in scatter and k not in (fields or {}):
+        if k in scatter and k not in fields:
             row.tolerance_from = scatter[k][1]
         if k in stale:
             row.note = "; ".join(filter(None, [row.note, stale[k]]))

@@ -201,6 +201,41 @@ def test_the_dissipation_heat_is_split_into_contact_damping_and_viscosity(short_
     assert undamped.summary["heat_dissipation"]["viscosity_J"] > 0
 
 
+@pytest.mark.parametrize("every", [1, 3])
+def test_the_contact_damping_heat_is_the_time_integral_of_its_power(monkeypatch, every):
+    """summary.heat_dissipation.contact_damping_J = sum over the steps of dt x the contact's damping power (summed over
+    the particles) at the step's last force evaluation (the scene's leapfrog evaluates the forces once a step, at its
+    end, and twice in the first; the last evaluation's rates make the step's heat), integrated here from the contact's
+    own results: recorded at every evaluation of the tool contact
+    (PenaltyCoupling.with_tools) and cut into steps by a hook. With the heat step every 3 mechanical steps the
+    ledger books the kept heat when it is applied, so the steps after the last heat step are left out."""
+    from refsph.coupling import PenaltyCoupling
+    calls, steps = [], []
+    real = PenaltyCoupling.with_tools
+
+    def recording(self, state, n, dt):
+        c = real(self, state, n, dt)
+        calls.append(float(c.heat_power_a.sum()))
+        return c
+
+    def hook(state, solver):
+        steps.append((float(state.t), list(calls)))
+        calls.clear()
+
+    monkeypatch.setattr(PenaltyCoupling, "with_tools", recording)
+    from refsph.simulate import build, simulate
+    b = build("thermal_cutting", "tlsph", quick=True, options=dict(case=1, length=0.5e-3, travel=0.25),
+              numerics=dict(threads=1, heat_every=every))
+    res = simulate(b.setup, "tlsph", scene=b.scene, metrics=b.metrics, hook=hook, progress=False)
+    t = np.array([0.0] + [s[0] for s in steps])
+    assert b.setup.numerics.integrator == "leapfrog" and all(len(s[1]) >= 1 for s in steps)
+    power = np.array([s[1][-1] for s in steps])
+    n_booked = len(steps) - len(steps) % every
+    integral = float(np.sum(np.diff(t)[:n_booked] * power[:n_booked]))
+    booked = res.summary["heat_dissipation"]["contact_damping_J"]
+    assert integral > 0 and booked == pytest.approx(integral, rel=1e-9)
+
+
 def test_side_by_side_table_names_the_method_and_the_measurement_of_a_case0_run():
     """refsph run thermal_cutting --method both: each row names its method, spacing and length of cut; a case-0 run
     at case 1's material, v_c and t_u (the SPH scene's defaults) shows case 1's measurement, marked; one at

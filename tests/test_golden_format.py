@@ -2,7 +2,8 @@
 npz of float64/int64 arrays in C order, case.json describing every array and every convention as data, the
 per-term cases; and the proof: an independent C checker (checkers/c/) with its own zip/NPY reader that computes
 the cubic kernel and the ESPH cases from the spec alone and matches them to round-off, and `refsph compare` naming
-a bug planted in it down to the term (the case) and the particle or pair."""
+a bug planted in it down to the term (the case) and the particle or pair; and plain Python loops written from
+FORMAT.md's sections alone that reproduce the penalty, conduction and surface cases."""
 import json
 import shutil
 import subprocess
@@ -222,3 +223,119 @@ def test_planted_support_bug_is_named(checker, tmp_path):
         r, h = z["r"], float(z["h"])
     k = int(failed["kernel_cubic_2d/W"].where.split()[1])
     assert failed["kernel_cubic_2d/W"].where == f"sample {k}" and h * (1 - 1e-12) <= r[k] <= 2 * h
+
+
+def _wendland_dw_dr(r: float, h: float) -> float:
+    """dW/dr of the 2D Wendland C2 kernel, W = 7/(4 pi h^2) (1 - q/2)^4 (2q + 1), q = r/h (its case.json 'kernel')."""
+    q = r / h
+    if q >= 2.0:
+        return 0.0
+    return 7.0 / (4.0 * np.pi * h * h) * (-5.0 * q * (1.0 - 0.5 * q) ** 3) / h
+
+
+def test_penalty_case_follows_format_md_alone():
+    """penalty_friction recomputed particle by particle from FORMAT.md's 'penalty' section alone (gap to the rounded
+    polygon, spring-damper normal force, return-mapped friction, power, reaction), not from refsph/penalty.py."""
+    i, o = _golden("penalty_friction", "input"), _golden("penalty_friction", "output")
+    P = i["core"] + i["shift"]
+    tau, alpha, dt = float(i["time_scale"]), float(i["alpha"]), float(i["dt"])
+    beta = 2.0 * float(i["damping"]) * np.sqrt(alpha)
+    total, in_contact, slipping = np.zeros(2), 0, 0
+    for p in range(len(i["x"])):
+        x, m = i["x"][p], float(i["m"][p])
+        best, inside, lines = None, True, []
+        for k in range(len(P)):
+            a, b = P[k], P[(k + 1) % len(P)]
+            e = b - a
+            nrm = np.array([e[1], -e[0]]) / np.hypot(*e)
+            s = min(max(np.dot(x - a, e) / np.dot(e, e), 0.0), 1.0)
+            q = a + s * e
+            if best is None or np.hypot(*(x - q)) < best[0]:
+                best = (np.hypot(*(x - q)), q)
+            side = np.dot(x - a, nrm)
+            inside &= side <= 0.0
+            lines.append((side, nrm))
+        if inside:
+            side, n = max(lines, key=lambda t: t[0])
+            d = side - float(i["radius"])
+        else:
+            d, n = best[0] - float(i["radius"]), (x - best[1]) / best[0]
+        g = float(i["offset"]) - d
+        assert o["gap"][p] == pytest.approx(g, abs=1e-18)
+        f_t, xi, power, fN = np.zeros(2), np.zeros(2), 0.0, 0.0
+        if g > 0:
+            in_contact += 1
+            k_s = alpha * m / tau**2
+            vr = i["v"][p] - i["V"]
+            vn = np.dot(vr, n)
+            fN = max(k_s * g - beta * m * vn / tau, 0.0)
+            xi_p = i["xi_in"][p] - np.dot(i["xi_in"][p], n) * n
+            xi_star = xi_p + (vr - vn * n) * dt
+            f_star = -k_s * xi_star
+            Ts = min(max((i["T"][p] - i["T_room"]) / (i["T_melt"] - i["T_room"]), 0.0), 1.0)
+            limit = float(i["mu0"]) * (1.0 - Ts ** float(i["q"])) * fN
+            if np.hypot(*f_star) <= limit:
+                f_t, xi = f_star, xi_star
+            else:
+                slipping += 1
+                f_t = limit * f_star / np.hypot(*f_star)
+                xi = -f_t / k_s
+            power = np.hypot(*f_t) * max(np.hypot(*xi_star) - np.hypot(*xi), 0.0) / dt
+        f = fN * n + f_t if g > 0 else np.zeros(2)
+        total -= f
+        scale = max(abs(fN), 1e-30)
+        assert o["f_normal"][p] == pytest.approx(fN, rel=1e-12, abs=1e-12 * scale)
+        np.testing.assert_allclose(o["f_tangent"][p], f_t, rtol=1e-12, atol=1e-12 * scale)
+        np.testing.assert_allclose(o["xi"][p], xi, rtol=1e-12, atol=1e-22)
+        np.testing.assert_allclose(o["a"][p], f / m, rtol=1e-12, atol=1e-12 * scale / m)
+        assert o["friction_power"][p] == pytest.approx(power, rel=1e-9, abs=1e-12 * scale)
+    np.testing.assert_allclose(o["force_on_tool"], total, rtol=1e-12)
+    assert in_contact >= 5 and 0 < slipping < in_contact                 # the case exercises stick and slip
+
+
+def test_conduction_case_follows_format_md_alone():
+    """conduction recomputed pair by pair from FORMAT.md (Brookshaw's Laplacian with the Wendland C2 kernel)."""
+    i, o = _golden("conduction", "input"), _golden("conduction", "output")
+    h, lap = float(i["h"]), np.zeros(len(i["x"]))
+    for a, b in zip(i["I"], i["J"]):
+        r = np.hypot(*(i["x"][a] - i["x"][b]))
+        w = 2.0 * _wendland_dw_dr(r, h) / r
+        lap[a] += w * (i["T"][a] - i["T"][b]) * i["V"][b]
+        lap[b] += w * (i["T"][b] - i["T"][a]) * i["V"][a]
+    np.testing.assert_allclose(o["lap_T"], lap, rtol=1e-10, atol=1e-10 * np.abs(lap).max())
+    np.testing.assert_allclose(o["T_dot"], i["a"] * lap + i["source"], rtol=1e-10,
+                               atol=1e-10 * np.abs(o["T_dot"]).max())
+
+
+def test_surface_case_follows_format_md_alone():
+    """surface_notch recomputed from FORMAT.md: the moment matrix's smaller eigenvalue by a double loop and the
+    alpha-shape from scipy's Delaunay with circumradii from the triangles' sides (R = abc / (4 area))."""
+    from scipy.spatial import Delaunay
+    i, o = _golden("surface_notch", "input"), _golden("surface_notch", "output")
+    x, V, h, n = i["x"], i["V"], float(i["h"]), len(i["x"])
+    lam = np.zeros(n)
+    for a in range(n):
+        M = np.zeros((2, 2))
+        for b in range(n):
+            r = np.hypot(*(x[a] - x[b]))
+            if b != a and r < 2 * h:
+                xab = x[a] - x[b]
+                M -= V[b] * np.outer(xab, _wendland_dw_dr(r, h) / r * xab)
+        lam[a] = np.linalg.eigvalsh(0.5 * (M + M.T))[0]
+    np.testing.assert_allclose(o["lambda_min"], lam, rtol=1e-10, atol=1e-12)
+    np.testing.assert_array_equal(o["surface_sph"], (lam <= float(i["threshold"])).astype(np.int64))
+    edges: dict = {}
+    for t in Delaunay(x).simplices:
+        A, B, C = x[t]
+        sides = [np.hypot(*(B - C)), np.hypot(*(A - C)), np.hypot(*(A - B))]
+        area = 0.5 * abs((B - A)[0] * (C - A)[1] - (B - A)[1] * (C - A)[0])
+        if area == 0 or np.prod(sides) / (4 * area) > float(i["alpha"]) * float(i["dp"]):
+            continue
+        for e in ((t[0], t[1]), (t[1], t[2]), (t[0], t[2])):
+            edges[tuple(sorted(e))] = edges.get(tuple(sorted(e)), 0) + 1
+    mask = np.zeros(n, dtype=np.int64)
+    for e, c in edges.items():
+        if c == 1:
+            mask[list(e)] = 1
+    np.testing.assert_array_equal(o["surface_alpha"], mask)
+    assert 0 < mask.sum() < n and 0 < o["surface_sph"].sum() < n

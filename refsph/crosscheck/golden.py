@@ -656,7 +656,11 @@ SCENE_CONVENTIONS = dict(
     method="esph: ESPH (Eqs. (9)-(14), (20)-(24), the conventions of the esph_rates case), the tools' particles "
            "as SPH neighbours; tlsph: TLSPH (Eqs. (2), (16)-(24), the tlsph_* cases) with the contact of "
            "setup.numerics.contact between workpiece and tools: pinball (Eqs. (32)-(36), R = contact_k h, "
-           "contact_k null meaning R = dp / 2) or penalty (refsph/penalty.py, the tools' setup.rigid_bodies[].shape)",
+           "contact_k null meaning R = dp / 2) or penalty (the formulas of the penalty_friction case, golden/FORMAT.md "
+           "'penalty', against each tool's setup.rigid_bodies[].shape with shift = the centroid of its particles: "
+           "alpha = numerics.penalty_alpha, damping = numerics.penalty_damping, offset = dp / 2, time_scale = "
+           "courant h / c_L, mu(T) of setup.friction; the tangential history xi starts at 0 and is committed at the "
+           "end of each step from the step's last contact evaluation)",
     time_step="dt = courant h / (c_L + max_i |v_i|), c_L = sqrt((K + 4 G / 3) / rho0) (the CFL step, evaluated at "
               "the start of every step; a step is shortened to land on the next output time)",
     integrator="setup.numerics.integrator: predictor_corrector (y_1/2 = y + dt/2 f(y), y_1 = y + dt f(y_1/2)) or "

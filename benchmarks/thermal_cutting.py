@@ -94,7 +94,7 @@ def _s(case: int) -> float:
 
 
 STUDY_NAMES = ("cases", "coarse", "pfem", "detector", "scaling", "scatter", "resolution", "timestep", "tool",
-               "contact", "refupdate", "selfcontact", "gain", "frequency", "refined", "gap")
+               "contact", "refupdate", "selfcontact", "gain", "frequency", "refined", "gap", "conductivity")
 COURANT = 0.15                             # every run at dx <= t_u / 10: half the scene's step (module text)
 COARSE = " n_tu 5"                         # the key suffix of the 'coarse' study: all 18 cases at dx = t_u / 5
 PFEM = " pfem n_tu 5"                      # the key suffix of the 'pfem' study: the 18 cases with the PFEM at t_u / 5
@@ -129,6 +129,10 @@ GAP_CHANGES = ((" frictionless", dict(friction=False)),           # the 'gap' st
                (" no dissipation heat", dict(dissipation_heat=False)),
                (" friction without heat", dict(eta=0.0)))        # friction's mechanics without its heat
 WITHOUT_HEAT = GAP_CHANGES[2][0]                               # ... its key suffix, also run at t_u/10
+COND_KEY = " conductivity x"               # the 'conductivity' study (a sensitivity, not the paper's model): the
+CONDUCTIVITY = ((10, 2.0), (1, 0.6))       # workpiece's k of Table A1 times a factor ((case, factor): Ti6Al4V's k
+#                                            about doubles from room temperature to 1000 K, a carbon steel's falls by
+#                                            about 40 %; the paper holds the room-temperature value), at t_u/10 REFINED
 REFINED_NUMERICS = dict(ref_update_strain=REF_UPDATE, frequency_step=FREQUENCY_STEP)   # what 'refined' sets
 REFINED_RETRY = f" courant {COURANT:g}"      # a 'refined' case that failed: again at half the CFL part of its step
 RETRIES = {"": (RETRY,), PFEM10: (f" n_tu 10{BOSSAK}", DAMPED), REFINED: (REFINED_RETRY,)}
@@ -293,6 +297,10 @@ def more_jobs() -> list[tuple[str, str, dict, dict]]:
     # and the resolution check at REF_UPDATE (REFINED_NOISE), which took it from the scene's 0.5 before
     out += [("gap", f"case 10{COARSE}{REF_KEY}{REF_UPDATE:g} jitter {seed}",
              converged(10, n_tu=5.0, jitter=0.01, seed=seed), dict(ref_update_strain=REF_UPDATE)) for seed in (1, 2)]
+    # the rake face's sensitivity to the workpiece's conductivity (held at its room-temperature value by the paper):
+    # Ti6Al4V's k doubled, AISI 1045's at 0.6, each at the 'refined' numerics, read against its case's scatter there
+    out += [("conductivity", f"case {n}{REFINED}{COND_KEY}{f:g}", converged(n, conductivity_factor=f),
+             dict(REFINED_NUMERICS)) for n, f in CONDUCTIVITY]
     out += [("pfem", key, options, pfem) for key, options in time_rule_jobs() + remesh_jobs() + pfem_resolution_jobs()]
     # the PFEM's run-to-run scatter (case 2 at t_u/5, today's solver, unperturbed and with its nodes jittered by 0.01
     # of their spacing, three seeds), for the changes of the spacing study (pfem_spacing_convergence) to be read by
@@ -1517,6 +1525,8 @@ GAP_RUNS = tuple(k for group, singles in GAP_SINGLES for k in (group[0], *single
 SOLVER_CHANGES = tuple(k for n in PFEM5_RERUN_CASES for sfx, cases in ((PFEM, PFEM5_RERUN_CASES),
                                                                         (PFEM10, PFEM10_RERUN_CASES))
                        if n in cases for k in (f"case {n}{sfx}", f"case {n}{sfx}{RERUN}"))   # (record, rerun) pairs
+CONDUCTIVITY_RUNS = tuple(k for n, f in CONDUCTIVITY
+                          for k in (f"case {n}{REFINED}", f"case {n}{REFINED}{COND_KEY}{f:g}"))
 PFEM_GAP_RUNS = tuple(f"case {n}{PFEM10}{sfx}" for n in (1, 10) for sfx in ("", WITHOUT_HEAT))   # ... the PFEM's
 REFINED_SERIES = (("refsph SPH, t_u/10,\nref update 0.5,\ncourant 0.15", "", "D", "C1"),   # the figure's series
                   (f"refsph SPH, t_u/10,\nref update {REF_UPDATE:g},\nfrequency step", REFINED, "o", "C3"))
@@ -1593,6 +1603,12 @@ STUDIES = (
      "with each case's scatter at ref update 0.1 and t_u/5 (case 10's below, case 1's further down)", GAP_RUNS,
      BASIC + (("T_RF - T_FCS [K]", "gap", ".0f"), ("friction heat [% of work]", "friction_of_work", ".1f"),
               ("viscosity + damping heat [% of work]", "dissipation_of_work", ".1f"), ("CPU [min]", "cpu_min", ".1f"))),
+    ("The workpiece's conductivity (a sensitivity study, not the paper's model, which holds Table A1's "
+     "room-temperature k): case 10 with Ti6Al4V's k doubled (it about doubles by 1000 K) and case 1 with AISI 1045's "
+     "at 0.6 (a carbon steel's falls by about 40 %), each below its 'refined' run (t_u/10, ref update 0.1) and read "
+     "against its scatter there (the tables of the scatter at reference update 0.1)", CONDUCTIVITY_RUNS,
+     BASIC + (("T_RF - T_FCS [K]", "gap", ".0f"), ("friction heat [% of work]", "friction_of_work", ".1f"),
+              ("CPU [min]", "cpu_min", ".1f"))),
     ("The PFEM's run-to-run scatter (case 2 at t_u/5 with today's solver: unperturbed, and with the workpiece's "
      "nodes moved at random by up to 0.01 of their spacing, three seeds; the sweep's record 'case 2 pfem n_tu 5', "
      "made by an earlier solver, against their spread below them): what the t_u/5 changes (the solver's t_u/5 "
@@ -1936,9 +1952,9 @@ COMPARED = {SCATTER_S2: SCATTER_T5, REF_SCATTER: SCATTER_T5, SELF_SCATTER: SCATT
 SINGLES = {SCATTER_KEYS: ("case 1 s/2", "case 1 heat every 8"), SCATTER_TI10: ("case 10 s/2",),   # one run each
            PFEM_SCATTER: (f"case {PFEM_SCATTER_CASE}{PFEM}",), PFEM_SCATTER10: (f"case {PFEM_SCATTER_CASE}{PFEM10}",),
            SCATTER_TI10_REF: (f"case 10 n_tu 15{REFINED}", f"case 10{REFINED}{TO_CHIP}",
-                              f"case 10{REFINED}{WITHOUT_HEAT}"),
+                              f"case 10{REFINED}{WITHOUT_HEAT}", f"case 10{REFINED}{COND_KEY}2"),
            SCATTER_REF: (f"case 1 n_tu 15{REFINED}", f"case 1{REFINED}{TO_CHIP}", f"case 1{REFINED}{WITHOUT_HEAT}",
-                         f"case 1 s/2{REFINED}")}
+                         f"case 1 s/2{REFINED}", f"case 1{REFINED}{COND_KEY}0.6")}
 # the 'refupdate' study's single runs, each against the scatter group of its resolution and material (at the
 # scene's reference update, or at REF_UPDATE for case 1 at t_u/5): which changes the scatter does not explain
 REF_SINGLES = ((SCATTER_T5, tuple(f"case 1{COARSE}{REF_KEY}{r:g}" for r in REF_UPDATES if r > SCENE_REF_UPDATE)

@@ -42,6 +42,9 @@ The model, as in their Sections 2.1-2.4 and Tables 1-2, A1-A3 (``refsph.paper_da
   rho c = sqrt(s rho E), the same fraction of A in every case (beta1 sqrt(inertia_ratio E / A) h |grad v| / v_c).
 * **Cut length**: ``travel`` t_u (8 by default; the benchmark's sweep: 16 at dx = t_u / 10); steady-state means
   over the last quarter of the cut, with each quantity's drift over that quarter (:func:`drift`).
+* **Conductivity** (a sensitivity study, not the paper's model): ``conductivity_factor`` multiplies the workpiece's
+  k of Table A1 (a room-temperature value held constant, as the paper does), e.g. 2 for Ti6Al4V, whose conductivity
+  about doubles between room temperature and 1000 K.
 * **Perturbed runs**: ``jitter`` moves the workpiece's particles at random by up to that many dx (``seed``), for the
   run-to-run scatter.
 
@@ -109,6 +112,8 @@ OPTIONS = {
     "seed": (0, "the random seed of the jitter"),
     "friction": (True, "Coulomb friction mu(T) on the tool (false: frictionless)"),
     "conduction": (True, "heat conduction, frictional heat and losses (false: adiabatic, the first paper's model)"),
+    "conductivity_factor": (1.0, "the workpiece's conductivity times this (1: the paper's room-temperature k; a "
+                                 "sensitivity study: Ti6Al4V's k about doubles by 1000 K, a carbon steel's falls)"),
 }
 
 
@@ -188,12 +193,14 @@ def _default_dp(dim, quick):
 
 
 def _build(dim, dp, quick, *, case, material, vc, tu, n_tu, travel, length, mass_scale, inertia_ratio, detector,
-           chip_fraction, eta, friction, conduction, dissipation_heat, tool_length, tool_depth, jitter, seed):
+           chip_fraction, eta, friction, conduction, dissipation_heat, tool_length, tool_depth, jitter, seed,
+           conductivity_factor):
     if dim != 2:
         raise ValueError("the thermal cutting scene is 2D plane strain")
     row, material, vc, tu = _case_values(case, material, vc, tu)
     for name, v in (("vc", vc), ("tu", tu), ("travel", travel), ("length", length), ("n_tu", n_tu),
-                    ("inertia_ratio", inertia_ratio), ("tool_length", tool_length), ("tool_depth", tool_depth)):
+                    ("inertia_ratio", inertia_ratio), ("tool_length", tool_length), ("tool_depth", tool_depth),
+                    ("conductivity_factor", conductivity_factor)):
         if not (np.isfinite(v) and v > 0):
             raise ValueError(f"option {name} must be positive, got {v!r}")
     if not (np.isfinite(mass_scale) and mass_scale >= 0):
@@ -221,7 +228,7 @@ def _build(dim, dp, quick, *, case, material, vc, tu, n_tu, travel, length, mass
     heat_of_dissipation = False
     if parse_bool(conduction, "option conduction"):
         loss = SurfaceLoss(**RLA_SURFACE_LOSS, T_ambient=T0, detector=detector, alpha_radius=1.3 * dx, refresh=0.1)
-        thermal = Conduction(k=mat["k_W_mK"], courant=0.3,
+        thermal = Conduction(k=mat["k_W_mK"] * float(conductivity_factor), courant=0.3,
                              tools={TOOL_BODY: (tool_mat["k_W_mK"], tool_mat["cp_J_kgK"])},
                              fixed=tuple(int(k) for k in np.concatenate([held, work.n + np.flatnonzero(tool_held)])),
                              T_fixed=T0, loss=loss)
@@ -233,7 +240,7 @@ def _build(dim, dp, quick, *, case, material, vc, tu, n_tu, travel, length, mass
                 inertia_ratio=s * mat["rho"] * vc * vc / mat["A_Pa"], rake_deg=RAKE_DEG, clearance_deg=CLEARANCE_DEG,
                 edge_radius_m=EDGE_RADIUS, apex0=[nx * dx, y0], detector=detector, chip_fraction=float(chip_fraction),
                 eta=float(eta), A_Pa=mat["A_Pa"], tool_length_m=tool_length * tu, tool_depth_m=tool_depth * tu,
-                jitter=float(jitter), seed=int(seed), measured=row)
+                jitter=float(jitter), seed=int(seed), conductivity_factor=float(conductivity_factor), measured=row)
     body = RigidBody("tool", TOOL_BODY, (-vc, 0.0),
                      shape=tool_shape(tu, (nx * dx, y0), xt.mean(axis=0), tool_length, tool_depth))
     return Setup(state=concatenate_states(work, tool), material=ElasticMaterial(s * mat["rho"], mat["E_Pa"], mat["nu"]),

@@ -139,7 +139,7 @@ RETRIES = {"": (RETRY,), PFEM10: (f" n_tu 10{BOSSAK}", DAMPED), REFINED: (REFINE
 REDONE = {PFEM10: (RERUN,), PFEM: (RERUN,)}   # a table's case made again by today's solver (RERUN): taken before its
 #                                            record (refsph.teaching.plots.cut_record; PFEM*_RERUN_CASES)
 PFEM_OPTIONS = ("case", "n_tu", "travel", "length", "gamma", "remesh_when_needed", "bossak", "eta", "jitter",
-                "seed")  # the PFEM cut's options a key may set (the rest are the scene's SPH options)
+                "seed", "conductivity_factor")   # the PFEM cut's options a key may set (the rest: the SPH scene's)
 REMESH = " remesh when needed"              # the key suffix of a PFEM cut that remeshes only where the quality asks
 PAPER_CUT = (1.5e-3, 2.0e-3)   # m of tool travel: the last quarter of the paper's PFEM cut, 2/3 of its 3 mm workpiece
 TO_CHIP = " all friction heat to the chip"   # key suffix: chip_fraction 1 (the paper's SPH code's choice; scene 0.5)
@@ -301,6 +301,8 @@ def more_jobs() -> list[tuple[str, str, dict, dict]]:
     # Ti6Al4V's k doubled, AISI 1045's at 0.6, each at the 'refined' numerics, read against its case's scatter there
     out += [("conductivity", f"case {n}{REFINED}{COND_KEY}{f:g}", converged(n, conductivity_factor=f),
              dict(REFINED_NUMERICS)) for n, f in CONDUCTIVITY]
+    out += [("conductivity", f"case {n}{PFEM10}{COND_KEY}{f:g}", converged(n, n_tu=10.0, conductivity_factor=f), pfem)
+            for n, f in CONDUCTIVITY]                       # ... and the same in the PFEM, at t_u/10
     out += [("pfem", key, options, pfem) for key, options in time_rule_jobs() + remesh_jobs() + pfem_resolution_jobs()]
     # the PFEM's run-to-run scatter (case 2 at t_u/5, today's solver, unperturbed and with its nodes jittered by 0.01
     # of their spacing, three seeds), for the changes of the spacing study (pfem_spacing_convergence) to be read by
@@ -1525,8 +1527,8 @@ GAP_RUNS = tuple(k for group, singles in GAP_SINGLES for k in (group[0], *single
 SOLVER_CHANGES = tuple(k for n in PFEM5_RERUN_CASES for sfx, cases in ((PFEM, PFEM5_RERUN_CASES),
                                                                         (PFEM10, PFEM10_RERUN_CASES))
                        if n in cases for k in (f"case {n}{sfx}", f"case {n}{sfx}{RERUN}"))   # (record, rerun) pairs
-CONDUCTIVITY_RUNS = tuple(k for n, f in CONDUCTIVITY
-                          for k in (f"case {n}{REFINED}", f"case {n}{REFINED}{COND_KEY}{f:g}"))
+CONDUCTIVITY_RUNS = tuple(k for sfx in (REFINED, PFEM10) for n, f in CONDUCTIVITY
+                          for k in (f"case {n}{sfx}", f"case {n}{sfx}{COND_KEY}{f:g}"))
 PFEM_GAP_RUNS = tuple(f"case {n}{PFEM10}{sfx}" for n in (1, 10) for sfx in ("", WITHOUT_HEAT))   # ... the PFEM's
 REFINED_SERIES = (("refsph SPH, t_u/10,\nref update 0.5,\ncourant 0.15", "", "D", "C1"),   # the figure's series
                   (f"refsph SPH, t_u/10,\nref update {REF_UPDATE:g},\nfrequency step", REFINED, "o", "C3"))
@@ -1606,7 +1608,8 @@ STUDIES = (
     ("The workpiece's conductivity (a sensitivity study, not the paper's model, which holds Table A1's "
      "room-temperature k): case 10 with Ti6Al4V's k doubled (it about doubles by 1000 K) and case 1 with AISI 1045's "
      "at 0.6 (a carbon steel's falls by about 40 %), each below its 'refined' run (t_u/10, ref update 0.1) and read "
-     "against its scatter there (the tables of the scatter at reference update 0.1)", CONDUCTIVITY_RUNS,
+     "against its scatter there (the tables of the scatter at reference update 0.1); then the same in the PFEM at "
+     "t_u/10, each below the 18-case table's run", CONDUCTIVITY_RUNS,
      BASIC + (("T_RF - T_FCS [K]", "gap", ".0f"), ("friction heat [% of work]", "friction_of_work", ".1f"),
               ("CPU [min]", "cpu_min", ".1f"))),
     ("The PFEM's run-to-run scatter (case 2 at t_u/5 with today's solver: unperturbed, and with the workpiece's "
@@ -1950,7 +1953,9 @@ COMPARED = {SCATTER_S2: SCATTER_T5, REF_SCATTER: SCATTER_T5, SELF_SCATTER: SCATT
             SCATTER_TI10_REF: SCATTER_TI10, SCATTER_TI10_REF_S2: SCATTER_TI10_REF, SCATTER_REF: SCATTER_KEYS,
             PFEM_SCATTER10: PFEM_SCATTER}
 SINGLES = {SCATTER_KEYS: ("case 1 s/2", "case 1 heat every 8"), SCATTER_TI10: ("case 10 s/2",),   # one run each
-           PFEM_SCATTER: (f"case {PFEM_SCATTER_CASE}{PFEM}",), PFEM_SCATTER10: (f"case {PFEM_SCATTER_CASE}{PFEM10}",),
+           PFEM_SCATTER: (f"case {PFEM_SCATTER_CASE}{PFEM}",),
+           PFEM_SCATTER10: (f"case {PFEM_SCATTER_CASE}{PFEM10}", f"case 1{PFEM10}{COND_KEY}0.6"),
+           PFEM_SCATTER10_TI: (f"case 10{PFEM10}{COND_KEY}2",),
            SCATTER_TI10_REF: (f"case 10 n_tu 15{REFINED}", f"case 10{REFINED}{TO_CHIP}",
                               f"case 10{REFINED}{WITHOUT_HEAT}", f"case 10{REFINED}{COND_KEY}2"),
            SCATTER_REF: (f"case 1 n_tu 15{REFINED}", f"case 1{REFINED}{TO_CHIP}", f"case 1{REFINED}{WITHOUT_HEAT}",

@@ -254,3 +254,26 @@ def test_side_by_side_table_names_the_method_and_the_measurement_of_a_case0_run(
         assert cells[9] == "0.79" and cells[11] == "668" and cells[13] == "647"
     assert lines[1].split()[-3:-1] == ["25.0", "0.80"] and lines[2].split()[-3] == "20.0"
     assert lines[3].split()[0] == "0" and lines[3].split()[9] == "-" and "*: case 0" in lines[-1]
+
+
+def test_conductivity_factor_scales_the_workpiece_s_k_only():
+    """Option conductivity_factor (a sensitivity study): the workpiece's k of Table A1 times the factor in both
+    methods' heat models, the tool's k unchanged, the factor in scene_info / info; refused unless positive."""
+    from refsph.pfem.cutting import pfem_cut
+    from refsph.scenes.thermal_cutting import MATERIALS
+    from refsph.simulate import build
+    k = MATERIALS["Ti6Al4V"]["k_W_mK"]
+    opts = dict(case=10, length=0.6e-3, travel=1.0)
+    base = build("thermal_cutting", "tlsph", quick=True, options=opts).setup
+    b = build("thermal_cutting", "tlsph", quick=True, options=dict(opts, conductivity_factor=2.0)).setup
+    assert base.thermal.k == k and b.thermal.k == pytest.approx(2 * k)
+    assert b.thermal.tools == base.thermal.tools and b.info["conductivity_factor"] == 2.0
+    with pytest.raises(ValueError, match="conductivity_factor"):
+        build("thermal_cutting", "tlsph", quick=True, options=dict(opts, conductivity_factor=0.0))
+    cut = pfem_cut(10, n_tu=3.0, travel=1.0, length=0.6e-3, conductivity_factor=2.0)
+    plain = pfem_cut(10, n_tu=3.0, travel=1.0, length=0.6e-3)
+    assert cut.heat.k_work == pytest.approx(2 * k) and plain.heat.k_work == k
+    assert cut.heat.k_tool == plain.heat.k_tool and cut.info["conductivity_factor"] == 2.0
+    assert "conductivity_factor" not in plain.info
+    with pytest.raises(ValueError, match="conductivity_factor"):
+        pfem_cut(10, n_tu=3.0, travel=1.0, length=0.6e-3, conductivity_factor=-1.0)

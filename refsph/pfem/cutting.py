@@ -227,7 +227,8 @@ def pfem_cut(case: int, n_tu: float = 10.0, travel: float = 16.0, length: float 
              conduction: bool = True, chip_fraction: float = 0.5, refine: bool = True, r_min: float = 0.5,
              a_max: float = 2.5, gamma: float = 0.5, edge_nodes: bool = False,
              remesh_when_needed: bool = False, bossak: float = 0.0, edge_radius: float = EDGE_RADIUS,
-             eta: float = CONTACT_RLA["friction_work_to_heat"], jitter: float = 0.0, seed: int = 0) -> PFEMCut:
+             eta: float = CONTACT_RLA["friction_work_to_heat"], jitter: float = 0.0, seed: int = 0,
+             conductivity_factor: float = 1.0) -> PFEMCut:
     """The cut of row ``case`` of the paper's Appendix B: dx = t_u / n_tu, ``travel`` t_u of cut on a workpiece
     ``length`` [m] long (default (travel + 12) t_u), dt = courant dx / v_c, contact penalties ``penalty`` G / dx;
     ``conduction``: the heat step (module text; False: adiabatic), ``chip_fraction`` of the frictional heat into
@@ -243,7 +244,9 @@ def pfem_cut(case: int, n_tu: float = 10.0, travel: float = 16.0, length: float 
     ``eta``: the fraction of the frictional work that becomes heat (Eq. (7); the paper's 1; 0 keeps friction's
     mechanics without its heat); ``jitter``: each coordinate of the workpiece's free nodes moved at random by up to
     that many of their spacings (:func:`refsph.scenes.measure.jittered`, seed ``seed``): a perturbed run, for the
-    run-to-run scatter (on the square lattice, Delaunay's choice of diagonal, and so the path, turns on rounding)."""
+    run-to-run scatter (on the square lattice, Delaunay's choice of diagonal, and so the path, turns on rounding);
+    ``conductivity_factor``: the workpiece's k of Table A1 times this (1: the paper's; a sensitivity study, as the
+    SPH scene's option of that name)."""
     row = rla_cutting_case(int(case))
     mat = MATERIALS[row["material"]]
     vc, tu = row["vc_m_per_min"] / 60.0, row["tu_mm"] * 1e-3
@@ -251,6 +254,8 @@ def pfem_cut(case: int, n_tu: float = 10.0, travel: float = 16.0, length: float 
     length = (travel + 12.0) * tu if length is None else length
     _check_cut(n_tu=n_tu, travel=travel, length=length, tu=tu, courant=courant, penalty=penalty,
                chip_fraction=chip_fraction, eta=eta, gamma=gamma, bossak=bossak)
+    if not (np.isfinite(conductivity_factor) and conductivity_factor > 0):
+        raise ValueError(f"PFEM cut: conductivity_factor must be positive, got {conductivity_factor!r}")
     newmark = (Newmark.bossak(bossak) if bossak != 0.0 else TRAPEZOIDAL if gamma == 0.5      # raise out of range
                else Newmark((gamma + 0.5) ** 2 / 4.0, gamma))
     x, h = graded_workpiece(length, tu, dx)
@@ -280,7 +285,7 @@ def pfem_cut(case: int, n_tu: float = 10.0, travel: float = 16.0, length: float 
         tool = TOOL_CARBIDE_RLA
         tmesh = alpha_shape_mesh(xt, 1.4, np.full(len(xt), dx))
         tool_mc = tool["rho"] * tool["cp_J_kgK"] * tributary_areas(xt, tmesh.tri, len(xt))
-        k_w, k_t = mat["k_W_mK"], tool["k_W_mK"]
+        k_w, k_t = mat["k_W_mK"] * float(conductivity_factor), tool["k_W_mK"]
         heat = CutHeat(k_work=k_w, cp_work=mat["cp_J_kgK"], x_tool=xt, tool_tri=tmesh.tri, k_tool=k_t,
                        tool_mc=tool_mc, tool_fixed=np.flatnonzero(tool_held),
                        tool_edges=tmesh.edges[~np.isin(tmesh.edges, np.flatnonzero(tool_held)).all(axis=1)],
@@ -295,7 +300,8 @@ def pfem_cut(case: int, n_tu: float = 10.0, travel: float = 16.0, length: float 
                 h_int=None if heat is None else heat.h_int, refine=bool(refine), r_min=r_min, a_max=a_max,
                 newmark_gamma=float(newmark.gamma), edge_nodes=bool(edge_nodes),
                 remesh_when_needed=bool(remesh_when_needed), eta=float(eta), jitter=float(jitter), seed=int(seed),
-                **({"newmark_alpha_B": float(bossak)} if bossak else {}))
+                **({"newmark_alpha_B": float(bossak)} if bossak else {}),
+                **({"conductivity_factor": float(conductivity_factor)} if conductivity_factor != 1.0 else {}))
     return PFEMCut(nodes=nodes, h=h, fixed=fixed, law=law, shape=shape, shift0=centroid, v_tool=np.array([-vc, 0.0]),
                    contact=contact, alpha=alpha, dt=courant * dx / vc, t_end=travel * tu / vc, X0=x.copy(), info=info,
                    heat=heat, node_rule=NodeRule(r_min=r_min, a_max=a_max) if refine else None, newmark=newmark,

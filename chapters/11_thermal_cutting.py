@@ -441,7 +441,7 @@ display(Markdown(slopes.split("\n\nWhich part of the thrust")[0]))      # the ta
 #   $\eta = 0$ is a diagnostic, not a model; it says that the measured low-speed cuts leave little room for heat
 #   made at the interface, where Coulomb friction at $\mu(T)$ makes 11–15 % of the tool's work. Case 1 at $t_u/10$
 #   splits alike: $\eta = 0$ takes its rake face from 799 ± 6 K (three runs) to 678 K (measured 668 K). So does
-#   the PFEM (chapter 12; `--option eta=0`): 814 → 698 K in case 1, 1006 → 793 K in case 10.
+#   the PFEM (chapter 12; `--option eta=0`): 816 → 698 K in case 1, 1006 → 793 K in case 10.
 #
 # %% [markdown]
 # * **Which side of the face?** A rake face belongs to the tool, and $T_{RF}$ here is the chip's contact layer,

@@ -205,7 +205,8 @@ def test_the_dissipation_heat_is_split_into_contact_damping_and_viscosity(short_
 def test_the_contact_damping_heat_is_the_time_integral_of_its_power(monkeypatch, every):
     """summary.heat_dissipation.contact_damping_J = sum over the steps of dt x the contact's damping power (summed over
     the particles) at the step's last force evaluation (the scene's leapfrog evaluates the forces once a step, at its
-    end, and twice in the first; the last evaluation's rates make the step's heat), integrated here from the contact's
+    end, and twice in the first, before any contact; the last evaluation's rates make the step's heat; so this checks
+    dt, the sum and the kept heat's bookkeeping, not which evaluation), integrated here from the contact's
     own results: recorded at every evaluation of the tool contact
     (PenaltyCoupling.with_tools) and cut into steps by a hook. With the heat step every 3 mechanical steps the
     ledger books the kept heat when it is applied, so the steps after the last heat step are left out."""
@@ -274,6 +275,13 @@ def test_conductivity_factor_scales_the_workpiece_s_k_only():
     plain = pfem_cut(10, n_tu=3.0, travel=1.0, length=0.6e-3)
     assert cut.heat.k_work == pytest.approx(2 * k) and plain.heat.k_work == k
     assert cut.heat.k_tool == plain.heat.k_tool and cut.info["conductivity_factor"] == 2.0
+    k_t = cut.heat.k_tool                                  # the chip-tool conductance follows the workpiece's k
+    assert cut.heat.h_int / plain.heat.h_int == pytest.approx((2 * k / (2 * k + k_t)) / (k / (k + k_t)))
     assert "conductivity_factor" not in plain.info
     with pytest.raises(ValueError, match="conductivity_factor"):
         pfem_cut(10, n_tu=3.0, travel=1.0, length=0.6e-3, conductivity_factor=-1.0)
+    for bad in (lambda: pfem_cut(10, n_tu=3.0, travel=1.0, length=0.6e-3, conduction=False, conductivity_factor=2.0),
+                lambda: build("thermal_cutting", "tlsph", quick=True,
+                              options=dict(opts, conduction=False, conductivity_factor=2.0))):
+        with pytest.raises(ValueError, match="conductivity_factor"):
+            bad()

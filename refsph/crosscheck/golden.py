@@ -659,8 +659,11 @@ SCENE_CONVENTIONS = dict(
            "contact_k null meaning R = dp / 2) or penalty (the formulas of the penalty_friction case, golden/FORMAT.md "
            "'penalty', against each tool's setup.rigid_bodies[].shape with shift = the centroid of its particles: "
            "alpha = numerics.penalty_alpha, damping = numerics.penalty_damping, offset = dp / 2, time_scale = "
-           "courant h / c_L, mu(T) of setup.friction; the tangential history xi starts at 0 and is committed at the "
-           "end of each step from the step's last contact evaluation)",
+           "courant h / c_L, mu(T) of setup.friction (null: frictionless); every contact evaluation of a step takes "
+           "the whole step's dt in xi* = xi + v_t dt and starts from the same committed xi, which starts at 0 and is "
+           "committed at the end of each step from the step's last evaluation (the leapfrog's, at the step's end "
+           "with the half-step velocity); the friction power heats the sliding particle and the tool row nearest it, "
+           "and with dissipation_heat the damping power heats the particle)",
     time_step="dt = courant h / (c_L + max_i |v_i|), c_L = sqrt((K + 4 G / 3) / rho0) (the CFL step, evaluated at "
               "the start of every step; a step is shortened to land on the next output time)",
     integrator="setup.numerics.integrator: predictor_corrector (y_1/2 = y + dt/2 f(y), y_1 = y + dt f(y_1/2)) or "

@@ -245,8 +245,9 @@ def pfem_cut(case: int, n_tu: float = 10.0, travel: float = 16.0, length: float 
     mechanics without its heat); ``jitter``: each coordinate of the workpiece's free nodes moved at random by up to
     that many of their spacings (:func:`refsph.scenes.measure.jittered`, seed ``seed``): a perturbed run, for the
     run-to-run scatter (on the square lattice, Delaunay's choice of diagonal, and so the path, turns on rounding);
-    ``conductivity_factor``: the workpiece's k of Table A1 times this (1: the paper's; a sensitivity study, as the
-    SPH scene's option of that name)."""
+    ``conductivity_factor``: the workpiece's k of Table A1 times this, and with it the chip-tool conductance
+    2 k_w k_t / ((k_w + k_t) dx) (1: the paper's; a sensitivity study, as the SPH scene's option of that name;
+    refused without conduction)."""
     row = rla_cutting_case(int(case))
     mat = MATERIALS[row["material"]]
     vc, tu = row["vc_m_per_min"] / 60.0, row["tu_mm"] * 1e-3
@@ -256,6 +257,8 @@ def pfem_cut(case: int, n_tu: float = 10.0, travel: float = 16.0, length: float 
                chip_fraction=chip_fraction, eta=eta, gamma=gamma, bossak=bossak)
     if not (np.isfinite(conductivity_factor) and conductivity_factor > 0):
         raise ValueError(f"PFEM cut: conductivity_factor must be positive, got {conductivity_factor!r}")
+    if conductivity_factor != 1.0 and not conduction:
+        raise ValueError("PFEM cut: conductivity_factor acts on the heat step; without conduction it would do nothing")
     newmark = (Newmark.bossak(bossak) if bossak != 0.0 else TRAPEZOIDAL if gamma == 0.5      # raise out of range
                else Newmark((gamma + 0.5) ** 2 / 4.0, gamma))
     x, h = graded_workpiece(length, tu, dx)

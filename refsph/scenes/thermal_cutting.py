@@ -203,6 +203,9 @@ def _build(dim, dp, quick, *, case, material, vc, tu, n_tu, travel, length, mass
                     ("conductivity_factor", conductivity_factor)):
         if not (np.isfinite(v) and v > 0):
             raise ValueError(f"option {name} must be positive, got {v!r}")
+    if float(conductivity_factor) != 1.0 and not parse_bool(conduction, "option conduction"):
+        raise ValueError("option conductivity_factor acts on the heat conduction; with conduction=false it would do "
+                         "nothing")
     if not (np.isfinite(mass_scale) and mass_scale >= 0):
         raise ValueError(f"option mass_scale must be >= 0 (0: chosen from inertia_ratio), got {mass_scale!r}")
     mat = MATERIALS[material]

@@ -303,6 +303,11 @@ def more_jobs() -> list[tuple[str, str, dict, dict]]:
              dict(REFINED_NUMERICS)) for n, f in CONDUCTIVITY]
     out += [("conductivity", f"case {n}{PFEM10}{COND_KEY}{f:g}", converged(n, n_tu=10.0, conductivity_factor=f), pfem)
             for n, f in CONDUCTIVITY]                       # ... and the same in the PFEM, at t_u/10
+    # case 1's x0.6 stalled at 1.56 of 1.6 ms with the trapezoidal rule (the late ringing of cases 8, 9, 12, 14, 16):
+    # the pair again with the Bossak rule, so that the change is read between two runs of one time rule
+    out += [("conductivity", f"case 1{PFEM10}{sfx}{BOSSAK}",
+             dict(converged(1, n_tu=10.0, **more), bossak=BOSSAK_ALPHA), pfem)
+            for sfx, more in ((" n_tu 10", {}), (f"{COND_KEY}0.6", dict(conductivity_factor=0.6)))]
     out += [("pfem", key, options, pfem) for key, options in time_rule_jobs() + remesh_jobs() + pfem_resolution_jobs()]
     # the PFEM's run-to-run scatter (case 2 at t_u/5, today's solver, unperturbed and with its nodes jittered by 0.01
     # of their spacing, three seeds), for the changes of the spacing study (pfem_spacing_convergence) to be read by
@@ -1538,6 +1543,7 @@ def pfem10_base(n: int) -> str:
 CONDUCTIVITY_RUNS = tuple(k for n, f in CONDUCTIVITY
                           for k in (f"case {n}{REFINED}", f"case {n}{REFINED}{COND_KEY}{f:g}"))
 CONDUCTIVITY_RUNS += tuple(k for n, f in CONDUCTIVITY for k in (pfem10_base(n), f"case {n}{PFEM10}{COND_KEY}{f:g}"))
+CONDUCTIVITY_RUNS += (f"case 1{PFEM10} n_tu 10{BOSSAK}", f"case 1{PFEM10}{COND_KEY}0.6{BOSSAK}")   # its retry pair
 PFEM_GAP_RUNS = tuple(k for n in (1, 10) for k in (pfem10_base(n), f"case {n}{PFEM10}{WITHOUT_HEAT}"))   # the PFEM's
 REFINED_SERIES = (("refsph SPH, t_u/10,\nref update 0.5,\ncourant 0.15", "", "D", "C1"),   # the figure's series
                   (f"refsph SPH, t_u/10,\nref update {REF_UPDATE:g},\nfrequency step", REFINED, "o", "C3"))

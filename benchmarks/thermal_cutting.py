@@ -297,17 +297,7 @@ def more_jobs() -> list[tuple[str, str, dict, dict]]:
     # and the resolution check at REF_UPDATE (REFINED_NOISE), which took it from the scene's 0.5 before
     out += [("gap", f"case 10{COARSE}{REF_KEY}{REF_UPDATE:g} jitter {seed}",
              converged(10, n_tu=5.0, jitter=0.01, seed=seed), dict(ref_update_strain=REF_UPDATE)) for seed in (1, 2)]
-    # the rake face's sensitivity to the workpiece's conductivity (held at its room-temperature value by the paper):
-    # Ti6Al4V's k doubled, AISI 1045's at 0.6, each at the 'refined' numerics, read against its case's scatter there
-    out += [("conductivity", f"case {n}{REFINED}{COND_KEY}{f:g}", converged(n, conductivity_factor=f),
-             dict(REFINED_NUMERICS)) for n, f in CONDUCTIVITY]
-    out += [("conductivity", f"case {n}{PFEM10}{COND_KEY}{f:g}", converged(n, n_tu=10.0, conductivity_factor=f), pfem)
-            for n, f in CONDUCTIVITY]                       # ... and the same in the PFEM, at t_u/10
-    # case 1's x0.6 stalled at 1.56 of 1.6 ms with the trapezoidal rule (the late ringing of cases 8, 9, 12, 14, 16):
-    # the pair again with the Bossak rule, so that the change is read between two runs of one time rule
-    out += [("conductivity", f"case 1{PFEM10}{sfx}{BOSSAK}",
-             dict(converged(1, n_tu=10.0, **more), bossak=BOSSAK_ALPHA), pfem)
-            for sfx, more in ((" n_tu 10", {}), (f"{COND_KEY}0.6", dict(conductivity_factor=0.6)))]
+    out += [("conductivity", key, options, numerics) for key, (options, numerics) in conductivity_jobs().items()]
     out += [("pfem", key, options, pfem) for key, options in time_rule_jobs() + remesh_jobs() + pfem_resolution_jobs()]
     # the PFEM's run-to-run scatter (case 2 at t_u/5, today's solver, unperturbed and with its nodes jittered by 0.01
     # of their spacing, three seeds), for the changes of the spacing study (pfem_spacing_convergence) to be read by
@@ -326,6 +316,22 @@ def more_jobs() -> list[tuple[str, str, dict, dict]]:
     out += [("pfem", f"case {n}{PFEM10}{RERUN}", converged(n, n_tu=10.0), pfem) for n in PFEM10_RERUN_CASES]
     out += [("pfem", f"case {n}{PFEM10}{TO_2MM}", to_2mm(n, n_tu=10.0), pfem) for n in TU_01]
     return out + [("cases", f"case {n}{TO_2MM}", to_2mm(n), sweep_numerics()) for n in TU_01]
+
+
+def conductivity_jobs() -> dict:
+    """{key: (options, numerics)} of the 'conductivity' study: the rake face's sensitivity to the workpiece's
+    conductivity (held at its room-temperature value by the paper): Ti6Al4V's k doubled, AISI 1045's at 0.6, each at
+    the 'refined' numerics, read against its case's scatter there; the same in the PFEM at t_u/10; and, as case 1's
+    x0.6 stalled at 1.56 of 1.6 ms with the trapezoidal rule (the late ringing of cases 8, 9, 12, 14, 16), the PFEM's
+    pair again with the Bossak rule, so that the change is read between two runs of one time rule."""
+    out = {f"case {n}{REFINED}{COND_KEY}{f:g}": (converged(n, conductivity_factor=f), dict(REFINED_NUMERICS))
+           for n, f in CONDUCTIVITY}
+    out.update({f"case {n}{PFEM10}{COND_KEY}{f:g}": (converged(n, n_tu=10.0, conductivity_factor=f),
+                                                     dict(method="pfem")) for n, f in CONDUCTIVITY})
+    for sfx, more in ((" n_tu 10", {}), (f"{COND_KEY}0.6", dict(conductivity_factor=0.6))):
+        out[f"case 1{PFEM10}{sfx}{BOSSAK}"] = (dict(converged(1, n_tu=10.0, **more), bossak=BOSSAK_ALPHA),
+                                               dict(method="pfem"))
+    return out
 
 
 def reference_update_jobs() -> dict:

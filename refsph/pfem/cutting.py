@@ -209,8 +209,13 @@ def graded_workpiece(length: float, tu: float, dx: float) -> tuple[np.ndarray, n
     return x, h
 
 
-def _check_cut(*, n_tu, travel, length, tu, courant, penalty, chip_fraction, eta, gamma, bossak) -> None:
+def _check_cut(*, n_tu, travel, length, tu, courant, penalty, chip_fraction, eta, gamma, bossak,
+               conductivity_factor=1.0, conduction=True) -> None:
     """ValueError naming what :func:`pfem_cut` cannot take."""
+    if not (np.isfinite(conductivity_factor) and conductivity_factor > 0):
+        raise ValueError(f"PFEM cut: conductivity_factor must be positive, got {conductivity_factor!r}")
+    if conductivity_factor != 1.0 and not conduction:
+        raise ValueError("PFEM cut: conductivity_factor acts on the heat step; without conduction it would do nothing")
     if not (n_tu >= 2 and travel > 0 and length > 1.25 * travel * tu and courant > 0 and penalty > 0
             and 0.0 <= chip_fraction <= 1.0 and 0.0 <= eta <= 1.0):
         raise ValueError(f"PFEM cut: need n_tu >= 2, travel > 0, a cut within 80 % of the workpiece, courant > 0, "
@@ -220,6 +225,23 @@ def _check_cut(*, n_tu, travel, length, tu, courant, penalty, chip_fraction, eta
     if bossak != 0.0 and gamma != 0.5:
         raise ValueError(f"PFEM cut: give gamma (damped Newmark) or bossak (Bossak-Newmark), not both; got gamma = "
                          f"{gamma!r}, bossak = {bossak!r}")
+
+
+def _cut_heat(k_w: float, cp_w: float, xt: np.ndarray, tool_held: np.ndarray, dx: float, T0: float,
+              chip_fraction: float, eta: float) -> CutHeat:
+    """The heat step's model of a cut (:class:`CutHeat`): the workpiece's k_w and c_p, the tool meshed by its
+    alpha-shape (the paper's carbide, its held rows at T0), the chip-tool conductance of perfect contact
+    2 k_w k_t / ((k_w + k_t) dx), the losses on the free edges, the frictional heat's split and eta."""
+    tool = TOOL_CARBIDE_RLA
+    tmesh = alpha_shape_mesh(xt, 1.4, np.full(len(xt), dx))
+    tool_mc = tool["rho"] * tool["cp_J_kgK"] * tributary_areas(xt, tmesh.tri, len(xt))
+    k_t = tool["k_W_mK"]
+    return CutHeat(k_work=k_w, cp_work=cp_w, x_tool=xt, tool_tri=tmesh.tri, k_tool=k_t, tool_mc=tool_mc,
+                   tool_fixed=np.flatnonzero(tool_held),
+                   tool_edges=tmesh.edges[~np.isin(tmesh.edges, np.flatnonzero(tool_held)).all(axis=1)],
+                   T_fixed=T0, h_int=2.0 * k_w * k_t / (k_w + k_t) / dx,
+                   loss=SurfaceLoss(**RLA_SURFACE_LOSS, T_ambient=T0), chip_fraction=float(chip_fraction),
+                   eta=float(eta))
 
 
 def pfem_cut(case: int, n_tu: float = 10.0, travel: float = 16.0, length: float | None = None,
@@ -245,20 +267,16 @@ def pfem_cut(case: int, n_tu: float = 10.0, travel: float = 16.0, length: float 
     mechanics without its heat); ``jitter``: each coordinate of the workpiece's free nodes moved at random by up to
     that many of their spacings (:func:`refsph.scenes.measure.jittered`, seed ``seed``): a perturbed run, for the
     run-to-run scatter (on the square lattice, Delaunay's choice of diagonal, and so the path, turns on rounding);
-    ``conductivity_factor``: the workpiece's k of Table A1 times this, and with it the chip-tool conductance
-    2 k_w k_t / ((k_w + k_t) dx) (1: the paper's; a sensitivity study, as the SPH scene's option of that name;
-    refused without conduction)."""
+    ``conductivity_factor``: the workpiece's k of Table A1 times this, the chip-tool conductance with it (1: the
+    paper's; a sensitivity study, as the SPH scene's option)."""
     row = rla_cutting_case(int(case))
     mat = MATERIALS[row["material"]]
     vc, tu = row["vc_m_per_min"] / 60.0, row["tu_mm"] * 1e-3
     dx = tu / n_tu
     length = (travel + 12.0) * tu if length is None else length
     _check_cut(n_tu=n_tu, travel=travel, length=length, tu=tu, courant=courant, penalty=penalty,
-               chip_fraction=chip_fraction, eta=eta, gamma=gamma, bossak=bossak)
-    if not (np.isfinite(conductivity_factor) and conductivity_factor > 0):
-        raise ValueError(f"PFEM cut: conductivity_factor must be positive, got {conductivity_factor!r}")
-    if conductivity_factor != 1.0 and not conduction:
-        raise ValueError("PFEM cut: conductivity_factor acts on the heat step; without conduction it would do nothing")
+               chip_fraction=chip_fraction, eta=eta, gamma=gamma, bossak=bossak,
+               conductivity_factor=conductivity_factor, conduction=conduction)
     newmark = (Newmark.bossak(bossak) if bossak != 0.0 else TRAPEZOIDAL if gamma == 0.5      # raise out of range
                else Newmark((gamma + 0.5) ** 2 / 4.0, gamma))
     x, h = graded_workpiece(length, tu, dx)
@@ -283,18 +301,8 @@ def pfem_cut(case: int, n_tu: float = 10.0, travel: float = 16.0, length: float 
     contact = ToolContact(k_normal=penalty * law.G / dx, k_tangent=penalty * law.G / dx, friction=mu)
     A_cell = np.where(h > dx * 1.5, 4 * dx * dx, dx * dx)
     nodes = make_nodes(x, mat["rho"] * A_cell, T0)
-    heat = None
-    if conduction:
-        tool = TOOL_CARBIDE_RLA
-        tmesh = alpha_shape_mesh(xt, 1.4, np.full(len(xt), dx))
-        tool_mc = tool["rho"] * tool["cp_J_kgK"] * tributary_areas(xt, tmesh.tri, len(xt))
-        k_w, k_t = mat["k_W_mK"] * float(conductivity_factor), tool["k_W_mK"]
-        heat = CutHeat(k_work=k_w, cp_work=mat["cp_J_kgK"], x_tool=xt, tool_tri=tmesh.tri, k_tool=k_t,
-                       tool_mc=tool_mc, tool_fixed=np.flatnonzero(tool_held),
-                       tool_edges=tmesh.edges[~np.isin(tmesh.edges, np.flatnonzero(tool_held)).all(axis=1)],
-                       T_fixed=T0, h_int=2.0 * k_w * k_t / (k_w + k_t) / dx,
-                       loss=SurfaceLoss(**RLA_SURFACE_LOSS, T_ambient=T0), chip_fraction=float(chip_fraction),
-                       eta=float(eta))
+    heat = _cut_heat(mat["k_W_mK"] * float(conductivity_factor), mat["cp_J_kgK"], xt, tool_held, dx, T0,
+                     chip_fraction, eta) if conduction else None
     info = dict(case=int(case), material=row["material"], vc_m_s=vc, tu_m=tu, dx=dx, length_m=x_end,
                 height_m=H, y0=y0, n_work=len(x), n_tool=len(xt), travel_m=travel * tu, mass_scale=1.0,
                 inertia_ratio=mat["rho"] * vc * vc / mat["A_Pa"], rake_deg=RAKE_DEG, clearance_deg=CLEARANCE_DEG,

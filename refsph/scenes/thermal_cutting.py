@@ -203,7 +203,8 @@ def _build(dim, dp, quick, *, case, material, vc, tu, n_tu, travel, length, mass
                     ("conductivity_factor", conductivity_factor)):
         if not (np.isfinite(v) and v > 0):
             raise ValueError(f"option {name} must be positive, got {v!r}")
-    if float(conductivity_factor) != 1.0 and not parse_bool(conduction, "option conduction"):
+    conducting = parse_bool(conduction, "option conduction")
+    if float(conductivity_factor) != 1.0 and not conducting:
         raise ValueError("option conductivity_factor acts on the heat conduction; with conduction=false it would do "
                          "nothing")
     if not (np.isfinite(mass_scale) and mass_scale >= 0):
@@ -229,7 +230,7 @@ def _build(dim, dp, quick, *, case, material, vc, tu, n_tu, travel, length, mass
                         contact="penalty")
     thermal = friction_heat = None
     heat_of_dissipation = False
-    if parse_bool(conduction, "option conduction"):
+    if conducting:
         loss = SurfaceLoss(**RLA_SURFACE_LOSS, T_ambient=T0, detector=detector, alpha_radius=1.3 * dx, refresh=0.1)
         thermal = Conduction(k=mat["k_W_mK"] * float(conductivity_factor), courant=0.3,
                              tools={TOOL_BODY: (tool_mat["k_W_mK"], tool_mat["cp_J_kgK"])},

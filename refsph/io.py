@@ -273,6 +273,9 @@ def claim_run_folder(out, scene: str, method: str, overwrite: bool = False) -> l
     out = Path(out)
     if out.exists() and not out.is_dir():
         raise ValueError(f"--out {out} is a file, not a folder")
+    blocking = next((p for p in out.parents if p.exists() and not p.is_dir()), None)
+    if blocking is not None:           # e.g. --out FILE for a scene run with two methods (FILE/esph, FILE/tlsph)
+        raise ValueError(f"--out {out}: {blocking} is a file, not a folder")
     if not out.exists():
         return []
     everything = [p for p in out.rglob("*") if p.is_file()]

@@ -55,6 +55,16 @@ def test_the_same_scene_and_method_reruns_in_place_and_keeps_the_users_files(tmp
         claim_run_folder(out / "notes.txt", "bar", "tlsph")
 
 
+def test_out_naming_a_file_is_refused_for_a_scene_with_two_methods(tmp_path, capsys):
+    """Taylor runs ESPH and TLSPH into OUT/esph and OUT/tlsph: where OUT is a file, the run is refused with exit 2
+    and a message naming the file, and the file is left as it was (nothing is created beside it)."""
+    notes = tmp_path / "notes.txt"
+    notes.write_text("keep me")
+    assert main(["run", "taylor", "--dim", "2", "--out", str(notes)] + QUICK) == 2
+    assert f"{notes} is a file, not a folder" in capsys.readouterr().err
+    assert notes.read_text() == "keep me" and [p.name for p in tmp_path.iterdir()] == ["notes.txt"]
+
+
 def test_a_run_whose_folder_vanishes_stops_and_says_so(tmp_path, capsys):
     out = tmp_path / "gone"
     calls = []

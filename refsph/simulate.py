@@ -100,7 +100,9 @@ def make_solver(method: str, setup: Setup) -> Solver:
                              "through the SPH sums and have no friction model (set contact='penalty' with a tool "
                              "that has a shape, run TLSPH, or set friction=None)")
         if setup.dissipation_heat:
-            raise ValueError("dissipation_heat is a TLSPH option (ESPH's artificial viscosity heat is not computed)")
+            raise ValueError("dissipation_heat is a TLSPH option (ESPH's artificial viscosity heat is not computed); "
+                             "a scene that turns it on by default (thermal_cutting) runs ESPH only with "
+                             "--option dissipation_heat=false")
         if nm.hourglass:
             raise ValueError("hourglass control is a TLSPH option (ESPH's neighbours change every step, its zig-zag "
                              "modes are the tensile instability's, see gamma)")

@@ -149,9 +149,10 @@ def test_scene_options_and_refusals():
         scene.setup(case=13, jitter=0.5)
     with pytest.raises(ValueError, match="material"):
         scene.setup(material="copper")
-    with pytest.raises(ValueError, match="case"):
-        scene.setup(case=19)
-    with pytest.raises(ValueError, match="dissipation_heat"):         # ESPH has the friction, not the viscous heat
+    for bad in (19, -1, 2.5):
+        with pytest.raises(ValueError, match="option case must be a whole number 0-18"):
+            scene.setup(case=bad)
+    with pytest.raises(ValueError, match="dissipation_heat=false"):   # ESPH has the friction, not the viscous heat
         run("thermal_cutting", "esph", quick=True, progress=False, options=dict(length=0.6e-3, travel=1.0))
 
 

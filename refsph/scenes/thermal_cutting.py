@@ -162,7 +162,7 @@ def tool_shape(tu: float, apex, centroid, length: float = 5.0, depth: float = 3.
 
 
 def _case_values(case, material, vc, tu):
-    if not (np.isfinite(case) and float(case) == int(case)):
+    if not (np.isfinite(case) and float(case) == int(case)) or not 0 <= int(case) <= 18:
         raise ValueError(f"option case must be a whole number 0-18, got {case!r}")
     if int(case) != 0:
         given = [f"{k} = {v!r}" for k, v, default in (("material", material, OPTIONS["material"][0]),

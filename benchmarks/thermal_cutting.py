@@ -1806,6 +1806,8 @@ def _study_lines(res: dict) -> list[str]:
         if keys == REFINED_RESOLUTION:
             lines += _resolution_lines(res, REFINED_RESOLUTION_KEYS, REFINED_NOISE, "refined_orders")
         lines += [_single_run_line(res, k, group) for group, singles in TABLE_SINGLES.get(keys, ()) for k in singles]
+        if keys == CONDUCTIVITY_RUNS:
+            lines += [_pair_change_line(res, CONDUCTIVITY_RUNS[-1], CONDUCTIVITY_RUNS[-2], PFEM_SCATTER10)]
         if keys == HALF_STEP_RUNS:
             lines += ["", _group_errors(res)]
         if keys == REFINED_RUNS:
@@ -2012,6 +2014,24 @@ def _single_run_line(res: dict, key: str, group) -> str:
         parts.append(f"{name} {100 * d / abs(y.mean()):+.1f} %" + (f" (z = {d / sd:+.1f})" if sd > 0 else ""))
     return (f"\n'{key}' less the mean of these {len(g['Fc'])} runs, percent of it (z: in their standard "
             "deviations): " + ", ".join(parts) + ".")
+
+
+def _pair_change_line(res: dict, key: str, base: str, group) -> str:
+    """One run less another (``base``), in percent of the latter and in units of a scatter group's relative standard
+    deviation (z: the percent change over the group's standard deviation in percent of its mean), for two single
+    runs whose own scatter is not measured but a like case's is."""
+    r, b, g = res["runs"].get(key), res["runs"].get(base), _groups(res, group)
+    if any(x is None or x.get("status") != "ok" for x in (r, b)) or len(g["Fc"]) < 2:
+        return f"\n'{key}' against '{base}': not recorded yet, or fewer than two runs in its scatter group."
+    v, w, parts = _values(r), _values(b), []
+    for name, q, _ in BASIC:
+        if v.get(q) is None or w.get(q) is None or not (np.isfinite(v[q]) and np.isfinite(w[q])):
+            continue
+        d = 100 * (v[q] - w[q]) / abs(w[q])
+        sd = 100 * g[q].std(ddof=1) / abs(g[q].mean())
+        parts.append(f"{name} {d:+.1f} %" + (f" (z = {d / sd:+.1f})" if sd > 0 else ""))
+    return (f"\n'{key}' less '{base}', percent of the latter (z: in the relative standard deviation of "
+            f"'{group[0]}' and its {len(g['Fc']) - 1} jittered runs): " + ", ".join(parts) + ".")
 
 
 def _groups(res: dict, keys) -> dict:

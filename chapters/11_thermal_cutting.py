@@ -454,8 +454,8 @@ display(Markdown(slopes.split("\n\nWhich part of the thrust")[0]))      # the ta
 # * **Nor does the conductivity** (the page's 'conductivity' study; `--option conductivity_factor`). Table A1 holds
 #   each workpiece's room-temperature $k$; Ti6Al4V's about doubles by 1000 K, a carbon steel's falls by about 40 %.
 #   Doubled, Ti6Al4V's $k$ takes 36 K (SPH) and 69 K (PFEM) off case 10's rake face, which stands 274-310 K above
-#   the measurement; steel's at 0.6 heats case 1's by 49 K, away from it. A temperature-dependent $k$ would move
-#   both materials the wrong way or too little.
+#   the measurement; steel's at 0.6 heats case 1's by 49 K (SPH) and 70 K (PFEM), away from it. A
+#   temperature-dependent $k$ would move both materials the wrong way or too little.
 #
 # ## Your turn
 #

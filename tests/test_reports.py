@@ -239,6 +239,24 @@ def test_thermal_cutting_single_run_against_a_scatter_group():
     assert "not recorded yet" in mod._single_run_line(res, "one", ("a",))
 
 
+def test_thermal_cutting_pair_change_in_units_of_a_like_case_s_scatter():
+    """Two single runs: the change in percent of the base run, and z in the scatter group's relative standard
+    deviation (a group at 90 and 110 has 14.1 %, so a 10 % change is z = 0.71); missing runs are said, not drawn."""
+    mod = _script("thermal_cutting")
+    rec = lambda fc: dict(status="ok", dp=1e-5, scene_info=dict(tu_m=1e-4),        # noqa: E731
+                          metrics=dict(cutting_force_N_per_m=1e3 * fc, passive_force_N_per_m=5e4, force_ratio=50 / fc,
+                                       rake_face_temperature_K=600.0, rake_face_temperature_max_K=650.0,
+                                       free_chip_surface_temperature_K=500.0, chip_thickness_mm=0.3,
+                                       contact_length_mm=0.3))
+    res = dict(runs={"g": rec(90.0), "g jitter 1": rec(110.0), "base": rec(200.0), "new": rec(220.0)})
+    line = mod._pair_change_line(res, "new", "base", ("g", "g jitter 1"))
+    rel_sd = 100 * np.std([90.0, 110.0], ddof=1) / 100.0
+    assert f"Fc [N/mm] +10.0 % (z = {10.0 / rel_sd:+.1f})" in line and "Fp [N/mm] +0.0 %," in line
+    assert "its 1 jittered runs" in line
+    assert "not recorded yet" in mod._pair_change_line(res, "new", "missing", ("g", "g jitter 1"))
+    assert "not recorded yet" in mod._pair_change_line(res, "new", "base", ("g",))
+
+
 def test_thermal_cutting_status_reads_records_and_run_folders(tmp_path, monkeypatch):
     """thermal_cutting --status: a recorded job shows its record's status, a job whose run folder has a summary
     shows how far it got (simulated time against the end), any other is 'to run'."""

@@ -136,6 +136,7 @@ def test_thermal_cutting_rake_face_ceiling_is_merchants_bound():
     steel = c["AISI1045"]
     assert steel["ceiling_mu0"] == pytest.approx(math.tan(math.atan(0.81) - math.radians(10.0)), rel=1e-12)
     assert steel["ceiling_T"][1] < steel["ceiling_mu0"] and steel["error_T"] > steel["error_mu0"] > 0
+    assert steel["error_T"] > steel["error_T_cooler"] > steel["error_mu0"]      # a cooler face: mu(T) nearer mu0
     assert steel["above"]["_exp"] == 9 and steel["above"][""] == steel["recorded"] == 0   # no refsph record
     for r in rows:                                   # a measured ratio on the ceiling: error 0, not counted above it
         if r["material"] == "AISI1045":

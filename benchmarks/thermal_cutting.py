@@ -951,7 +951,8 @@ def _rake_gap_lines(gaps: list) -> list[str]:
 def _ceiling_lines(rows: list) -> list[str]:
     return [f"| {c['material']} | {c['mu0']:.2f} | {c['measured'][0]:.2f}-{c['measured'][1]:.2f} | "
             f"{c['ceiling_mu0']:.3f} | {c['error_mu0']:.1f} | {c['ceiling_T'][0]:.3f}-{c['ceiling_T'][1]:.3f} | "
-            f"{c['error_T']:.1f} | {c['error_T_cooler']:.1f} | " + " / ".join(str(c["above"][k]) for k in ("_exp", "_sph", "_pfem"))
+            f"{c['error_T']:.1f} | {c['error_T_cooler']:.1f} | "
+            + " / ".join(str(c["above"][k]) for k in ("_exp", "_sph", "_pfem"))
             + f" / {c['above']['']} of {c['recorded']} |"
             for c in rake_face_ceiling(rows)]
 

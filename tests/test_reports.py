@@ -223,16 +223,19 @@ def test_pfem_step_cost_report_is_generated_from_the_json_and_the_versions_agree
             assert f == pytest.approx(forces[0], rel=1e-6), (n_tu, forces)
 
 
+def _cut_rec(fc: float) -> dict:
+    """A sweep record that ended well with Fc = fc N/mm, Fp = 50 N/mm and fixed temperatures and chip."""
+    return dict(status="ok", dp=1e-5, scene_info=dict(tu_m=1e-4),
+                metrics=dict(cutting_force_N_per_m=1e3 * fc, passive_force_N_per_m=5e4, force_ratio=50 / fc,
+                             rake_face_temperature_K=600.0, rake_face_temperature_max_K=650.0,
+                             free_chip_surface_temperature_K=500.0, chip_thickness_mm=0.3, contact_length_mm=0.3))
+
+
 def test_thermal_cutting_single_run_against_a_scatter_group():
     """One run against the mean and standard deviation of a scatter group, from the records: a group made of one
     run's copies has no spread (no z), and a run 10 % above a group of two at 100 +- 10 % is z = +1."""
     mod = _script("thermal_cutting")
-    rec = lambda fc: dict(status="ok", dp=1e-5, scene_info=dict(tu_m=1e-4),        # noqa: E731
-                          metrics=dict(cutting_force_N_per_m=1e3 * fc, passive_force_N_per_m=5e4, force_ratio=50 / fc,
-                                       rake_face_temperature_K=600.0, rake_face_temperature_max_K=650.0,
-                                       free_chip_surface_temperature_K=500.0, chip_thickness_mm=0.3,
-                                       contact_length_mm=0.3))
-    res = dict(runs={"a": rec(90.0), "b": rec(110.0), "one": rec(110.0)})
+    res = dict(runs={"a": _cut_rec(90.0), "b": _cut_rec(110.0), "one": _cut_rec(110.0)})
     line = mod._single_run_line(res, "one", ("a", "b"))
     sd = np.std([90.0, 110.0], ddof=1)
     assert f"Fc [N/mm] +10.0 % (z = {10.0 / sd:+.1f})" in line and "Fp [N/mm] +0.0 %," in line
@@ -244,12 +247,8 @@ def test_thermal_cutting_pair_change_in_units_of_a_like_case_s_scatter():
     """Two single runs: the change in percent of the base run, and z in the scatter group's relative standard
     deviation (a group at 90 and 110 has 14.1 %, so a 10 % change is z = 0.71); missing runs are said, not drawn."""
     mod = _script("thermal_cutting")
-    rec = lambda fc: dict(status="ok", dp=1e-5, scene_info=dict(tu_m=1e-4),        # noqa: E731
-                          metrics=dict(cutting_force_N_per_m=1e3 * fc, passive_force_N_per_m=5e4, force_ratio=50 / fc,
-                                       rake_face_temperature_K=600.0, rake_face_temperature_max_K=650.0,
-                                       free_chip_surface_temperature_K=500.0, chip_thickness_mm=0.3,
-                                       contact_length_mm=0.3))
-    res = dict(runs={"g": rec(90.0), "g jitter 1": rec(110.0), "base": rec(200.0), "new": rec(220.0)})
+    res = dict(runs={"g": _cut_rec(90.0), "g jitter 1": _cut_rec(110.0), "base": _cut_rec(200.0),
+                     "new": _cut_rec(220.0)})
     line = mod._pair_change_line(res, "new", "base", ("g", "g jitter 1"))
     rel_sd = 100 * np.std([90.0, 110.0], ddof=1) / 100.0
     assert f"Fc [N/mm] +10.0 % (z = {10.0 / rel_sd:+.1f})" in line and "Fp [N/mm] +0.0 %," in line

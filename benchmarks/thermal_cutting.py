@@ -2100,6 +2100,45 @@ def figures(res: dict) -> None:
     plt.close(fig)
     resolution_figure(res, plt)
     dof_figure(dof_rows(res), plt)
+    ceiling_figure(ceiling_series(res), plt)
+
+
+def ceiling_series(res: dict) -> dict:
+    """{label: (comparison rows, marker, colour)} that :func:`ceiling_figure` draws: refsph's SPH at reference update
+    0.1 (the 'refined' study) and its PFEM at t_u/10."""
+    return {"refsph SPH, ref update 0.1": (comparison(res, REFINED), "o", "C3"),
+            "refsph PFEM": (comparison(res, PFEM10), "D", "C0")}
+
+
+def ceiling_figure(predicted: dict, plt) -> None:
+    """Fp/Fc against the rake-face temperature, per material: Merchant's ceiling of the rake face's Coulomb friction
+    under the paper's law, tan(atan(mu(T)) - gamma) (:func:`rake_face_ceiling`), as a curve; the measured cuts, the
+    paper's SPH and PFEM, and ``predicted`` ({label: (comparison rows, marker, colour)}) as points at their own T_RF.
+    A point above the curve has more thrust than friction on the rake face gives at that temperature; the band is
+    the T_RF target's 15 % below each measured point."""
+    fig, axes = plt.subplots(1, 2, figsize=(11, 4.2), constrained_layout=True)
+    for ax, mat in zip(axes, MATERIAL_NAMES):
+        _, _, ceiling = _ceiling_law(mat)
+        T = np.linspace(293.0, 1600.0, 200)
+        ax.plot(T, [ceiling(t) for t in T], "k-", lw=1.5, label="ceiling: rake-face friction, tan(atan mu(T) - 10 deg)")
+        rows = [r for r in predicted[next(iter(predicted))][0] if r["material"] == mat]
+        for r in rows:
+            ax.plot([(1.0 - TRF_TARGET) * r["TRF_exp"], r["TRF_exp"]], [r["ratio_exp"]] * 2, "-", color="0.8", lw=4)
+        for src, marker, label in (("_exp", "s", "measured"), ("_sph", "s", "paper SPH"), ("_pfem", "^", "paper PFEM")):
+            pts = np.array([(r[f"TRF{src}"], r[f"ratio{src}"]) for r in rows])
+            ax.plot(pts[:, 0], pts[:, 1], marker, mfc="none" if src != "_exp" else "k",
+                    color="k" if src == "_exp" else "0.5", label=label)
+        for label, (pred, marker, colour) in predicted.items():
+            pts = np.array([(r["TRF"], r["ratio"]) for r in pred
+                            if r["material"] == mat and r["TRF"] is not None and r["ratio"] is not None])
+            if len(pts):
+                ax.plot(pts[:, 0], pts[:, 1], marker, color=colour, label=label)
+        ax.set_xlabel("rake-face temperature T_RF [K]")
+        ax.set_ylabel("Fp / Fc")
+        ax.set_title(f"{mat} (grey bars: 15 % below each measured T_RF)")
+        ax.set_ylim(0.0, 1.0)
+        ax.legend(fontsize=7)
+    study.save_figure(fig, FIG / "11_thermal_cutting_ceiling.png", dpi=100)
 
 
 def dof_figure(rows: list[dict], plt) -> None:

@@ -848,6 +848,28 @@ def test_thermal_cutting_dof_figure_is_what_the_code_draws(tmp_path):
     assert new.shape == old.shape and np.abs(new - old).max() < 0.05
 
 
+def test_thermal_cutting_ceiling_figure_is_what_the_code_draws(tmp_path):
+    """The Fp/Fc-T_RF figure is drawn from the committed JSON, and what it shows holds: every measured Fp/Fc lies above
+    the rake-face friction ceiling at its measured T_RF and at 15 % below it, for both materials."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    mod = _script("thermal_cutting")
+    mod.FIG = tmp_path
+    series = mod.ceiling_series(json.loads((ROOT / "benchmarks" / "thermal_cutting.json").read_text()))
+    rows = next(iter(series.values()))[0]
+    for mat in mod.MATERIAL_NAMES:
+        _, _, ceiling = mod._ceiling_law(mat)
+        mine = [r for r in rows if r["material"] == mat]
+        assert len(mine) == 9
+        for f in (1.0, 1.0 - mod.TRF_TARGET):
+            assert all(r["ratio_exp"] > ceiling(f * r["TRF_exp"]) for r in mine), (mat, f)
+    mod.ceiling_figure(series, plt)
+    figure = "11_thermal_cutting_ceiling.png"
+    new, old = matplotlib.image.imread(tmp_path / figure), matplotlib.image.imread(ROOT / "figures" / figure)
+    assert new.shape == old.shape and np.abs(new - old).max() < 0.05
+
+
 def test_thermal_cutting_refined_figure_draws_each_recorded_case_of_both_numerics():
     """The 'refined' figure: measured_cuts with REFINED_SERIES draws the t_u/10 table's 18 cases and, for the
     reference update 0.1, exactly the cases recorded ok."""

@@ -2003,7 +2003,9 @@ REF_SINGLES = ((SCATTER_T5, tuple(f"case 1{COARSE}{REF_KEY}{r:g}" for r in REF_U
                                       if r < SCENE_REF_UPDATE and r != REF_UPDATE)),   # ... and at REF_UPDATE's
                (SCATTER_KEYS, (f"case 1{REF_KEY}{REF_UPDATE:g}",)),
                (SCATTER_TI10, (f"case 10{REF_KEY}{REF_UPDATE:g}",)))
-TABLE_SINGLES = {REF_RUNS: REF_SINGLES, GAP_RUNS: GAP_SINGLES}   # a table -> (group, its single runs) read under it
+TABLE_SINGLES = {REF_RUNS: REF_SINGLES, GAP_RUNS: GAP_SINGLES,   # a table -> (group, its single runs) read under it
+                 # the refined numerics' step checked: case 1 at 0.1, fixed courant 0.075, against its scatter there
+                 GAIN_RUNS: ((SCATTER_REF, (f"case 1{REF_KEY}{REF_UPDATE:g}{RETRY}",)),)}
 
 
 def _single_run_line(res: dict, key: str, group) -> str:

@@ -316,7 +316,8 @@ for title in ("## Mass scaling", "## The mass scale", "## Run-to-run scatter at 
 
 # %% mystnb={"markdown_format": "gfm"}
 ceiling = page.split("## What friction on the rake face alone")[1].split("\n## ")[0]
-display(Markdown(ceiling.split("\n\n", 2)[2]))               # its tables, without the heading and first prose
+ceiling = "\n".join(x for x in ceiling.split("\n\n", 2)[2].split("\n") if not x.startswith("!["))   # no figure
+display(Markdown(ceiling))                                   # its tables, without the heading and first prose
 split_page = (repository_root() / "benchmarks" / "force_split_report.md").read_text()
 display(Markdown(split_page.split("\n\n", 1)[1]))             # the page without its title
 
